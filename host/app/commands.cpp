@@ -1,0 +1,258 @@
+#include "app/commands.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <thread>
+#include <filesystem>
+#include <memory>
+#include <numeric>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cl/cl_runtime.h"
+#include "cl/device.h"
+#include "cl/image_kernels.h"
+#include "render/image_io.h"
+#include "scene/scene_loader.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+#ifndef RTPG_SOURCE_DIR
+#define RTPG_SOURCE_DIR "."
+#endif
+
+namespace rtpg {
+namespace fs = std::filesystem;
+namespace {
+
+// The documented, fixed display transform of PNG output (kernels/shared/tonemap.h).
+constexpr float kPngExposure = 1.0f;
+
+std::string extension_of(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+void check_output_path(const std::string& path, const char* flag, bool png_allowed) {
+  if (path.empty()) return;
+  const std::string ext = extension_of(path);
+  if (ext != ".exr" && !(png_allowed && ext == ".png"))
+    throw InputError(flag, "output must end in .exr" + std::string(png_allowed ? " or .png" : "") +
+                               ", got '" + path + "'");
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent))
+    throw InputError(path, "folder '" + parent.string() + "' does not exist");
+}
+
+Scene load(const CommonOptions& common) {
+  const std::string path = common.scene.empty() ? default_scene_path() : common.scene;
+  SceneLoadOptions options;
+  options.asset_root = common.asset_root;
+  return load_scene(path, options);
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+ImageRgb to_image(const Renderer& renderer) {
+  ImageRgb image;
+  image.width = renderer.settings().width;
+  image.height = renderer.settings().height;
+  image.pixels = renderer.image();
+  return image;
+}
+
+void write_output(const std::string& path, const ImageRgb& image, ClRuntime& cl,
+                  const std::map<std::string, std::string>& metadata) {
+  if (extension_of(path) == ".png") {
+    std::vector<glm::vec4> radiance(image.pixels.size());
+    for (std::size_t i = 0; i < radiance.size(); ++i) radiance[i] = glm::vec4(image.pixels[i], 1.0f);
+    std::vector<std::uint8_t> rgba8;
+    tonemap_on_device(cl, radiance, image.width, image.height, kPngExposure, rgba8);
+    write_png(path, image.width, image.height, rgba8);
+  } else {
+    write_exr(path, image, metadata);
+  }
+}
+
+}  // namespace
+
+std::string default_scene_path() {
+  if (fs::exists("scenes/cornell-box.json")) return "scenes/cornell-box.json";
+  return std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json";
+}
+
+int run_render(const RenderOptions& options) {
+  check_output_path(options.output, "--output", true);
+  if (options.frames <= 0) throw InputError("--frames", "must be at least 1");
+  ImageRgb reference;
+  if (!options.reference.empty()) {
+    reference = read_image(options.reference);
+    if (reference.width != options.settings.width || reference.height != options.settings.height)
+      throw InputError(options.reference,
+                       fmt::format("reference is {}x{}, the render is {}x{}", reference.width,
+                                   reference.height, options.settings.width, options.settings.height));
+  }
+  const std::string scene_path = options.common.scene.empty() ? default_scene_path() : options.common.scene;
+  const Scene scene = load(options.common);
+  ClRuntime cl(options.common.device);
+  Renderer renderer(scene, options.settings);
+
+  nlohmann::json frames = nlohmann::json::array();
+  std::vector<double> totals;
+  double last_relmse = -1.0;
+  std::uint64_t nonfinite = 0;
+  for (int f = 0; f < options.frames; ++f) {
+    FrameStats stats = renderer.render_frame(f);
+    totals.push_back(stats.time_ms["total"]);
+    nonfinite += stats.nonfinite_samples;
+    nlohmann::json frame = {{"index", f},
+                            {"time_ms", stats.time_ms},
+                            {"nonfinite_samples", stats.nonfinite_samples},
+                            {"rays", {{"primary", stats.primary_rays},
+                                      {"secondary", stats.secondary_rays},
+                                      {"shadow", stats.shadow_rays}}}};
+    for (const auto& [key, value] : stats.extra) frame[key] = value;
+    if (!options.reference.empty()) {
+      last_relmse = relative_mse(to_image(renderer), reference);
+      frame["relmse"] = last_relmse;
+    }
+    frames.push_back(frame);
+    if (!options.common.quiet && options.frames > 1)
+      std::printf("frame %d: %.1f ms%s\n", f, stats.time_ms["total"],
+                  last_relmse >= 0.0 ? fmt::format(", relMSE {:.4g}", last_relmse).c_str() : "");
+  }
+
+  if (!options.output.empty()) {
+    write_output(options.output, to_image(renderer), cl,
+                 {{"scene", scene_path},
+                  {"spp", std::to_string(options.settings.spp)},
+                  {"seed", std::to_string(options.settings.seed)},
+                  {"frame", std::to_string(options.frames - 1)},
+                  {"render_time_ms", fmt::format("{:.3f}", totals.back())},
+                  {"guiding", options.guiding}});
+  }
+  if (!options.stats_json.empty()) {
+    const nlohmann::json stats = {{"scene", scene_path},
+                                  {"width", options.settings.width},
+                                  {"height", options.settings.height},
+                                  {"spp", options.settings.spp},
+                                  {"seed", options.settings.seed},
+                                  {"jitter", options.settings.jitter},
+                                  {"guiding", options.guiding},
+                                  {"device", cl.info().device_name},
+                                  {"threads", static_cast<int>(std::thread::hardware_concurrency())},
+                                  {"bvh_build_ms", renderer.tracer().build_seconds() * 1e3},
+                                  {"frames", frames}};
+    write_text_atomically(options.stats_json, stats.dump(2) + "\n");
+  }
+  if (!options.common.quiet) {
+    std::printf("rendered %s at %dx%d, %d spp, %d frame%s (guiding %s) on %s + Embree\n",
+                scene_path.c_str(), options.settings.width, options.settings.height,
+                options.settings.spp, options.frames, options.frames == 1 ? "" : "s",
+                options.guiding.c_str(), cl.info().device_name.c_str());
+    std::printf("time per frame: %.1f ms (median of %zu)%s\n", median(totals), totals.size(),
+                nonfinite ? fmt::format(", {} non-finite samples dropped", nonfinite).c_str() : "");
+    if (last_relmse >= 0.0) std::printf("relMSE of the last frame: %.5g\n", last_relmse);
+    if (!options.output.empty()) std::printf("wrote %s\n", options.output.c_str());
+  }
+  return 0;
+}
+
+int run_reference(const ReferenceOptions& options) {
+  check_output_path(options.output, "--output", false);
+  if (options.spp <= 0) throw InputError("--spp", "must be at least 1");
+  const Scene scene = load(options.common);
+  RenderSettings settings;
+  settings.width = options.width;
+  settings.height = options.height;
+  settings.seed = options.seed;
+  // Several samples share a G-buffer; new jitter per pass gives the pixel filter's integral.
+  settings.spp = options.spp % 4 == 0 ? 4 : 1;
+  const int passes = options.spp / settings.spp;
+  Renderer renderer(scene, settings);
+  const bool progress = !options.common.quiet && ::isatty(STDERR_FILENO);
+  ImageRgb sum;
+  sum.width = options.width;
+  sum.height = options.height;
+  sum.pixels.assign(static_cast<std::size_t>(options.width) * options.height, glm::vec3(0.0f));
+  std::uint64_t nonfinite = 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (int p = 0; p < passes; ++p) {
+    nonfinite += renderer.render_frame(p).nonfinite_samples;
+    const auto& img = renderer.image();
+    for (std::size_t i = 0; i < img.size(); ++i) sum.pixels[i] += img[i];
+    if (progress) {
+      const int width = 40, filled = (p + 1) * width / passes;
+      std::fprintf(stderr, "\r[%s%s] %d/%d spp", std::string(filled, '#').c_str(),
+                   std::string(width - filled, ' ').c_str(), (p + 1) * settings.spp, options.spp);
+      std::fflush(stderr);
+    }
+  }
+  if (progress) std::fprintf(stderr, "\n");
+  for (auto& px : sum.pixels) px /= static_cast<float>(passes);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  write_exr(options.output, sum,
+            {{"scene", options.common.scene},
+             {"spp", std::to_string(options.spp)},
+             {"seed", std::to_string(options.seed)},
+             {"render_time_ms", fmt::format("{:.1f}", seconds * 1e3)},
+             {"nonfinite_samples", std::to_string(nonfinite)}});
+  if (!options.common.quiet)
+    std::printf("reference %s: %dx%d, %d spp in %.1f s -> %s\n", options.common.scene.c_str(),
+                options.width, options.height, options.spp, seconds, options.output.c_str());
+  return 0;
+}
+
+int run_info(const CommonOptions& options) {
+  const Scene scene = load(options);
+  const SceneFeatures f = scene.features();
+  std::size_t emissive_triangles = 0;
+  for (const Mesh& m : scene.meshes)
+    if (scene.materials[m.material].is_emissive()) emissive_triangles += m.triangles.size();
+  const glm::vec3 lo = scene.bounds_min(), hi = scene.bounds_max();
+  std::printf("scene: %s\n", scene.source_path.c_str());
+  std::printf("triangles: %zu\nmeshes: %zu\nmaterials: %zu\ntextures: %zu\n", scene.triangle_count(),
+              scene.meshes.size(), scene.materials.size(), scene.textures.size());
+  std::printf("lights: %zu emissive triangles, sun: %s, environment: %s\n", emissive_triangles,
+              scene.sun.enabled ? "yes" : "no",
+              scene.environment.kind == Environment::Kind::None       ? "none"
+              : scene.environment.kind == Environment::Kind::Constant ? "constant"
+                                                                       : "map");
+  std::printf("bounds: [%g %g %g] - [%g %g %g]\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
+  std::printf("camera paths: %zu", scene.camera.paths.size());
+  for (const auto& [name, path] : scene.camera.paths) std::printf(" %s", name.c_str());
+  std::printf("\nfeatures:");
+  const std::pair<const char*, bool> list[] = {
+      {"textures", f.textures},       {"normal_maps", f.normal_maps}, {"bump_maps", f.bump_maps},
+      {"alpha_masks", f.alpha_masks}, {"area_lights", f.area_lights}, {"sun", f.sun},
+      {"environment", f.environment}, {"environment_map", f.environment_map},
+      {"glossy", f.glossy},           {"metallic", f.metallic},       {"transmission", f.transmission},
+      {"camera_paths", f.camera_paths}};
+  for (const auto& [name, on] : list)
+    if (on) std::printf(" %s", name);
+  std::printf("\n");
+  return 0;
+}
+
+int run_devices() {
+  const auto devices = list_devices();
+  for (const DeviceInfo& d : devices)
+    std::printf("%u:%u  %-5s %s (%s), %s, %u compute units, %llu KiB local memory\n",
+                d.platform_index, d.device_index, d.type.c_str(), d.device_name.c_str(),
+                d.platform_name.c_str(), d.opencl_c_version.c_str(), d.compute_units,
+                static_cast<unsigned long long>(d.local_mem_size / 1024));
+  if (devices.empty()) std::printf("no OpenCL devices\n");
+  return devices.empty() ? 1 : 0;
+}
+
+}  // namespace rtpg

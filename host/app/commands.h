@@ -1,0 +1,44 @@
+// The subcommands of the rtpg program. main.cpp parses flags into these options.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "render/renderer.h"
+
+namespace rtpg {
+
+struct CommonOptions {
+  std::string scene;       // "" = the built-in default scene
+  std::string asset_root;  // "" = RTPG_ASSET_ROOT or ../shared/scenes
+  std::string device;      // "" = RTPG_DEVICE or a GPU, else the CPU
+  bool quiet = false;
+};
+
+struct RenderOptions {
+  CommonOptions common;
+  RenderSettings settings;
+  int frames = 1;
+  std::string output;      // .exr or .png; "" = none
+  std::string reference;   // EXR to compute relMSE against
+  std::string stats_json;  // "" = none
+  std::string guiding = "off";
+};
+
+struct ReferenceOptions {
+  CommonOptions common;
+  int width = 640, height = 360, spp = 1024;
+  std::uint32_t seed = 0;
+  std::string output;
+};
+
+int run_render(const RenderOptions& options);
+int run_reference(const ReferenceOptions& options);
+int run_info(const CommonOptions& options);
+int run_devices();
+
+// The scene used when none is given: scenes/cornell-box.json of the source tree or of the
+// installed share folder.
+std::string default_scene_path();
+
+}  // namespace rtpg

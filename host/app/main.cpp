@@ -1,0 +1,110 @@
+// rtpg: real-time path guiding. Parses the command line and runs one subcommand; bad input
+// ends with a one-line message and exit code 2.
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "app/commands.h"
+#include "cl/cl_error.h"
+#include "util/error.h"
+
+namespace {
+
+void add_common(CLI::App* cmd, rtpg::CommonOptions& common, bool scene_required) {
+  auto* scene = cmd->add_option("scene", common.scene, "Scene JSON file (default: scenes/cornell-box.json)");
+  if (scene_required) scene->required();
+  cmd->add_option("--asset-root", common.asset_root,
+                  "Folder for scene assets (default: $RTPG_ASSET_ROOT, else ../shared/scenes)");
+  cmd->add_option("--device", common.device,
+                  "OpenCL device: gpu, cpu, P:D or part of its name (default: $RTPG_DEVICE, else a GPU, else the CPU)");
+  cmd->add_flag("-q,--quiet", common.quiet, "Print nothing but errors");
+}
+
+bool parse_resolution(const std::string& text, int& w, int& h) {
+  unsigned long long pw = 0, ph = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%llu%c%llu%c", &pw, &x, &ph, &extra) != 3 || (x != 'x' && x != 'X'))
+    return false;
+  if (pw > 1000000 || ph > 1000000) return false;
+  w = static_cast<int>(pw);
+  h = static_cast<int>(ph);
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rtpg: real-time screen-space path guiding (Embree + OpenCL)"};
+  app.require_subcommand(1);
+
+  rtpg::RenderOptions render;
+  std::string render_res = "640x360";
+  auto* render_cmd = app.add_subcommand("render", "Render frames of a scene");
+  add_common(render_cmd, render.common, false);
+  render_cmd->add_option("--res", render_res, "Resolution WxH")->capture_default_str();
+  render_cmd->add_option("--spp", render.settings.spp, "Samples per pixel per frame")->capture_default_str();
+  render_cmd->add_option("--frames", render.frames, "Number of frames")->capture_default_str();
+  render_cmd->add_option("--seed", render.settings.seed, "Random seed")->capture_default_str();
+  render_cmd->add_flag("--no-jitter", [&](std::int64_t) { render.settings.jitter = false; },
+                       "Sample pixel centres (no sub-pixel jitter)");
+  render_cmd->add_option("--camera-path", render.settings.camera_path, "Named camera path of the scene");
+  render_cmd->add_option("--max-bounces", render.settings.path_tracer.max_bounces,
+                         "Path vertices after the primary hit")->capture_default_str();
+  render_cmd->add_flag("--no-nee", [&](std::int64_t) { render.settings.path_tracer.next_event = false; },
+                       "BSDF sampling only (no next-event estimation)");
+  render_cmd->add_option("-o,--output", render.output, "Last frame: .exr (linear) or .png (tonemapped)");
+  render_cmd->add_option("--reference", render.reference, "Reference EXR: relMSE per frame");
+  render_cmd->add_option("--stats-json", render.stats_json, "Write per-frame statistics as JSON");
+
+  rtpg::ReferenceOptions reference;
+  std::string reference_res = "640x360";
+  auto* reference_cmd = app.add_subcommand("reference", "Render a many-sample reference image");
+  add_common(reference_cmd, reference.common, true);
+  reference_cmd->add_option("--res", reference_res, "Resolution WxH")->capture_default_str();
+  reference_cmd->add_option("--spp", reference.spp, "Samples per pixel")->capture_default_str();
+  reference_cmd->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
+  reference_cmd->add_option("-o,--output", reference.output, "Output EXR")->required();
+
+  rtpg::CommonOptions info;
+  auto* info_cmd = app.add_subcommand("info", "Describe a scene");
+  add_common(info_cmd, info, true);
+
+  app.add_subcommand("devices", "List OpenCL devices");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "rtpg: %s\n", e.what());
+    return 2;
+  }
+
+  try {
+    if (*render_cmd) {
+      if (!parse_resolution(render_res, render.settings.width, render.settings.height))
+        throw rtpg::InputError("--res", "expected WxH, got '" + render_res + "'");
+      return rtpg::run_render(render);
+    }
+    if (*reference_cmd) {
+      if (!parse_resolution(reference_res, reference.width, reference.height))
+        throw rtpg::InputError("--res", "expected WxH, got '" + reference_res + "'");
+      return rtpg::run_reference(reference);
+    }
+    if (*info_cmd) return rtpg::run_info(info);
+    return rtpg::run_devices();
+  } catch (const rtpg::InputError& e) {
+    std::fprintf(stderr, "rtpg: %s\n", e.what());
+    return 2;
+  } catch (const rtpg::ClError& e) {
+    std::fprintf(stderr, "rtpg: OpenCL: %s\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rtpg: %s\n", e.what());
+    return 1;
+  }
+}

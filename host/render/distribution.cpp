@@ -1,0 +1,74 @@
+#include "render/distribution.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rtpg {
+
+Distribution1D::Distribution1D(std::vector<float> weights) : weights_(std::move(weights)) {
+  cdf_.assign(weights_.size() + 1, 0.0);
+  for (std::size_t i = 0; i < weights_.size(); ++i) {
+    if (!(weights_[i] > 0.0f) || !std::isfinite(weights_[i])) weights_[i] = 0.0f;
+    cdf_[i + 1] = cdf_[i] + weights_[i];
+  }
+  total_ = static_cast<float>(cdf_.back());
+}
+
+std::size_t Distribution1D::sample_discrete(float u, float* probability, float* remapped) const {
+  const double target = static_cast<double>(u) * cdf_.back();
+  auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), target);
+  std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - cdf_.begin()) - 1, weights_.size() - 1);
+  while (i > 0 && weights_[i] == 0.0f) --i;  // u at the very top of a run of empty cells
+  if (probability) *probability = this->probability(i);
+  if (remapped) {
+    const double width = cdf_[i + 1] - cdf_[i];
+    const double r = width > 0.0 ? (target - cdf_[i]) / width : 0.5;
+    *remapped = static_cast<float>(std::clamp(r, 0.0, 1.0 - 1e-7));
+  }
+  return i;
+}
+
+float Distribution1D::sample_continuous(float u, float* pdf, std::size_t* cell) const {
+  const std::size_t i = sample_discrete(u, nullptr);
+  const double lo = cdf_[i], width = cdf_[i + 1] - cdf_[i];
+  double offset = width > 0.0 ? (static_cast<double>(u) * cdf_.back() - lo) / width : 0.5;
+  offset = std::clamp(offset, 0.0, 1.0 - 1e-7);
+  const float n = static_cast<float>(weights_.size());
+  if (pdf) *pdf = total_ > 0.0f ? weights_[i] * n / total_ : 0.0f;
+  if (cell) *cell = i;
+  return std::min((static_cast<float>(i) + static_cast<float>(offset)) / n, 0.99999994f);
+}
+
+float Distribution1D::pdf_continuous(float x) const {
+  if (total_ <= 0.0f) return 0.0f;
+  const float n = static_cast<float>(weights_.size());
+  const std::size_t i = std::min(static_cast<std::size_t>(std::max(x, 0.0f) * n), weights_.size() - 1);
+  return weights_[i] * n / total_;
+}
+
+Distribution2D::Distribution2D(const std::vector<float>& weights, int width, int height) {
+  std::vector<float> row_totals(height);
+  rows_.reserve(height);
+  for (int y = 0; y < height; ++y) {
+    rows_.emplace_back(std::vector<float>(weights.begin() + static_cast<std::ptrdiff_t>(y) * width,
+                                          weights.begin() + static_cast<std::ptrdiff_t>(y + 1) * width));
+    row_totals[y] = rows_.back().total();
+  }
+  marginal_ = Distribution1D(std::move(row_totals));
+}
+
+void Distribution2D::sample(float u0, float u1, float& u, float& v, float& pdf) const {
+  float pdf_v = 0.0f, pdf_u = 0.0f;
+  std::size_t row = 0;
+  v = marginal_.sample_continuous(u1, &pdf_v, &row);
+  u = rows_[row].sample_continuous(u0, &pdf_u, nullptr);
+  pdf = pdf_v * pdf_u;
+}
+
+float Distribution2D::pdf(float u, float v) const {
+  const std::size_t h = rows_.size();
+  const std::size_t row = std::min(static_cast<std::size_t>(std::max(v, 0.0f) * static_cast<float>(h)), h - 1);
+  return marginal_.pdf_continuous(v) * rows_[row].pdf_continuous(u);
+}
+
+}  // namespace rtpg

@@ -1,0 +1,42 @@
+#include "render/first_bounce.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "shared/rng.h"
+
+namespace rtpg {
+
+void BsdfFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
+                             std::vector<FirstBounceSample>& out) {
+  out.resize(g.pixel_count());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, g.pixel_count(), 4096), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      FirstBounceSample& s = out[i];
+      s = FirstBounceSample{};
+      if (!g.has_surface(i)) continue;
+      shared::pg_rng rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
+                                               at.sample, /*stream_tag=*/1u);
+      const shared::pg_frame frame = gbuffer_frame(g, i);
+      const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
+      const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
+      const float u_lobe = shared::pg_rng_next(&rng);
+      const float u1 = shared::pg_rng_next(&rng);
+      const float u2 = shared::pg_rng_next(&rng);
+      const shared::pg_bsdf_sample_t bs = shared::pg_bsdf_sample(lobes, wo, u_lobe, u1, u2);
+      if (bs.pdf <= 0.0f) continue;
+      s.direction = shared::pg_to_world(frame, bs.wi);
+      s.pdf = bs.pdf;
+      s.strategy = kStrategyBsdf;
+    }
+  });
+}
+
+float BsdfFirstBounce::pdf(const GBuffer& g, std::size_t i, const glm::vec3& wi) const {
+  const shared::pg_frame frame = gbuffer_frame(g, i);
+  const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
+  const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
+  return shared::pg_bsdf_pdf(lobes, wo, shared::pg_to_local(frame, wi));
+}
+
+}  // namespace rtpg

@@ -1,0 +1,46 @@
+// The exchangeable step of the integrator: how the first bounce direction at the primary
+// hit is chosen. Plain path tracing samples the BSDF (BsdfFirstBounce); guiding replaces it
+// with the mixture of the paper (eq. 2) without touching the rest of the path tracer.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "render/gbuffer.h"
+
+namespace rtpg {
+
+// Which strategy produced a first-bounce direction (the paper trains only on kBsdf samples).
+enum FirstBounceStrategy : std::uint32_t { kStrategyNone = 0, kStrategyBsdf = 1, kStrategyGuide = 2 };
+
+struct FirstBounceSample {
+  glm::vec3 direction{0.0f};  // world space, unit
+  float pdf = 0.0f;           // solid-angle density of the whole sampler; 0 = no sample
+  std::uint32_t strategy = kStrategyNone;
+};
+
+struct SampleCoordinates {
+  std::uint32_t seed = 0, frame = 0, sample = 0;
+};
+
+class FirstBounceSampler {
+ public:
+  virtual ~FirstBounceSampler() = default;
+  // One direction for every surface pixel of the G-buffer (others get pdf 0).
+  virtual void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
+                      std::vector<FirstBounceSample>& out) = 0;
+  // The density sample() uses at pixel i for direction wi (world): next-event estimation at
+  // the primary hit needs it for its MIS weight.
+  virtual float pdf(const GBuffer& gbuffer, std::size_t i, const glm::vec3& wi) const = 0;
+};
+
+// BSDF importance sampling, on the host.
+class BsdfFirstBounce final : public FirstBounceSampler {
+ public:
+  void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
+              std::vector<FirstBounceSample>& out) override;
+  float pdf(const GBuffer& gbuffer, std::size_t i, const glm::vec3& wi) const override;
+};
+}  // namespace rtpg

@@ -1,0 +1,94 @@
+#include "render/image_io.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include "util/error.h"
+
+namespace rtpg {
+namespace fs = std::filesystem;
+namespace {
+
+// "dir/.name.tmp-<pid>.ext": same folder (so rename is atomic), same extension (OpenImageIO
+// picks the format from it).
+std::string temporary_path_for(const std::string& path) {
+  const fs::path p(path);
+  const std::string name = "." + p.stem().string() + ".tmp-" + std::to_string(::getpid()) + p.extension().string();
+  return (p.parent_path() / name).string();
+}
+
+void write_atomically(const std::string& path, int width, int height, int channels,
+                      OIIO::TypeDesc type, const void* data,
+                      const std::map<std::string, std::string>& metadata) {
+  const std::string tmp = temporary_path_for(path);
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) throw InputError(path, "cannot write this image format: " + OIIO::geterror());
+  OIIO::ImageSpec spec(width, height, channels, type);
+  for (const auto& [key, value] : metadata) spec.attribute("rtpg:" + key, value);
+  if (!out->open(tmp, spec)) {
+    const std::string err = out->geterror();
+    std::remove(tmp.c_str());
+    throw InputError(path, "cannot open for writing: " + err);
+  }
+  const bool ok = out->write_image(type, data) && out->close();
+  if (!ok) {
+    const std::string err = out->geterror();
+    std::remove(tmp.c_str());
+    throw InputError(path, "write failed: " + err);
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw InputError(path, "cannot move the finished file into place: " + ec.message());
+  }
+}
+
+}  // namespace
+
+void write_exr(const std::string& path, const ImageRgb& image,
+               const std::map<std::string, std::string>& metadata) {
+  write_atomically(path, image.width, image.height, 3, OIIO::TypeDesc::FLOAT, image.pixels.data(),
+                   metadata);
+}
+
+void write_png(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgba8) {
+  write_atomically(path, width, height, 4, OIIO::TypeDesc::UINT8, rgba8.data(), {});
+}
+
+ImageRgb read_image(const std::string& path) {
+  if (!fs::exists(path)) throw InputError(path, "no such file");
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw InputError(path, "cannot read image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  ImageRgb image;
+  image.width = spec.width;
+  image.height = spec.height;
+  std::vector<float> data(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data()))
+    throw InputError(path, "cannot decode image: " + in->geterror());
+  image.pixels.resize(static_cast<std::size_t>(spec.width) * spec.height);
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    const float* px = &data[i * spec.nchannels];
+    image.pixels[i] = spec.nchannels >= 3 ? glm::vec3(px[0], px[1], px[2]) : glm::vec3(px[0]);
+  }
+  return image;
+}
+
+double relative_mse(const ImageRgb& image, const ImageRgb& reference) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double d = image.pixels[i][c] - reference.pixels[i][c];
+      const double r = reference.pixels[i][c];
+      sum += d * d / (r * r + 0.01);
+    }
+  return image.pixels.empty() ? 0.0 : sum / (3.0 * static_cast<double>(image.pixels.size()));
+}
+
+}  // namespace rtpg

@@ -1,0 +1,214 @@
+#include "render/lights.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "shared/compat.h"
+
+namespace rtpg {
+namespace {
+
+constexpr float kPi = 3.14159265358979323846f;
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+}  // namespace
+
+Lights::Lights(const Scene& scene) : scene_(scene) {
+  // Emissive triangles, weighted by their emitted power (area * luminance of Le).
+  std::vector<float> weights;
+  triangle_index_.resize(scene.meshes.size());
+  for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    const Material& mat = scene.materials[mesh.material];
+    if (!mat.is_emissive()) continue;
+    triangle_index_[m].assign(mesh.triangles.size(), -1);
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::uvec3 tri = mesh.triangles[t];
+      EmissiveTriangle e;
+      e.p0 = mesh.positions[tri.x];
+      e.e1 = mesh.positions[tri.y] - e.p0;
+      e.e2 = mesh.positions[tri.z] - e.p0;
+      const glm::vec3 c = glm::cross(e.e1, e.e2);
+      e.area = 0.5f * glm::length(c);
+      if (!(e.area > 0.0f)) continue;
+      e.normal = glm::normalize(c);
+      e.radiance = mat.emission;
+      triangle_index_[m][t] = static_cast<std::int32_t>(triangles_.size());
+      triangles_.push_back(e);
+      weights.push_back(e.area * luminance(e.radiance));
+    }
+  }
+  triangle_selection_ = Distribution1D(weights);
+
+  // Rough powers decide how often each kind is chosen; any positive split is unbiased.
+  const glm::vec3 extent = scene.bounds_max() - scene.bounds_min();
+  const float radius = 0.5f * glm::length(extent);
+  const float disc = kPi * radius * radius;
+  std::vector<float> kinds(3, 0.0f);
+  kinds[kTriangles] = kPi * triangle_selection_.total();
+  if (scene.sun.enabled && luminance(scene.sun.irradiance) > 0.0f) {
+    kinds[kSun] = luminance(scene.sun.irradiance) * disc;
+    const shared::pg_frame f = shared::pg_frame_from_normal(glm::normalize(scene.sun.direction));
+    sun_frame_t_ = f.t;
+    sun_frame_b_ = f.b;
+    if (scene.sun.angular_radius > 0.0f) {
+      sun_cos_max_ = std::cos(scene.sun.angular_radius);
+      sun_solid_angle_ = 2.0f * kPi * (1.0f - sun_cos_max_);
+      sun_radiance_ = scene.sun.irradiance / sun_solid_angle_;
+    }
+  }
+  const Environment& env = scene.environment;
+  if (env.kind == Environment::Kind::Constant) {
+    kinds[kEnvironment] = kPi * luminance(env.color) * disc;
+  } else if (env.kind == Environment::Kind::Map && env.map_texture >= 0) {
+    env_map_ = &scene.textures[env.map_texture];
+    const int w = env_map_->width, h = env_map_->height;
+    std::vector<float> texel_weights(static_cast<std::size_t>(w) * h);
+    double sum = 0.0;
+    for (int y = 0; y < h; ++y) {
+      const float sin_theta = std::sin(kPi * (static_cast<float>(y) + 0.5f) / static_cast<float>(h));
+      for (int x = 0; x < w; ++x) {
+        const float l = luminance(glm::vec3(env_map_->fetch(x, y)) * env.color);
+        texel_weights[static_cast<std::size_t>(y) * w + x] = l * sin_theta;
+        sum += l * sin_theta;
+      }
+    }
+    env_distribution_ = Distribution2D(texel_weights, w, h);
+    const float mean_radiance = static_cast<float>(sum / (static_cast<double>(w) * h)) * (kPi / 2.0f);
+    kinds[kEnvironment] = kPi * mean_radiance * disc;
+  }
+  selection_ = Distribution1D(kinds);
+}
+
+glm::vec2 Lights::direction_to_equirect(const glm::vec3& d) const {
+  // +y is up; u runs with the azimuth (rotated by the scene's rotation), v from the zenith.
+  const float theta = std::acos(std::clamp(d.y, -1.0f, 1.0f));
+  float phi = std::atan2(d.z, d.x) - scene_.environment.rotation;
+  phi = phi - 2.0f * kPi * std::floor(phi / (2.0f * kPi));
+  return {phi / (2.0f * kPi), theta / kPi};
+}
+
+glm::vec3 Lights::equirect_to_direction(float u, float v) const {
+  const float theta = v * kPi, phi = u * 2.0f * kPi + scene_.environment.rotation;
+  const float s = std::sin(theta);
+  return {s * std::cos(phi), std::cos(theta), s * std::sin(phi)};
+}
+
+glm::vec3 Lights::environment_radiance(const glm::vec3& d) const {
+  const Environment& env = scene_.environment;
+  if (env.kind == Environment::Kind::Constant) return env.color;
+  if (env_map_) {
+    const glm::vec2 uv = direction_to_equirect(d);
+    // Texture::sample has v = 0 at the bottom row; the map's v = 0 is the zenith (top row).
+    return glm::vec3(env_map_->sample({uv.x, 1.0f - uv.y})) * env.color;
+  }
+  return glm::vec3(0.0f);
+}
+
+float Lights::environment_pdf(const glm::vec3& d) const {
+  const Environment& env = scene_.environment;
+  if (env.kind == Environment::Kind::Constant) return 1.0f / (4.0f * kPi);
+  if (env_map_ && !env_distribution_.empty()) {
+    const glm::vec2 uv = direction_to_equirect(d);
+    const float sin_theta = std::sin(uv.y * kPi);
+    if (sin_theta <= 0.0f) return 0.0f;
+    return env_distribution_.pdf(uv.x, uv.y) / (2.0f * kPi * kPi * sin_theta);
+  }
+  return 0.0f;
+}
+
+bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2, LightSample& out) const {
+  if (empty()) return false;
+  float p_kind = 0.0f, u_next = 0.0f;
+  const std::size_t kind = selection_.sample_discrete(u_select, &p_kind, &u_next);
+  if (kind == kTriangles) {
+    float p_tri = 0.0f;
+    const std::size_t i = triangle_selection_.sample_discrete(u_next, &p_tri);
+    const EmissiveTriangle& e = triangles_[i];
+    // Uniform point on the triangle (pbrt's square-root parameterisation).
+    const float su = std::sqrt(u1);
+    const float b1 = u2 * su;
+    const glm::vec3 y = e.p0 + e.e1 * (1.0f - su) + e.e2 * b1;
+    const glm::vec3 to = y - p;
+    const float d2 = glm::dot(to, to);
+    if (!(d2 > 0.0f)) return false;
+    const float d = std::sqrt(d2);
+    out.direction = to / d;
+    const float cos_light = -glm::dot(out.direction, e.normal);
+    if (cos_light <= 0.0f) return false;  // one-sided emitters
+    out.distance = d;
+    out.radiance = e.radiance;
+    out.pdf = p_kind * p_tri * d2 / (cos_light * e.area);
+    out.delta = false;
+    return true;
+  }
+  if (kind == kSun) {
+    const glm::vec3 axis = glm::normalize(scene_.sun.direction);
+    out.distance = kInfinity;
+    if (sun_solid_angle_ <= 0.0f) {
+      out.direction = axis;
+      out.radiance = scene_.sun.irradiance;  // delta: the estimator divides by pdf = p_kind
+      out.pdf = p_kind;
+      out.delta = true;
+      return true;
+    }
+    const float cos_t = 1.0f - u1 * (1.0f - sun_cos_max_);
+    const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
+    const float phi = 2.0f * kPi * u2;
+    out.direction = glm::normalize(sun_frame_t_ * (sin_t * std::cos(phi)) +
+                                   sun_frame_b_ * (sin_t * std::sin(phi)) + axis * cos_t);
+    out.radiance = escaped_radiance(out.direction);
+    out.pdf = pdf_escaped(out.direction);
+    out.delta = false;
+    return true;
+  }
+  // Environment.
+  out.distance = kInfinity;
+  out.delta = false;
+  if (env_map_) {
+    float u = 0.0f, v = 0.0f, pdf_uv = 0.0f;
+    env_distribution_.sample(u1, u2, u, v, pdf_uv);
+    out.direction = equirect_to_direction(u, v);
+  } else {
+    const float z = 1.0f - 2.0f * u1, r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    const float phi = 2.0f * kPi * u2;
+    out.direction = {r * std::cos(phi), z, r * std::sin(phi)};
+  }
+  out.radiance = escaped_radiance(out.direction);
+  out.pdf = pdf_escaped(out.direction);
+  return out.pdf > 0.0f;
+}
+
+float Lights::pdf_triangle(std::uint32_t mesh, std::uint32_t triangle, const glm::vec3& p,
+                           const glm::vec3& y, const glm::vec3& ng) const {
+  if (mesh >= triangle_index_.size() || triangle_index_[mesh].empty()) return 0.0f;
+  const std::int32_t i = triangle_index_[mesh][triangle];
+  if (i < 0) return 0.0f;
+  const EmissiveTriangle& e = triangles_[i];
+  const glm::vec3 to = y - p;
+  const float d2 = glm::dot(to, to);
+  const float cos_light = std::fabs(glm::dot(to, e.normal)) / std::sqrt(d2);
+  if (!(cos_light > 0.0f)) return 0.0f;
+  (void)ng;
+  return selection_.probability(kTriangles) * triangle_selection_.probability(i) * d2 /
+         (cos_light * e.area);
+}
+
+glm::vec3 Lights::escaped_radiance(const glm::vec3& d) const {
+  glm::vec3 l = environment_radiance(d);
+  if (sun_solid_angle_ > 0.0f && glm::dot(d, glm::normalize(scene_.sun.direction)) >= sun_cos_max_)
+    l += sun_radiance_;
+  return l;
+}
+
+float Lights::pdf_escaped(const glm::vec3& d) const {
+  float pdf = selection_.probability(kEnvironment) * environment_pdf(d);
+  if (sun_solid_angle_ > 0.0f && glm::dot(d, glm::normalize(scene_.sun.direction)) >= sun_cos_max_)
+    pdf += selection_.probability(kSun) / sun_solid_angle_;
+  return pdf;
+}
+
+}  // namespace rtpg

@@ -1,0 +1,71 @@
+// Light sampling for next-event estimation and the densities MIS needs when a BSDF-sampled
+// ray finds a light by itself: emissive triangles (chosen by power, uniform by area), the sun
+// (a cone of finite angular radius, or a delta direction) and the environment (constant, or
+// an equirectangular map sampled by luminance times sin(theta)).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "render/distribution.h"
+#include "scene/scene.h"
+
+namespace rtpg {
+
+struct LightSample {
+  glm::vec3 direction{0.0f};  // unit, from the shading point towards the light
+  float distance = 0.0f;      // to the light point; infinity for the sun and the environment
+  glm::vec3 radiance{0.0f};   // arriving along -direction (before visibility)
+  float pdf = 0.0f;           // solid-angle density of this sample (selection included)
+  bool delta = false;         // a delta light: BSDF sampling can never hit it (no MIS)
+};
+
+class Lights {
+ public:
+  explicit Lights(const Scene& scene);
+
+  bool empty() const { return selection_.total() <= 0.0f; }
+  // u: three uniform numbers (select, then two for the point or direction).
+  bool sample(const glm::vec3& p, float u_select, float u1, float u2, LightSample& out) const;
+
+  // Density with which sample() would produce the direction from p to the hit point y on
+  // triangle `triangle` of mesh `mesh` (with its geometric normal ng, any side).
+  float pdf_triangle(std::uint32_t mesh, std::uint32_t triangle, const glm::vec3& p,
+                     const glm::vec3& y, const glm::vec3& ng) const;
+  // Radiance arriving from infinity along -direction (environment plus the sun's disc), and
+  // the density with which sample() produces that direction.
+  glm::vec3 escaped_radiance(const glm::vec3& direction) const;
+  float pdf_escaped(const glm::vec3& direction) const;
+
+  std::size_t emissive_triangle_count() const { return triangles_.size(); }
+
+ private:
+  struct EmissiveTriangle {
+    glm::vec3 p0, e1, e2;
+    glm::vec3 normal;  // unit, front side
+    float area;
+    glm::vec3 radiance;
+  };
+  enum Kind : std::size_t { kTriangles = 0, kSun = 1, kEnvironment = 2 };
+
+  glm::vec3 environment_radiance(const glm::vec3& direction) const;
+  float environment_pdf(const glm::vec3& direction) const;
+  glm::vec2 direction_to_equirect(const glm::vec3& d) const;
+  glm::vec3 equirect_to_direction(float u, float v) const;
+
+  const Scene& scene_;
+  std::vector<EmissiveTriangle> triangles_;
+  std::vector<std::vector<std::int32_t>> triangle_index_;  // [mesh][triangle] -> light or -1
+  Distribution1D triangle_selection_;
+  Distribution1D selection_;  // over Kind
+  glm::vec3 sun_frame_t_{1, 0, 0}, sun_frame_b_{0, 1, 0};
+  float sun_cos_max_ = 1.0f;
+  float sun_solid_angle_ = 0.0f;
+  glm::vec3 sun_radiance_{0.0f};
+  const Texture* env_map_ = nullptr;
+  Distribution2D env_distribution_;
+};
+
+}  // namespace rtpg

@@ -1,0 +1,88 @@
+// The host path tracer, wavefront style: every stage handles all live paths of a frame in one
+// batch (Embree queries and shading spread over all cores with TBB). Next-event estimation
+// for area lights, the sun and the environment is combined with BSDF sampling by MIS (power
+// heuristic); Russian roulette ends paths. The first bounce comes from a FirstBounceSampler.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "render/first_bounce.h"
+#include "render/gbuffer.h"
+#include "render/lights.h"
+#include "scene/scene.h"
+#include "trace/embree_scene.h"
+
+namespace rtpg {
+
+struct PathTracerSettings {
+  int max_bounces = 8;          // path vertices after the primary hit
+  int roulette_start = 3;       // first bounce at which Russian roulette may end a path
+  bool next_event = true;       // false: BSDF sampling only (emitters found by chance)
+};
+
+// The VPL buffer the guiding trainer reads (layout: kernels/shared/vpl.h).
+struct VplBuffer {
+  std::vector<glm::vec4> position, normal, radiance;
+  std::vector<std::uint32_t> info;
+  void resize(std::size_t n);
+};
+
+struct RayCounts {
+  std::uint64_t secondary = 0, shadow = 0;
+};
+
+struct PassTimes {
+  double trace_ms = 0.0, shade_ms = 0.0;
+};
+
+class PathTracer {
+ public:
+  PathTracer(const Scene& scene, const EmbreeScene& tracer, const Lights& lights,
+             PathTracerSettings settings);
+
+  // One path per surface pixel of the G-buffer, starting with `first` (from `sampler`).
+  // radiance[i] receives the estimate of pixel i (primary emission included); a non-finite
+  // estimate is replaced by zero and counted. vpls (optional) receives the first-bounce hits.
+  void trace(const GBuffer& gbuffer, const std::vector<FirstBounceSample>& first,
+             const FirstBounceSampler& sampler, const SampleCoordinates& at,
+             std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite,
+             RayCounts& rays, PassTimes& times);
+
+  const PathTracerSettings& settings() const { return settings_; }
+
+ private:
+  struct PathState {
+    glm::vec3 throughput;       // from the camera
+    glm::vec3 vpl_throughput;   // from the first-bounce hit y (for the VPL's radiance)
+    glm::vec3 radiance;         // accumulated pixel estimate
+    glm::vec3 vpl_radiance;     // accumulated radiance leaving y towards x0
+    float prev_pdf;             // density of the direction that led here (for MIS)
+    glm::vec3 prev_position;    // origin of the current ray
+    std::uint32_t rng;          // pg_rng state
+  };
+  struct ShadowWork {
+    glm::vec3 contribution;      // to the pixel, if unoccluded
+    glm::vec3 vpl_contribution;  // to the VPL radiance, if unoccluded
+  };
+
+  void run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times);
+  void apply_shadow_rays(std::size_t count, const std::vector<std::uint32_t>& owners);
+
+  const Scene& scene_;
+  const EmbreeScene& tracer_;
+  const Lights& lights_;
+  PathTracerSettings settings_;
+
+  // Scratch, reused across frames.
+  std::vector<PathState> paths_;
+  std::vector<std::uint32_t> active_, next_active_, shadow_owner_;
+  std::vector<Ray> rays_, shadow_rays_;
+  std::vector<Hit> hits_;
+  std::vector<std::uint8_t> occluded_;
+  std::vector<ShadowWork> shadow_work_;
+};
+
+}  // namespace rtpg

@@ -1,0 +1,165 @@
+#include "render/renderer.h"
+
+#include <chrono>
+#include <cmath>
+#include <new>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "render/surface.h"
+#include "shared/rng.h"
+#include "util/error.h"
+
+namespace rtpg {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
+    : scene_(scene), settings_(settings) {
+  if (settings.width <= 0 || settings.height <= 0)
+    throw InputError("--res", "resolution must be positive, got " + std::to_string(settings.width) +
+                                  "x" + std::to_string(settings.height));
+  const std::uint64_t pixels = static_cast<std::uint64_t>(settings.width) * settings.height;
+  if (pixels > kMaxPixels)
+    throw InputError("--res", std::to_string(settings.width) + "x" + std::to_string(settings.height) +
+                                  " is too large (at most " + std::to_string(kMaxPixels) + " pixels)");
+  if (settings.spp <= 0) throw InputError("--spp", "must be at least 1");
+  if (!settings.camera_path.empty() && !scene.camera.paths.count(settings.camera_path))
+    throw InputError("--camera-path", "scene has no camera path named '" + settings.camera_path + "'");
+  try {
+    gbuffer_.resize(settings.width, settings.height);
+    image_.assign(pixels, glm::vec3(0.0f));
+  } catch (const std::bad_alloc&) {
+    throw InputError("--res", "not enough memory for " + std::to_string(pixels) + " pixels");
+  }
+  tracer_ = std::make_unique<EmbreeScene>(scene);
+  lights_ = std::make_unique<Lights>(scene);
+  path_tracer_ = std::make_unique<PathTracer>(scene, *tracer_, *lights_, settings.path_tracer);
+  sampler_ = std::make_unique<BsdfFirstBounce>();
+}
+
+Renderer::~Renderer() = default;
+
+void Renderer::set_first_bounce_sampler(std::unique_ptr<FirstBounceSampler> sampler) {
+  sampler_ = std::move(sampler);
+}
+
+CameraView Renderer::camera_at(int frame) const {
+  if (settings_.camera_path.empty()) return scene_.camera.view;
+  const CameraPath& path = scene_.camera.paths.at(settings_.camera_path);
+  return path.at(static_cast<float>(frame) / path.fps);
+}
+
+void Renderer::build_gbuffer(int frame, FrameStats& stats) {
+  const int w = settings_.width, h = settings_.height;
+  const float aspect = static_cast<float>(w) / static_cast<float>(h);
+  const CameraFrame camera = make_camera_frame(camera_at(frame), aspect);
+  const CameraFrame previous = make_camera_frame(camera_at(frame > 0 ? frame - 1 : 0), aspect);
+  const std::size_t n = gbuffer_.pixel_count();
+  camera_rays_.resize(n);
+  camera_hits_.resize(n);
+
+  auto start = Clock::now();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
+      float jx = 0.5f, jy = 0.5f;
+      if (settings_.jitter) {
+        shared::pg_rng rng = shared::pg_rng_make(settings_.seed, static_cast<shared::uint>(i),
+                                                 static_cast<shared::uint>(frame), 0u, 2u);
+        jx = shared::pg_rng_next(&rng);
+        jy = shared::pg_rng_next(&rng);
+      }
+      Ray ray;
+      ray.origin = camera.position;
+      ray.direction = camera.ray_direction((static_cast<float>(x) + jx) / static_cast<float>(w),
+                                           (static_cast<float>(y) + jy) / static_cast<float>(h));
+      camera_rays_[i] = ray;
+    }
+  });
+  tracer_->intersect(camera_rays_.data(), camera_hits_.data(), n, RayMode::Packet8);
+  stats.time_ms["primary"] += ms_since(start);
+  stats.primary_rays += n;
+
+  start = Clock::now();
+  GBuffer& g = gbuffer_;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const Ray& ray = camera_rays_[i];
+      const Hit& hit = camera_hits_[i];
+      const glm::vec3 dir = glm::normalize(ray.direction);
+      g.motion[i] = glm::vec2(0.0f);
+      if (!hit.valid()) {
+        g.flags[i] = PG_GBUF_SKY;
+        g.position_depth[i] = glm::vec4(0.0f);
+        g.emission[i] = glm::vec4(lights_->escaped_radiance(dir), 0.0f);
+        g.view_dir[i] = glm::vec4(-dir, 0.0f);
+        continue;
+      }
+      const SurfacePoint sp = make_surface_point(scene_, ray, hit);
+      const float depth = glm::dot(sp.position - camera.position, camera.forward);
+      g.position_depth[i] = glm::vec4(sp.position, depth);
+      g.shading_normal[i] = glm::vec4(sp.shading_normal, 0.0f);
+      g.geometric_normal[i] = glm::vec4(sp.geometric_normal, 0.0f);
+      g.view_dir[i] = glm::vec4(-dir, 0.0f);
+      g.base_color_roughness[i] =
+          glm::vec4(sp.material.base_color.x, sp.material.base_color.y, sp.material.base_color.z,
+                    sp.material.roughness);
+      g.metallic_specular[i] = glm::vec4(sp.material.metallic, sp.material.specular, 0.0f, 0.0f);
+      g.emission[i] = glm::vec4(sp.emission, 0.0f);
+      g.material_id[i] = sp.material_id;
+      std::uint32_t flags = 0;
+      if (sp.emission.x > 0.0f || sp.emission.y > 0.0f || sp.emission.z > 0.0f) flags |= PG_GBUF_EMITTER;
+      if (sp.material.roughness <= PG_MIN_ROUGHNESS) flags |= PG_GBUF_DELTA;
+      if (sp.transmissive) flags |= PG_GBUF_TRANSMISSIVE;
+      g.flags[i] = flags;
+      float px = 0.0f, py = 0.0f;
+      if (previous.project(sp.position, px, py)) {
+        const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
+        g.motion[i] = glm::vec2(px * static_cast<float>(g.width) - (static_cast<float>(x) + 0.5f),
+                                py * static_cast<float>(g.height) - (static_cast<float>(y) + 0.5f));
+        // A static camera has exactly zero motion, whatever the jitter.
+        if (frame == 0 || settings_.camera_path.empty()) g.motion[i] = glm::vec2(0.0f);
+      }
+    }
+  });
+  stats.time_ms["gbuffer"] += ms_since(start);
+}
+
+FrameStats Renderer::render_frame(int index) {
+  FrameStats stats;
+  stats.index = index;
+  const auto start = Clock::now();
+  build_gbuffer(index, stats);
+  const std::size_t n = gbuffer_.pixel_count();
+  image_.assign(n, glm::vec3(0.0f));
+  PassTimes times;
+  RayCounts rays;
+  for (int s = 0; s < settings_.spp; ++s) {
+    SampleCoordinates at{settings_.seed, static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(s)};
+    auto t = Clock::now();
+    sampler_->sample(gbuffer_, at, first_);
+    stats.time_ms["sample"] += ms_since(t);
+    path_tracer_->trace(gbuffer_, first_, *sampler_, at, pass_, s == 0 ? &vpls_ : nullptr,
+                        stats.nonfinite_samples, rays, times);
+    t = Clock::now();
+    const float weight = 1.0f / static_cast<float>(settings_.spp);
+    for (std::size_t i = 0; i < n; ++i) image_[i] += pass_[i] * weight;
+    stats.time_ms["accumulate"] += ms_since(t);
+  }
+  stats.time_ms["trace"] = times.trace_ms;
+  stats.time_ms["shade"] = times.shade_ms;
+  stats.secondary_rays = rays.secondary;
+  stats.shadow_rays = rays.shadow;
+  stats.time_ms["total"] = ms_since(start);
+  return stats;
+}
+
+}  // namespace rtpg

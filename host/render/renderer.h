@@ -1,0 +1,82 @@
+// One frame, as data flows (DESIGN.md section 2): camera rays -> Embree primary hits ->
+// G-buffer -> first-bounce sampler -> host path tracer -> (guiding: training on the VPLs).
+// The renderer is the one place that joins scene, tracer and first-bounce sampler.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "render/first_bounce.h"
+#include "render/gbuffer.h"
+#include "render/lights.h"
+#include "render/path_tracer.h"
+#include "scene/scene.h"
+#include "trace/embree_scene.h"
+
+namespace rtpg {
+
+struct RenderSettings {
+  int width = 640, height = 360;
+  int spp = 1;                // paths per pixel per frame (sharing one G-buffer)
+  std::uint32_t seed = 0;
+  bool jitter = true;         // sub-pixel jitter of the camera ray, new every frame
+  std::string camera_path;    // "" = static camera
+  PathTracerSettings path_tracer;
+};
+
+struct FrameStats {
+  int index = 0;
+  std::map<std::string, double> time_ms;  // "total", "primary", "gbuffer", "sample", "trace", "shade", kernels
+  std::uint64_t nonfinite_samples = 0;
+  std::uint64_t primary_rays = 0, secondary_rays = 0, shadow_rays = 0;
+  std::map<std::string, double> extra;  // sampler-specific figures (e.g. guided fraction)
+};
+
+class Renderer {
+ public:
+  // Throws InputError when the resolution is zero or too large to allocate.
+  Renderer(const Scene& scene, const RenderSettings& settings);
+  ~Renderer();
+
+  // Replaces the first-bounce strategy (default: BSDF sampling on the host).
+  void set_first_bounce_sampler(std::unique_ptr<FirstBounceSampler> sampler);
+  FirstBounceSampler& first_bounce_sampler() { return *sampler_; }
+
+  // Renders frame `index` (camera at index / fps on the camera path): image() is its mean over
+  // spp samples.
+  FrameStats render_frame(int index);
+
+  const std::vector<glm::vec3>& image() const { return image_; }
+  const GBuffer& gbuffer() const { return gbuffer_; }
+  const VplBuffer& vpls() const { return vpls_; }
+  const RenderSettings& settings() const { return settings_; }
+  const EmbreeScene& tracer() const { return *tracer_; }
+  const Lights& lights() const { return *lights_; }
+  CameraView camera_at(int frame) const;
+
+ private:
+  void build_gbuffer(int frame, FrameStats& stats);
+
+  const Scene& scene_;
+  RenderSettings settings_;
+  std::unique_ptr<EmbreeScene> tracer_;
+  std::unique_ptr<Lights> lights_;
+  std::unique_ptr<PathTracer> path_tracer_;
+  std::unique_ptr<FirstBounceSampler> sampler_;
+  GBuffer gbuffer_;
+  VplBuffer vpls_;
+  std::vector<glm::vec3> image_, pass_;
+  std::vector<Ray> camera_rays_;
+  std::vector<Hit> camera_hits_;
+  std::vector<FirstBounceSample> first_;
+};
+
+// Largest image the renderer accepts (pixels); beyond it buffers would not fit in memory.
+constexpr std::uint64_t kMaxPixels = 8192ull * 8192ull;
+
+}  // namespace rtpg

@@ -1,0 +1,135 @@
+#include "render/surface.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace rtpg {
+namespace {
+
+glm::vec3 interpolate(const std::vector<glm::vec3>& a, const glm::uvec3& t, float u, float v) {
+  return (1.0f - u - v) * a[t.x] + u * a[t.y] + v * a[t.z];
+}
+
+// Tangent-space basis at the hit: the mesh's tangents, else one derived from the uv
+// parameterisation of the triangle, else any basis around n.
+void tangent_basis(const Mesh& mesh, const glm::uvec3& tri, float u, float v, const glm::vec3& n,
+                   glm::vec3& tangent, glm::vec3& bitangent) {
+  if (!mesh.tangents.empty()) {
+    const glm::vec4 t4 = (1.0f - u - v) * mesh.tangents[tri.x] + u * mesh.tangents[tri.y] +
+                         v * mesh.tangents[tri.z];
+    glm::vec3 t(t4);
+    t = t - n * glm::dot(n, t);
+    if (glm::dot(t, t) > 1e-12f) {
+      tangent = glm::normalize(t);
+      bitangent = glm::cross(n, tangent) * (t4.w < 0.0f ? -1.0f : 1.0f);
+      return;
+    }
+  }
+  if (!mesh.uvs.empty()) {
+    const glm::vec3 e1 = mesh.positions[tri.y] - mesh.positions[tri.x];
+    const glm::vec3 e2 = mesh.positions[tri.z] - mesh.positions[tri.x];
+    const glm::vec2 d1 = mesh.uvs[tri.y] - mesh.uvs[tri.x];
+    const glm::vec2 d2 = mesh.uvs[tri.z] - mesh.uvs[tri.x];
+    const float det = d1.x * d2.y - d1.y * d2.x;
+    if (std::fabs(det) > 1e-12f) {
+      glm::vec3 t = (e1 * d2.y - e2 * d1.y) / det;
+      t = t - n * glm::dot(n, t);
+      if (glm::dot(t, t) > 1e-12f) {
+        tangent = glm::normalize(t);
+        bitangent = glm::cross(n, tangent) * (det < 0.0f ? -1.0f : 1.0f);
+        return;
+      }
+    }
+  }
+  const shared::pg_frame f = shared::pg_frame_from_normal(n);
+  tangent = f.t;
+  bitangent = f.b;
+}
+
+float texture_channel(const glm::vec4& texel, int channel) {
+  return channel == 0 ? texel.x : channel == 1 ? texel.y : channel == 2 ? texel.z : texel.w;
+}
+
+}  // namespace
+
+glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n) {
+  constexpr float kOrigin = 1.0f / 32.0f, kFloatScale = 1.0f / 65536.0f, kIntScale = 256.0f;
+  glm::vec3 out;
+  for (int i = 0; i < 3; ++i) {
+    const int offset = static_cast<int>(kIntScale * n[i]);
+    std::int32_t bits;
+    std::memcpy(&bits, &p[i], sizeof(bits));
+    bits += p[i] < 0.0f ? -offset : offset;
+    float moved;
+    std::memcpy(&moved, &bits, sizeof(moved));
+    out[i] = std::fabs(p[i]) < kOrigin ? p[i] + kFloatScale * n[i] : moved;
+  }
+  return out;
+}
+
+SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
+  const Mesh& mesh = scene.meshes[hit.mesh];
+  const glm::uvec3 tri = mesh.triangles[hit.triangle];
+  const Material& mat = scene.materials[mesh.material];
+  SurfacePoint sp;
+  sp.material_id = mesh.material;
+  sp.position = ray.origin + ray.direction * hit.t;
+  const glm::vec3 p0 = mesh.positions[tri.x], p1 = mesh.positions[tri.y], p2 = mesh.positions[tri.z];
+  glm::vec3 ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+  const bool front = glm::dot(ng, ray.direction) < 0.0f;
+  if (!front) ng = -ng;
+  glm::vec3 ns = mesh.normals.empty() ? ng : interpolate(mesh.normals, tri, hit.u, hit.v);
+  if (glm::dot(ns, ns) < 1e-12f) ns = ng;
+  ns = glm::normalize(ns);
+  if (glm::dot(ns, ng) < 0.0f) ns = -ns;
+
+  glm::vec2 uv(0.0f);
+  if (!mesh.uvs.empty())
+    uv = (1.0f - hit.u - hit.v) * mesh.uvs[tri.x] + hit.u * mesh.uvs[tri.y] +
+         hit.v * mesh.uvs[tri.z];
+
+  glm::vec3 base = mat.base_color;
+  float roughness = mat.roughness, metallic = mat.metallic;
+  if (mat.base_color_texture >= 0) base *= glm::vec3(scene.textures[mat.base_color_texture].sample(uv));
+  if (mat.roughness_texture >= 0)
+    roughness *= texture_channel(scene.textures[mat.roughness_texture].sample(uv), mat.roughness_channel);
+  if (mat.metallic_texture >= 0)
+    metallic *= texture_channel(scene.textures[mat.metallic_texture].sample(uv), mat.metallic_channel);
+
+  if (mat.normal_texture >= 0 || mat.bump_texture >= 0) {
+    glm::vec3 t, b;
+    tangent_basis(mesh, tri, hit.u, hit.v, ns, t, b);
+    glm::vec3 perturbed = ns;
+    if (mat.normal_texture >= 0) {
+      const glm::vec3 tn = glm::vec3(scene.textures[mat.normal_texture].sample(uv)) * 2.0f - 1.0f;
+      perturbed = tn.x * t + tn.y * b + tn.z * ns;
+    } else {
+      // Height map: finite differences over one texel give the slope in tangent space.
+      const Texture& h = scene.textures[mat.bump_texture];
+      const float du = 1.0f / static_cast<float>(std::max(h.width, 1));
+      const float dv = 1.0f / static_cast<float>(std::max(h.height, 1));
+      const float h0 = h.sample(uv).x;
+      const float dhdu = (h.sample(uv + glm::vec2(du, 0.0f)).x - h0) / du;
+      const float dhdv = (h.sample(uv + glm::vec2(0.0f, dv)).x - h0) / dv;
+      // bump_scale converts height per unit uv into the normal's tilt.
+      perturbed = ns - mat.bump_scale * 0.01f * (dhdu * t + dhdv * b);
+    }
+    if (glm::dot(perturbed, perturbed) > 1e-12f) {
+      perturbed = glm::normalize(perturbed);
+      // A perturbed normal below the geometric surface would leak light: keep it above.
+      if (glm::dot(perturbed, ng) > 0.05f) ns = perturbed;
+    }
+  }
+  sp.geometric_normal = ng;
+  sp.shading_normal = ns;
+  sp.material.base_color = shared::float3(base.x, base.y, base.z);
+  sp.material.roughness = roughness;
+  sp.material.metallic = metallic;
+  sp.material.specular = mat.specular;
+  sp.transmissive = mat.transmissive;
+  if (front) sp.emission = mat.emission;
+  return sp;
+}
+
+}  // namespace rtpg

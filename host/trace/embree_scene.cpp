@@ -1,0 +1,245 @@
+#include "trace/embree_scene.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace rtpg {
+namespace {
+
+// What an alpha-tested mesh needs in its filter callbacks.
+struct AlphaMask {
+  const Mesh* mesh = nullptr;
+  const Texture* texture = nullptr;
+  float cutoff = 0.5f;
+};
+
+bool alpha_passes(const AlphaMask& mask, std::uint32_t prim, float u, float v) {
+  const Mesh& mesh = *mask.mesh;
+  if (mesh.uvs.empty()) return true;
+  const glm::uvec3 tri = mesh.triangles[prim];
+  const glm::vec2 uv =
+      (1.0f - u - v) * mesh.uvs[tri.x] + u * mesh.uvs[tri.y] + v * mesh.uvs[tri.z];
+  return mask.texture->sample(uv).w >= mask.cutoff;
+}
+
+// One callback for closest-hit and occlusion queries: rejects hits on transparent texels.
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* mask = static_cast<const AlphaMask*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const std::uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+    const float u = RTCHitN_u(args->hit, args->N, i);
+    const float v = RTCHitN_v(args->hit, args->N, i);
+    if (!alpha_passes(*mask, prim, u, v)) args->valid[i] = 0;
+  }
+}
+
+const char* embree_error_name(RTCError code) {
+  switch (code) {
+    case RTC_ERROR_NONE: return "RTC_ERROR_NONE";
+    case RTC_ERROR_UNKNOWN: return "RTC_ERROR_UNKNOWN";
+    case RTC_ERROR_INVALID_ARGUMENT: return "RTC_ERROR_INVALID_ARGUMENT";
+    case RTC_ERROR_INVALID_OPERATION: return "RTC_ERROR_INVALID_OPERATION";
+    case RTC_ERROR_OUT_OF_MEMORY: return "RTC_ERROR_OUT_OF_MEMORY";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "RTC_ERROR_UNSUPPORTED_CPU";
+    case RTC_ERROR_CANCELLED: return "RTC_ERROR_CANCELLED";
+  }
+  return "RTC_ERROR_?";
+}
+
+void check(RTCDevice device, const char* call) {
+  const RTCError code = rtcGetDeviceError(device);
+  if (code != RTC_ERROR_NONE) throw EmbreeError(std::string(call) + ": " + embree_error_name(code));
+}
+
+constexpr std::size_t kGrain = 1024;
+
+}  // namespace
+
+struct EmbreeScene::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<AlphaMask> masks;  // stable addresses: reserved before geometry creation
+};
+
+EmbreeScene::EmbreeScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
+  const auto start = std::chrono::steady_clock::now();
+  impl_->device = rtcNewDevice(nullptr);
+  if (!impl_->device) throw EmbreeError("rtcNewDevice: " + std::string(embree_error_name(rtcGetDeviceError(nullptr))));
+  impl_->scene = rtcNewScene(impl_->device);
+  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  impl_->masks.reserve(scene.meshes.size());
+  for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Embree reads vertices as 16-byte vectors: allocate through Embree, which pads.
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+    check(impl_->device, "rtcSetNewGeometryBuffer");
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+      vertices[3 * i + 0] = mesh.positions[i].x;
+      vertices[3 * i + 1] = mesh.positions[i].y;
+      vertices[3 * i + 2] = mesh.positions[i].z;
+    }
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+      indices[3 * i + 0] = mesh.triangles[i].x;
+      indices[3 * i + 1] = mesh.triangles[i].y;
+      indices[3 * i + 2] = mesh.triangles[i].z;
+    }
+    const Material& material = scene.materials.at(mesh.material);
+    if (material.alpha_texture >= 0 && !mesh.uvs.empty()) {
+      impl_->masks.push_back({&mesh, &scene.textures.at(material.alpha_texture), material.alpha_cutoff});
+      rtcSetGeometryUserData(geom, &impl_->masks.back());
+      rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(impl_->scene, geom, static_cast<unsigned>(m));
+    rtcReleaseGeometry(geom);
+    check(impl_->device, "rtcAttachGeometryByID");
+  }
+  rtcCommitScene(impl_->scene);
+  check(impl_->device, "rtcCommitScene");
+  build_seconds_ =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+EmbreeScene::~EmbreeScene() {
+  if (impl_->scene) rtcReleaseScene(impl_->scene);
+  if (impl_->device) rtcReleaseDevice(impl_->device);
+}
+
+namespace {
+
+void to_embree(const Ray& r, RTCRay& out) {
+  out.org_x = r.origin.x;
+  out.org_y = r.origin.y;
+  out.org_z = r.origin.z;
+  out.tnear = r.tmin;
+  out.dir_x = r.direction.x;
+  out.dir_y = r.direction.y;
+  out.dir_z = r.direction.z;
+  out.time = 0.0f;
+  out.tfar = r.tmax;
+  out.mask = 0xffffffffu;
+  out.id = 0;
+  out.flags = 0;
+}
+
+void set_ray8(RTCRay8& packet, int lane, const Ray& r) {
+  packet.org_x[lane] = r.origin.x;
+  packet.org_y[lane] = r.origin.y;
+  packet.org_z[lane] = r.origin.z;
+  packet.tnear[lane] = r.tmin;
+  packet.dir_x[lane] = r.direction.x;
+  packet.dir_y[lane] = r.direction.y;
+  packet.dir_z[lane] = r.direction.z;
+  packet.time[lane] = 0.0f;
+  packet.tfar[lane] = r.tmax;
+  packet.mask[lane] = 0xffffffffu;
+  packet.id[lane] = 0;
+  packet.flags[lane] = 0;
+}
+
+}  // namespace
+
+void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMode mode) const {
+  RTCScene scene = impl_->scene;
+  if (mode == RayMode::Single) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        RTCRayHit rh;
+        to_embree(rays[i], rh.ray);
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(scene, &context, &rh);
+        Hit& h = hits[i];
+        h.mesh = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID;
+        h.triangle = rh.hit.primID;
+        h.t = rh.ray.tfar;
+        h.u = rh.hit.u;
+        h.v = rh.hit.v;
+      }
+    });
+    return;
+  }
+  const std::size_t packets = (count + 7) / 8;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), [&](const auto& range) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (std::size_t p = range.begin(); p != range.end(); ++p) {
+      alignas(32) RTCRayHit8 rh;
+      alignas(32) int valid[8];
+      for (int lane = 0; lane < 8; ++lane) {
+        const std::size_t i = p * 8 + lane;
+        valid[lane] = i < count ? -1 : 0;
+        set_ray8(rh.ray, lane, rays[i < count ? i : count - 1]);
+        rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect8(valid, scene, &context, &rh);
+      for (int lane = 0; lane < 8; ++lane) {
+        const std::size_t i = p * 8 + lane;
+        if (i >= count) break;
+        Hit& h = hits[i];
+        h.mesh = rh.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID[lane];
+        h.triangle = rh.hit.primID[lane];
+        h.t = rh.ray.tfar[lane];
+        h.u = rh.hit.u[lane];
+        h.v = rh.hit.v[lane];
+      }
+    }
+  });
+}
+
+void EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
+                           RayMode mode) const {
+  RTCScene scene = impl_->scene;
+  if (mode == RayMode::Single) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        RTCRay ray;
+        to_embree(rays[i], ray);
+        rtcOccluded1(scene, &context, &ray);
+        occluded[i] = std::isinf(ray.tfar) && ray.tfar < 0.0f ? 1 : 0;
+      }
+    });
+    return;
+  }
+  const std::size_t packets = (count + 7) / 8;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), [&](const auto& range) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (std::size_t p = range.begin(); p != range.end(); ++p) {
+      alignas(32) RTCRay8 ray;
+      alignas(32) int valid[8];
+      for (int lane = 0; lane < 8; ++lane) {
+        const std::size_t i = p * 8 + lane;
+        valid[lane] = i < count ? -1 : 0;
+        set_ray8(ray, lane, rays[i < count ? i : count - 1]);
+      }
+      rtcOccluded8(valid, scene, &context, &ray);
+      for (int lane = 0; lane < 8; ++lane) {
+        const std::size_t i = p * 8 + lane;
+        if (i >= count) break;
+        occluded[i] = std::isinf(ray.tfar[lane]) && ray.tfar[lane] < 0.0f ? 1 : 0;
+      }
+    }
+  });
+}
+
+}  // namespace rtpg

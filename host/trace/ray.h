@@ -1,0 +1,32 @@
+// Rays and hits as the host tracer takes and returns them, in batches (structure of arrays
+// would save little here: Embree reads one ray at a time or 8-wide packets it gathers).
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+namespace rtpg {
+
+struct Ray {
+  glm::vec3 origin;
+  float tmin = 0.0f;
+  glm::vec3 direction;  // need not be normalised; t is in units of its length
+  float tmax = 1e30f;
+};
+
+constexpr std::uint32_t kNoHit = 0xffffffffu;
+
+struct Hit {
+  float t = 0.0f;
+  std::uint32_t mesh = kNoHit;  // index into Scene::meshes; kNoHit on a miss
+  std::uint32_t triangle = 0;   // index into Mesh::triangles
+  float u = 0.0f, v = 0.0f;     // barycentrics of vertices 1 and 2
+  bool valid() const { return mesh != kNoHit; }
+};
+
+// How a batch is handed to Embree. Packets of 8 pay off only for coherent rays (camera and
+// shadow rays towards one light); incoherent bounces are as fast one by one (DESIGN.md 7).
+enum class RayMode { Single, Packet8 };
+
+}  // namespace rtpg
