@@ -16,6 +16,7 @@
 #include "cl/cl_runtime.h"
 #include "cl/device.h"
 #include "cl/image_kernels.h"
+#include "render/guided_first_bounce.h"
 #include "render/image_io.h"
 #include "scene/scene_loader.h"
 #include "util/atomic_file.h"
@@ -106,6 +107,9 @@ int run_render(const RenderOptions& options) {
   const Scene scene = load(options.common);
   ClRuntime cl(options.common.device);
   Renderer renderer(scene, options.settings);
+  if (options.guiding == "pmm")
+    renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(
+        cl, options.settings.width, options.settings.height, options.guiding_config));
 
   nlohmann::json frames = nlohmann::json::array();
   std::vector<double> totals;
@@ -176,6 +180,7 @@ int run_reference(const ReferenceOptions& options) {
   settings.width = options.width;
   settings.height = options.height;
   settings.seed = options.seed;
+  settings.path_tracer = options.path_tracer;
   // Several samples share a G-buffer; new jitter per pass gives the pixel filter's integral.
   settings.spp = options.spp % 4 == 0 ? 4 : 1;
   const int passes = options.spp / settings.spp;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "render/renderer.h"
+#include "rtpg/guider.h"
 
 namespace rtpg {
 
@@ -22,13 +23,16 @@ struct RenderOptions {
   std::string output;      // .exr or .png; "" = none
   std::string reference;   // EXR to compute relMSE against
   std::string stats_json;  // "" = none
-  std::string guiding = "off";
+  std::string guiding = "pmm";  // "off" or "pmm"
+  GuidingConfig guiding_config;
+  std::string train_memory = "auto";
 };
 
 struct ReferenceOptions {
   CommonOptions common;
   int width = 640, height = 360, spp = 1024;
   std::uint32_t seed = 0;
+  PathTracerSettings path_tracer;
   std::string output;
 };
 

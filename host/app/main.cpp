@@ -22,6 +22,34 @@ void add_common(CLI::App* cmd, rtpg::CommonOptions& common, bool scene_required)
   cmd->add_flag("-q,--quiet", common.quiet, "Print nothing but errors");
 }
 
+void add_guiding_options(CLI::App* cmd, rtpg::RenderOptions& r) {
+  rtpg::GuidingConfig& g = r.guiding_config;
+  cmd->add_option("--guiding", r.guiding, "First-bounce sampling: pmm (guided) or off (BSDF)")
+      ->check(CLI::IsMember({"off", "pmm"}))
+      ->capture_default_str();
+  auto* grp = cmd->add_option_group("Guiding", "Parameters of the PMM guider (include/rtpg/guider.h)");
+  grp->add_option("--pg-kmax", g.k_max, "Epochs after which the EM step size stops shrinking")->capture_default_str();
+  grp->add_option("--pg-n-min", g.n_min, "Neighbour VPLs per pixel at k = kMax")->capture_default_str();
+  grp->add_option("--pg-n-max", g.n_max, "Neighbour VPLs per pixel at k = 0 (n-min = n-max: fixed N)")->capture_default_str();
+  grp->add_option("--pg-apron", g.apron, "Neighbourhood radius in pixels")->capture_default_str();
+  grp->add_option("--pg-local", g.local_x, "Work-group (tile) width and height")->capture_default_str()
+      ->each([&g](const std::string&) { g.local_y = g.local_x; });
+  grp->add_option("--pg-pi-min", g.pi_min, "Lower clamp of the mixing weight")->capture_default_str();
+  grp->add_option("--pg-pi-max", g.pi_max, "Upper clamp of the mixing weight")->capture_default_str();
+  grp->add_option("--pg-pi-init", g.pi_init, "Mixing weight of a new model")->capture_default_str();
+  grp->add_option("--pg-alpha", g.step_alpha, "Step size exponent: eta_k = max((k+1)^-alpha, 1/(kMax+1))")->capture_default_str();
+  grp->add_option("--pg-sigma-eps", g.sigma_eps, "Regularisation of the covariance diagonal")->capture_default_str();
+  grp->add_option("--pg-sigma-prior", g.sigma_prior, "Prior variance, added as sigma-prior / (k + 1)")->capture_default_str();
+  grp->add_option("--pg-reseed-ratio", g.reseed_ratio, "Re-seed a lobe on a sample this many times brighter than its history")->capture_default_str();
+  grp->add_option("--pg-weight-clamp", g.weight_clamp, "Clamp training weights to this multiple of the running mean (0 = off)")->capture_default_str();
+  grp->add_option("--pg-reproject-position", g.reproject_position, "Relative position change that rejects history")->capture_default_str();
+  grp->add_option("--pg-reproject-normal", g.reproject_normal, "Normal cosine below which history is rejected")->capture_default_str();
+  grp->add_option("--pg-roughness-skip", g.roughness_skip, "No guiding at or below this roughness")->capture_default_str();
+  grp->add_option("--pg-train-memory", r.train_memory, "VPL reads of the train kernel: auto, local or global")
+      ->check(CLI::IsMember({"auto", "local", "global"}))
+      ->capture_default_str();
+}
+
 bool parse_resolution(const std::string& text, int& w, int& h) {
   unsigned long long pw = 0, ph = 0;
   char x = 0, extra = 0;
@@ -57,6 +85,7 @@ int main(int argc, char** argv) {
   render_cmd->add_option("-o,--output", render.output, "Last frame: .exr (linear) or .png (tonemapped)");
   render_cmd->add_option("--reference", render.reference, "Reference EXR: relMSE per frame");
   render_cmd->add_option("--stats-json", render.stats_json, "Write per-frame statistics as JSON");
+  add_guiding_options(render_cmd, render);
 
   rtpg::ReferenceOptions reference;
   std::string reference_res = "640x360";
@@ -66,6 +95,8 @@ int main(int argc, char** argv) {
   reference_cmd->add_option("--spp", reference.spp, "Samples per pixel")->capture_default_str();
   reference_cmd->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
   reference_cmd->add_option("-o,--output", reference.output, "Output EXR")->required();
+  reference_cmd->add_option("--max-bounces", reference.path_tracer.max_bounces,
+                            "Path vertices after the primary hit")->capture_default_str();
 
   rtpg::CommonOptions info;
   auto* info_cmd = app.add_subcommand("info", "Describe a scene");
@@ -88,6 +119,10 @@ int main(int argc, char** argv) {
     if (*render_cmd) {
       if (!parse_resolution(render_res, render.settings.width, render.settings.height))
         throw rtpg::InputError("--res", "expected WxH, got '" + render_res + "'");
+      render.guiding_config.train_memory =
+          render.train_memory == "local"    ? rtpg::GuidingConfig::TrainMemory::Local
+          : render.train_memory == "global" ? rtpg::GuidingConfig::TrainMemory::Global
+                                            : rtpg::GuidingConfig::TrainMemory::Auto;
       return rtpg::run_render(render);
     }
     if (*reference_cmd) {
@@ -98,6 +133,9 @@ int main(int argc, char** argv) {
     if (*info_cmd) return rtpg::run_info(info);
     return rtpg::run_devices();
   } catch (const rtpg::InputError& e) {
+    std::fprintf(stderr, "rtpg: %s\n", e.what());
+    return 2;
+  } catch (const rtpg::GuiderError& e) {
     std::fprintf(stderr, "rtpg: %s\n", e.what());
     return 2;
   } catch (const rtpg::ClError& e) {

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -25,9 +27,19 @@ struct SampleCoordinates {
   std::uint32_t seed = 0, frame = 0, sample = 0;
 };
 
+struct VplBuffer;
+
 class FirstBounceSampler {
  public:
   virtual ~FirstBounceSampler() = default;
+  // Before the frame's first sample(): the G-buffer of the frame is final (guiding
+  // reprojects its state here).
+  virtual void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) {}
+  // After the frame's first path-tracing pass, with its VPLs (guiding trains here).
+  virtual void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls, const SampleCoordinates& at) {}
+  virtual bool wants_vpls() const { return false; }
+  // Figures of the last frame: times (ms) by kernel name, and other figures by name.
+  virtual void report(std::map<std::string, double>& time_ms, std::map<std::string, double>& extra) {}
   // One direction for every surface pixel of the G-buffer (others get pdf 0).
   virtual void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
                       std::vector<FirstBounceSample>& out) = 0;

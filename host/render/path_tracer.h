@@ -23,7 +23,8 @@ struct PathTracerSettings {
   bool next_event = true;       // false: BSDF sampling only (emitters found by chance)
 };
 
-// The VPL buffer the guiding trainer reads (layout: kernels/shared/vpl.h).
+// The VPL buffer the guiding trainer reads (layout: kernels/shared/vpl.h); radiance.w
+// repeats info as a float for the kernels.
 struct VplBuffer {
   std::vector<glm::vec4> position, normal, radiance;
   std::vector<std::uint32_t> info;

@@ -142,13 +142,23 @@ FrameStats Renderer::render_frame(int index) {
   image_.assign(n, glm::vec3(0.0f));
   PassTimes times;
   RayCounts rays;
+  const SampleCoordinates frame_at{settings_.seed, static_cast<std::uint32_t>(index), 0u};
+  auto t = Clock::now();
+  sampler_->begin_frame(gbuffer_, frame_at);
+  stats.time_ms["guiding_begin"] = ms_since(t);
   for (int s = 0; s < settings_.spp; ++s) {
     SampleCoordinates at{settings_.seed, static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(s)};
-    auto t = Clock::now();
+    t = Clock::now();
     sampler_->sample(gbuffer_, at, first_);
-    stats.time_ms["sample"] += ms_since(t);
-    path_tracer_->trace(gbuffer_, first_, *sampler_, at, pass_, s == 0 ? &vpls_ : nullptr,
+    stats.time_ms["first_bounce"] += ms_since(t);
+    const bool keep_vpls = s == 0 && sampler_->wants_vpls();
+    path_tracer_->trace(gbuffer_, first_, *sampler_, at, pass_, keep_vpls ? &vpls_ : nullptr,
                         stats.nonfinite_samples, rays, times);
+    if (keep_vpls) {
+      t = Clock::now();
+      sampler_->end_frame(gbuffer_, vpls_, frame_at);
+      stats.time_ms["guiding_end"] = ms_since(t);
+    }
     t = Clock::now();
     const float weight = 1.0f / static_cast<float>(settings_.spp);
     for (std::size_t i = 0; i < n; ++i) image_[i] += pass_[i] * weight;
@@ -158,6 +168,7 @@ FrameStats Renderer::render_frame(int index) {
   stats.time_ms["shade"] = times.shade_ms;
   stats.secondary_rays = rays.secondary;
   stats.shadow_rays = rays.shadow;
+  sampler_->report(stats.time_ms, stats.extra);
   stats.time_ms["total"] = ms_since(start);
   return stats;
 }

@@ -4,8 +4,8 @@
  *              that generated y, in area measure at y (solid angle for an escaped ray), so
  *              that a neighbouring pixel x can convert it to its own solid angle;
  *   normal   : xyz = geometric normal at y (facing x0), w unused;
- *   radiance : rgb = radiance leaving y towards x0, w unused;
- *   info     : PG_VPL_* bits and the strategy in bits 8..15. */
+ *   radiance : rgb = radiance leaving y towards x0, w = the info bits as a float:
+ *              PG_VPL_* bits and the strategy in bits 8..15. */
 #ifndef RTPG_SHARED_VPL_H
 #define RTPG_SHARED_VPL_H
 

@@ -1,0 +1,77 @@
+// One OpenCL device with its context, an in-order profiling queue and a cache of built
+// programs. Everything that launches kernels goes through a ClRuntime, so device choice,
+// build options, caching and error reporting are decided here once.
+#pragma once
+
+#include <map>
+#include <mutex>
+#include <string>
+
+#include "cl/cl_error.h"
+#include "cl/cl_include.h"
+#include "cl/device.h"
+#include "cl/program_cache.h"
+
+namespace rtpg {
+
+// How program() requests were served since construction (tests and logs read these).
+struct ProgramCacheStats {
+  int memory_hits = 0;    // the same key was built before by this runtime
+  int disk_hits = 0;      // loaded from a binary in the disk cache
+  int source_builds = 0;  // compiled from source (and then stored to disk)
+};
+
+class ClRuntime {
+ public:
+  // device_spec as select_device() reads it ("" = $RTPG_DEVICE or the default device).
+  // Throws InputError for a spec matching no device, ClError when OpenCL fails.
+  explicit ClRuntime(const std::string& device_spec = "");
+
+  // Programs and kernels point into this context: neither copied nor moved.
+  ClRuntime(const ClRuntime&) = delete;
+  ClRuntime& operator=(const ClRuntime&) = delete;
+
+  const DeviceInfo& info() const { return info_; }
+  cl::Context& context() { return context_; }
+  cl::Device& device() { return device_; }
+  // In-order, with CL_QUEUE_PROFILING_ENABLE so that every event can be timed (event_ms).
+  cl::CommandQueue& queue() { return queue_; }
+
+  // The program of kernels/<kernel_file> (e.g. "tonemap.cl") built with
+  // "-cl-std=CL1.2 <build_options>" (feature switches such as -DPG_...). Built once per
+  // (resolved source, options, device): from memory, else the disk binary cache, else from
+  // source. A failed compile throws ClBuildError with the log; a corrupt or unloadable
+  // cache entry is rebuilt from source silently. The reference lives as long as *this.
+  cl::Program& program(const std::string& kernel_file, const std::string& build_options = "");
+
+  // A new kernel object (kernels carry their arguments: one per user) from program().
+  cl::Kernel kernel(const std::string& kernel_file, const std::string& kernel_name,
+                    const std::string& build_options = "");
+
+  // END - START of a finished command in milliseconds, from its profiling info.
+  static double event_ms(const cl::Event& event);
+
+  const ProgramCacheStats& cache_stats() const { return stats_; }
+  // The rtpg cache folder this runtime uses (rtpg_cache_dir() at construction; "" = off).
+  const std::string& cache_dir() const { return cache_dir_; }
+
+ private:
+  explicit ClRuntime(SelectedDevice selected);
+  const std::string& resolved_source(const std::string& kernel_file);
+  cl::Program build(const std::string& kernel_file, const std::string& source,
+                    const std::string& options, const std::string& key);
+
+  DeviceInfo info_;
+  cl::Device device_;
+  cl::Context context_;
+  cl::CommandQueue queue_;
+  std::string cache_dir_;
+  DiskProgramCache disk_cache_;
+
+  std::mutex mutex_;  // guards everything below: program() may be called from any thread
+  std::map<std::string, std::string> embedded_sources_;  // resolved embedded sources
+  std::map<std::string, cl::Program> programs_;          // by cache key
+  ProgramCacheStats stats_;
+};
+
+}  // namespace rtpg

@@ -1,0 +1,128 @@
+#include "cl/kernel_source.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "util/error.h"
+
+namespace rtpg {
+namespace {
+
+const char* kernel_dir_override() {
+  const char* dir = std::getenv("RTPG_KERNEL_DIR");
+  return (dir != nullptr && dir[0] != '\0') ? dir : nullptr;
+}
+
+// Updates in_comment across one line: enough C lexing to tell whether the next line starts
+// inside a /* */ comment (string and character literals may hold "/*").
+void scan_comments(const std::string& line, bool& in_comment) {
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    const char next = i + 1 < line.size() ? line[i + 1] : '\0';
+    if (in_comment) {
+      if (c == '*' && next == '/') {
+        in_comment = false;
+        ++i;
+      }
+    } else if (c == '/' && next == '/') {
+      return;
+    } else if (c == '/' && next == '*') {
+      in_comment = true;
+      ++i;
+    } else if (c == '"' || c == '\'') {
+      for (++i; i < line.size() && line[i] != c; ++i)
+        if (line[i] == '\\') ++i;
+    }
+  }
+}
+
+// If line is `#include "path"` (any spacing), sets path and returns true.
+bool quoted_include(const std::string& line, std::string& path) {
+  std::size_t i = line.find_first_not_of(" \t");
+  if (i == std::string::npos || line[i] != '#') return false;
+  i = line.find_first_not_of(" \t", i + 1);
+  if (i == std::string::npos || line.compare(i, 7, "include") != 0) return false;
+  i = line.find_first_not_of(" \t", i + 7);
+  if (i == std::string::npos || line[i] != '"') return false;
+  const std::size_t end = line.find('"', i + 1);
+  if (end == std::string::npos) return false;
+  path = line.substr(i + 1, end - i - 1);
+  if (path.compare(0, 2, "./") == 0) path.erase(0, 2);
+  return true;
+}
+
+std::string line_directive(int line, const std::string& path) {
+  return "#line " + std::to_string(line) + " \"kernels/" + path + "\"\n";
+}
+
+class Resolver {
+ public:
+  explicit Resolver(const KernelFileLoader& load) : load_(load) {}
+
+  void include(const std::string& path, const std::string& included_from) {
+    const std::optional<std::string> text = load_(path);
+    if (!text) {
+      throw InputError("kernels/" + path,
+                       "no such kernel file" +
+                           (included_from.empty() ? "" : " (included from " + included_from + ")") +
+                           " in " + kernel_file_origin() + " kernel sources");
+    }
+    included_.insert(path);
+    out_ += line_directive(1, path);
+    std::istringstream in(*text);
+    std::string line, target;
+    bool in_comment = false;
+    for (int number = 1; std::getline(in, line); ++number) {
+      if (!in_comment && quoted_include(line, target)) {
+        if (included_.count(target) != 0) {
+          out_ += "// #include \"" + target + "\": already included above\n";
+        } else {
+          include(target, "kernels/" + path + ":" + std::to_string(number));
+          out_ += line_directive(number + 1, path);
+        }
+        continue;
+      }
+      scan_comments(line, in_comment);
+      out_ += line;
+      out_ += '\n';
+    }
+  }
+
+  std::string take() { return std::move(out_); }
+
+ private:
+  const KernelFileLoader& load_;
+  std::set<std::string> included_;
+  std::string out_;
+};
+
+}  // namespace
+
+std::optional<std::string> load_kernel_file(const std::string& path) {
+  if (const char* dir = kernel_dir_override()) {
+    std::ifstream file(std::string(dir) + "/" + path, std::ios::binary);
+    if (!file) return std::nullopt;
+    std::ostringstream text;
+    text << file.rdbuf();
+    return text.str();
+  }
+  const auto& files = embedded_kernel_files();
+  const auto it = files.find(path);
+  if (it == files.end()) return std::nullopt;
+  return it->second;
+}
+
+std::string kernel_file_origin() {
+  if (const char* dir = kernel_dir_override()) return std::string("RTPG_KERNEL_DIR=") + dir;
+  return "embedded";
+}
+
+std::string resolve_kernel_source(const std::string& kernel_file, const KernelFileLoader& load) {
+  Resolver resolver(load);
+  resolver.include(kernel_file, "");
+  return resolver.take();
+}
+
+}  // namespace rtpg

@@ -1,0 +1,51 @@
+// The guided first bounce: the renderer's side of the guiding library. Uploads the host
+// G-buffer and VPLs to the device, runs the guider's reproject / sample / train kernels and
+// brings the sampled directions back for the host path tracer.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "render/first_bounce.h"
+#include "rtpg/guider.h"
+
+namespace rtpg {
+
+class ClRuntime;
+
+class GuidedFirstBounce final : public FirstBounceSampler {
+ public:
+  GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingConfig& config);
+  ~GuidedFirstBounce() override;
+
+  void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) override;
+  void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
+              std::vector<FirstBounceSample>& out) override;
+  float pdf(const GBuffer& gbuffer, std::size_t i, const glm::vec3& wi) const override;
+  void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls, const SampleCoordinates& at) override;
+  bool wants_vpls() const override { return true; }
+  void report(std::map<std::string, double>& time_ms, std::map<std::string, double>& extra) override;
+
+  Guider& guider() { return *guider_; }
+  // Freezes (false) or resumes (true) training: frozen, end_frame() leaves the state alone.
+  void set_training(bool on) { training_ = on; }
+
+ private:
+  void upload(const GBuffer& g, GuiderGBuffer& dst);
+
+  ClRuntime& runtime_;
+  std::unique_ptr<Guider> guider_;
+  GuiderGBuffer gbuffers_[2];
+  int current_ = 0;
+  bool have_previous_ = false;
+  bool training_ = true;
+  GuiderVpls vpls_;
+  GuiderSamples samples_;
+  std::vector<glm::vec4> direction_pdf_;
+  std::vector<std::uint32_t> strategy_;
+  std::vector<float> state_;  // after reprojection: what sample() and pdf() use
+  double upload_ms_ = 0.0, readback_ms_ = 0.0, sample_ms_ = 0.0;
+  double guided_fraction_ = 0.0, trained_fraction_ = 0.0, mean_pi_ = 0.0;
+};
+
+}  // namespace rtpg

@@ -1,0 +1,134 @@
+// Image decoding with OpenImageIO: channel expansion, sRGB decoding, errors as InputError.
+#include "scene/image_loader.h"
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include "util/error.h"
+
+namespace rtpg {
+
+namespace {
+
+float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+// 8-bit images are by far the most common (Sponza has ~70 of them): a table avoids a pow per
+// channel.
+const std::array<float, 256>& srgb_table() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[i] = srgb_to_linear(static_cast<float>(i) / 255.0f);
+    return t;
+  }();
+  return table;
+}
+
+// The OIIO message, or a fallback when it set none.
+std::string reason(std::string message, const char* fallback) {
+  while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
+  return message.empty() ? fallback : message;
+}
+
+Texture read_opened(OIIO::ImageInput& in, const std::string& name, ImageDecode decode) {
+  const OIIO::ImageSpec spec = in.spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+    throw InputError(name, "image has no pixels");
+  if (spec.depth > 1) throw InputError(name, "volume images are not supported");
+
+  const int nch = std::min(spec.nchannels, 4);
+  const bool eight_bit = spec.format == OIIO::TypeDesc::UINT8;
+  const std::size_t count = static_cast<std::size_t>(spec.width) *
+                            static_cast<std::size_t>(spec.height) * static_cast<std::size_t>(nch);
+  std::vector<float> values(count);
+  std::vector<unsigned char> bytes;
+  bool ok;
+  if (eight_bit) {
+    bytes.resize(count);
+    ok = in.read_image(0, 0, 0, nch, OIIO::TypeDesc::UINT8, bytes.data());
+  } else {
+    ok = in.read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, values.data());
+  }
+  if (!ok) throw InputError(name, reason(in.geterror(), "could not read the pixels"));
+
+  // Which input channel holds alpha: OIIO knows for most formats; a 2- or 4-channel image
+  // without that metadata is grey+alpha or RGBA by convention.
+  int alpha = spec.alpha_channel;
+  if (alpha >= nch || (alpha < 0 && (nch == 2 || nch == 4))) alpha = nch - 1;
+  const int colour_channels = alpha >= 0 ? alpha : nch;
+  const bool linearise = decode.srgb && !spec.format.is_floating_point();
+  const std::array<float, 256>& table = srgb_table();
+
+  auto colour = [&](std::size_t i) {
+    if (eight_bit) return linearise ? table[bytes[i]] : static_cast<float>(bytes[i]) / 255.0f;
+    return linearise ? srgb_to_linear(values[i]) : values[i];
+  };
+  auto data = [&](std::size_t i) {
+    return eight_bit ? static_cast<float>(bytes[i]) / 255.0f : values[i];
+  };
+
+  Texture texture;
+  texture.path = name;
+  texture.width = spec.width;
+  texture.height = spec.height;
+  texture.texels.resize(static_cast<std::size_t>(spec.width) *
+                        static_cast<std::size_t>(spec.height));
+  for (std::size_t p = 0; p < texture.texels.size(); ++p) {
+    const std::size_t base = p * static_cast<std::size_t>(nch);
+    glm::vec4 t;
+    if (colour_channels >= 3) {
+      t = glm::vec4(colour(base), colour(base + 1), colour(base + 2), 1.0f);
+    } else {  // grey (or grey + alpha), expanded to RGB
+      const float g = colour(base);
+      t = glm::vec4(g, g, g, 1.0f);
+    }
+    if (alpha >= 0)
+      t.w = data(base + static_cast<std::size_t>(alpha));
+    else if (decode.mask)
+      t.w = data(base);
+    texture.texels[p] = t;
+  }
+  return texture;
+}
+
+// Colour channels as stored, not multiplied by alpha: OIIO premultiplies PNG/TGA by default,
+// which would darken the colour around alpha-masked leaves.
+OIIO::ImageSpec read_config() {
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  return config;
+}
+
+}  // namespace
+
+Texture load_image(const std::string& path, ImageDecode decode) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory");
+  const OIIO::ImageSpec config = read_config();
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path, &config);
+  if (!in) throw InputError(path, reason(OIIO::geterror(), "not a readable image"));
+  return read_opened(*in, path, decode);
+}
+
+Texture load_image_from_memory(const std::string& name, const void* data, std::size_t size,
+                               ImageDecode decode) {
+  OIIO::Filesystem::IOMemReader proxy(data, size);
+  // With a config, OIIO 2.4 takes the proxy from the config's "oiio:ioproxy" attribute and
+  // ignores the open() argument (it then looks for a file named `name`): give it both.
+  OIIO::ImageSpec config = read_config();
+  OIIO::Filesystem::IOProxy* proxy_pointer = &proxy;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_pointer);
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(name, &config, &proxy);
+  if (!in) throw InputError(name, reason(OIIO::geterror(), "not a readable image"));
+  return read_opened(*in, name, decode);
+}
+
+}  // namespace rtpg

@@ -1,0 +1,334 @@
+// The scene file format (scenes/README.md, "Scene file format"): parsing, asset lookup,
+// assembly of the Scene and the checks that make a scene renderable.
+#include "scene/scene_loader.h"
+
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
+#include <filesystem>
+#include <sstream>
+#include <system_error>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/asset_paths.h"
+#include "scene/camera_json.h"
+#include "scene/json_reader.h"
+#include "scene/material_json.h"
+#include "scene/mesh_loader.h"
+#include "scene/mesh_transform.h"
+#include "scene/shapes.h"
+#include "scene/texture_cache.h"
+#include "scene/transform_json.h"
+#include "util/error.h"
+
+namespace rtpg {
+
+namespace {
+
+// nlohmann::json keeps the last of two equal keys without a word; in a scene file that
+// silently drops a whole "materials" block. This parser callback rejects duplicates and names
+// the key path.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(const std::string& file) : file_(file) {}
+
+  bool operator()(int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+      case Event::array_start:
+        frames_.push_back({event == Event::array_start, 0, "", {}, child_path()});
+        break;
+      case Event::key: {
+        Frame& top = frames_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second)
+          throw InputError(file_, child_path() + ": duplicate key");
+        break;
+      }
+      case Event::value:
+        next_element();
+        break;
+      case Event::object_end:
+      case Event::array_end:
+        frames_.pop_back();
+        next_element();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    std::size_t index;
+    std::string key;
+    std::set<std::string> keys;
+    std::string path;
+  };
+
+  // Path of the value about to be read in the innermost object or array.
+  std::string child_path() const {
+    if (frames_.empty()) return "";
+    const Frame& top = frames_.back();
+    if (top.array) return top.path + "[" + std::to_string(top.index) + "]";
+    return top.path.empty() ? top.key : top.path + "." + top.key;
+  }
+
+  void next_element() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+  }
+
+  const std::string& file_;
+  std::vector<Frame> frames_;
+};
+
+nlohmann::json parse_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory");
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  if (!in) throw InputError(path, "cannot be read");
+  try {
+    DuplicateKeyCheck check(path);
+    return nlohmann::json::parse(text.str(), std::ref(check));
+  } catch (const nlohmann::json::parse_error& e) {
+    // e.what() is "[json.exception.parse_error.101] parse error at line 3, column 7: ...":
+    // keep the part a user needs.
+    std::string message = e.what();
+    const std::size_t bracket = message.find("] ");
+    if (message.rfind("[json.exception", 0) == 0 && bracket != std::string::npos)
+      message.erase(0, bracket + 2);
+    throw InputError(path, "invalid JSON: " + message);
+  }
+}
+
+// Everything one load needs; lives for the duration of load_scene.
+class SceneBuilder {
+ public:
+  SceneBuilder(const std::string& path, const SceneLoadOptions& options, Scene& scene)
+      : path_(path),
+        scene_(scene),
+        assets_(path, resolve_asset_root(path, options)),
+        cache_(scene.textures) {}
+
+  void build(const JsonNode& root) {
+    root.check_object({"description", "camera", "camera_paths", "meshes", "shapes", "materials",
+                       "material_overrides", "sun", "environment"});
+    if (root.has("description")) root.child("description").string();
+    scene_.camera.view = read_camera(root.child("camera"));
+    if (root.has("camera_paths"))
+      read_camera_paths(root.child("camera_paths"), scene_.camera.view, scene_.camera);
+    if (root.has("materials")) read_materials(root.child("materials"));
+    if (root.has("meshes")) {
+      const JsonNode meshes = root.child("meshes");
+      for (std::size_t i = 0; i < meshes.size(); ++i) read_mesh(meshes[i]);
+    }
+    if (root.has("shapes")) {
+      const JsonNode shapes = root.child("shapes");
+      for (std::size_t i = 0; i < shapes.size(); ++i) read_shape(shapes[i]);
+    }
+    if (root.has("material_overrides")) {
+      const JsonNode overrides = root.child("material_overrides");
+      for (std::size_t i = 0; i < overrides.size(); ++i) apply_override(overrides[i]);
+    }
+    if (root.has("sun")) read_sun(root.child("sun"));
+    if (root.has("environment")) read_environment(root.child("environment"));
+    if (scene_.meshes.empty())
+      throw InputError(path_, "the scene has no geometry (meshes, shapes)");
+    if (!has_light())
+      throw InputError(path_, "no light sources (an emissive material, sun or environment)");
+  }
+
+ private:
+  // The file a path value names, or a failure listing every place searched.
+  std::string asset(const JsonNode& value) {
+    const std::string written = value.string();
+    if (written.empty()) value.fail("empty path");
+    std::vector<std::string> searched;
+    if (auto found = assets_.find(written, searched)) return *found;
+    std::string where;
+    for (const std::string& s : searched) where += (where.empty() ? "" : ", ") + s;
+    std::string hint;
+    if (assets_.asset_root().empty())
+      hint = " (no asset root: set RTPG_ASSET_ROOT or SceneLoadOptions::asset_root)";
+    value.fail("file '" + written + "' not found; looked in: " + where + hint);
+  }
+
+  std::string context(const JsonNode& value) const { return value.path() + " in " + path_; }
+
+  int texture(const JsonNode& value, ImageDecode decode) {
+    return cache_.file(asset(value), decode, context(value));
+  }
+
+  void read_materials(const JsonNode& node) {
+    const TextureResolver resolve = [this](const JsonNode& v, ImageDecode d) {
+      return texture(v, d);
+    };
+    for (const std::string& name : node.keys()) {
+      Material m;
+      m.name = name;
+      apply_material_fields(node.child(name), m, resolve);
+      named_[name] = static_cast<std::uint32_t>(scene_.materials.size());
+      scene_.materials.push_back(m);
+    }
+  }
+
+  std::uint32_t named_material(const JsonNode& value) {
+    const std::string name = value.string();
+    const auto found = named_.find(name);
+    if (found == named_.end()) value.fail("no material named '" + name + "' in \"materials\"");
+    return found->second;
+  }
+
+  void add_mesh(Mesh mesh, const JsonNode& entry) {
+    if (entry.has("transform")) transform_mesh(mesh, read_transform(entry.child("transform")));
+    scene_.meshes.push_back(std::move(mesh));
+  }
+
+  void read_mesh(const JsonNode& entry) {
+    entry.check_object({"file", "transform", "material"});
+    const JsonNode file = entry.child("file");
+    const std::string mesh_path = asset(file);
+    const bool replace = entry.has("material");
+    const std::uint32_t replacement = replace ? named_material(entry.child("material")) : 0;
+    MeshFile loaded = load_mesh_file(mesh_path, replace ? nullptr : &cache_, context(file));
+    const auto offset = static_cast<std::uint32_t>(scene_.materials.size());
+    if (!replace)
+      scene_.materials.insert(scene_.materials.end(), loaded.materials.begin(),
+                              loaded.materials.end());
+    for (Mesh& mesh : loaded.meshes) {
+      mesh.material = replace ? replacement : mesh.material + offset;
+      add_mesh(std::move(mesh), entry);
+    }
+  }
+
+  void read_shape(const JsonNode& entry) {
+    const JsonNode type_node = entry.child("type");
+    const std::string type = type_node.string();
+    Mesh mesh;
+    if (type == "quad") {
+      entry.check_object({"type", "corner", "edge1", "edge2", "material", "transform"});
+      const glm::vec3 e1 = entry.child("edge1").vec3(), e2 = entry.child("edge2").vec3();
+      const glm::vec3 n = glm::cross(e1, e2);
+      if (!(glm::dot(n, n) > 0.0f)) entry.fail("edge1 and edge2 must span a parallelogram");
+      mesh = make_quad(entry.child("corner").vec3(), e1, e2);
+    } else if (type == "box") {
+      entry.check_object({"type", "min", "max", "material", "transform"});
+      const glm::vec3 lo = entry.child("min").vec3(), hi = entry.child("max").vec3();
+      if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
+        entry.child("max").fail("max must exceed min in every component");
+      mesh = make_box(lo, hi);
+    } else if (type == "sphere") {
+      entry.check_object(
+          {"type", "center", "radius", "subdivisions", "inward", "material", "transform"});
+      const JsonNode radius = entry.child("radius");
+      const float r = radius.number();
+      if (!(r > 0.0f)) radius.fail("radius must be positive");
+      int subdivisions = 4;
+      if (entry.has("subdivisions")) {
+        const JsonNode s = entry.child("subdivisions");
+        subdivisions = s.integer();
+        if (subdivisions < 0 || subdivisions > 8) s.fail("subdivisions must lie in [0, 8]");
+      }
+      mesh = make_sphere(entry.child("center").vec3(), r, subdivisions,
+                         entry.boolean_or("inward", false));
+    } else {
+      type_node.fail("unknown shape type '" + type + "' (expected quad, box or sphere)");
+    }
+    mesh.name = type + "#" + std::to_string(shape_count_++);
+    mesh.material = named_material(entry.child("material"));
+    add_mesh(std::move(mesh), entry);
+  }
+
+  void apply_override(const JsonNode& entry) {
+    entry.check_object({"match", "set"});
+    const JsonNode match = entry.child("match");
+    const std::string pattern = match.string();
+    const TextureResolver resolve = [this](const JsonNode& v, ImageDecode d) {
+      return texture(v, d);
+    };
+    const JsonNode set = entry.child("set");
+    bool matched = false;
+    for (Material& m : scene_.materials) {
+      if (pattern != "*" && m.name != pattern) continue;
+      apply_material_fields(set, m, resolve);
+      matched = true;
+    }
+    // A misspelt name would silently change nothing.
+    if (!matched) match.fail("no material is named '" + pattern + "'");
+  }
+
+  void read_sun(const JsonNode& node) {
+    node.check_object({"direction", "irradiance", "angular_radius_deg"});
+    const JsonNode direction = node.child("direction");
+    const glm::vec3 d = direction.vec3();
+    if (!(glm::dot(d, d) > 0.0f)) direction.fail("direction must not be zero");
+    scene_.sun.enabled = true;
+    scene_.sun.direction = glm::normalize(d);
+    const JsonNode irradiance = node.child("irradiance");
+    scene_.sun.irradiance = irradiance.vec3();
+    for (int i = 0; i < 3; ++i)
+      if (!(scene_.sun.irradiance[i] >= 0.0f)) irradiance.fail("components must not be negative");
+    const float radius = node.number_or("angular_radius_deg", 0.27f);
+    if (!(radius >= 0.0f && radius < 90.0f))
+      node.child("angular_radius_deg").fail("must lie in [0, 90) degrees");
+    scene_.sun.angular_radius = glm::radians(radius);
+  }
+
+  void read_environment(const JsonNode& node) {
+    Environment& env = scene_.environment;
+    if (node.has("color")) {
+      node.check_object({"color"});
+      const JsonNode color = node.child("color");
+      env.kind = Environment::Kind::Constant;
+      env.color = color.vec3();
+      for (int i = 0; i < 3; ++i)
+        if (!(env.color[i] >= 0.0f)) color.fail("components must not be negative");
+      return;
+    }
+    node.check_object({"file", "intensity", "rotation_deg"});
+    const JsonNode file = node.child("file");
+    env.kind = Environment::Kind::Map;
+    // Float maps (hdr, exr) are linear; an 8-bit map is an sRGB photograph.
+    env.map_texture = texture(file, ImageDecode{true, false});
+    const float intensity = node.number_or("intensity", 1.0f);
+    if (!(intensity >= 0.0f)) node.child("intensity").fail("intensity must not be negative");
+    env.color = glm::vec3(intensity);
+    env.rotation = glm::radians(node.number_or("rotation_deg", 0.0f));
+  }
+
+  bool has_light() const {
+    for (const Mesh& mesh : scene_.meshes)
+      if (!mesh.triangles.empty() && scene_.materials.at(mesh.material).is_emissive()) return true;
+    const glm::vec3 sun = scene_.sun.irradiance;
+    if (scene_.sun.enabled && (sun.x > 0.0f || sun.y > 0.0f || sun.z > 0.0f)) return true;
+    const glm::vec3 env = scene_.environment.color;
+    return scene_.environment.kind != Environment::Kind::None &&
+           (env.x > 0.0f || env.y > 0.0f || env.z > 0.0f);
+  }
+
+  const std::string& path_;
+  Scene& scene_;
+  AssetPaths assets_;
+  TextureCache cache_;
+  std::map<std::string, std::uint32_t> named_;  // "materials" name -> Scene::materials index
+  int shape_count_ = 0;
+};
+
+}  // namespace
+
+Scene load_scene(const std::string& json_path, const SceneLoadOptions& options) {
+  const nlohmann::json document = parse_file(json_path);
+  Scene scene;
+  scene.source_path = json_path;
+  SceneBuilder builder(json_path, options, scene);
+  builder.build(JsonNode(document, json_path, ""));
+  return scene;
+}
+
+}  // namespace rtpg

@@ -1,0 +1,43 @@
+/* The first-bounce direction of every surface pixel from its mixture (paper eq. 2, 3.1):
+ * the Gaussian with probability pi, else the BSDF; skipped pixels and pixels without a model
+ * sample the BSDF. Writes the world direction with the mixture density (one-sample MIS) and
+ * the strategy that produced it. */
+#include "shared/guiding_pixel.h"
+#include "shared/pmm.h"
+#include "shared/rng.h"
+
+__kernel void sample(__global const float4* state0, __global const float4* state1,
+                     __global const float4* shading_normal, __global const float4* view_dir,
+                     __global const float4* base_color_roughness,
+                     __global const float4* metallic_specular, __global const uint* flags,
+                     __global float4* direction_pdf, __global uint* strategy, uint width,
+                     uint height, uint seed, uint frame, uint sample_index,
+                     pg_guiding_params params) {
+  uint x = get_global_id(0), y = get_global_id(1);
+  if (x >= width || y >= height) return;
+  uint i = y * width + x;
+  uint f = flags[i];
+  if ((f & PG_GBUF_SKY) != 0u) {
+    direction_pdf[i] = (float4)(0.0f, 0.0f, 1.0f, 0.0f);
+    strategy[i] = PG_STRATEGY_NONE;
+    return;
+  }
+  float4 bcr = base_color_roughness[i];
+  pg_pmm_state state = pg_pmm_initial_state();
+  if (pg_guiding_applies(f, bcr.w, params)) {
+    state.s0 = state0[i];
+    state.s1 = state1[i];
+  }
+  pg_pmm_model model = pg_pmm_model_from_state(state, params);
+  pg_frame frame_x = pg_frame_from_normal(shading_normal[i].xyz);
+  float3 wo = pg_to_local(frame_x, view_dir[i].xyz);
+  pg_lobes lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), wo);
+  pg_rng rng = pg_rng_make(seed, i, frame, sample_index, 1u);
+  float xi = pg_rng_next(&rng);
+  float u1 = pg_rng_next(&rng);
+  float u2 = pg_rng_next(&rng);
+  pg_pmm_sample_t s = pg_pmm_sample(model, lobes, wo, xi, u1, u2);
+  float3 w = pg_to_world(frame_x, s.wi);
+  direction_pdf[i] = (float4)(w.x, w.y, w.z, s.pdf);
+  strategy[i] = s.strategy;
+}

@@ -1,0 +1,29 @@
+/* What the three guiding kernels read of one G-buffer pixel, and the rule for which pixels
+ * guiding skips (paper, section 5: sky, emitters, transmission, roughness near zero). */
+#ifndef RTPG_SHARED_GUIDING_PIXEL_H
+#define RTPG_SHARED_GUIDING_PIXEL_H
+
+#include "shared/bsdf.h"
+#include "shared/compat.h"
+#include "shared/gbuffer.h"
+#include "shared/pmm.h"
+
+PG_NAMESPACE_BEGIN
+
+PG_FN int pg_guiding_applies(uint flags, float roughness, pg_guiding_params p) {
+  if ((flags & (PG_GBUF_SKY | PG_GBUF_EMITTER | PG_GBUF_DELTA | PG_GBUF_TRANSMISSIVE)) != 0u) return 0;
+  return roughness > p.roughness_skip;
+}
+
+PG_FN pg_material pg_material_from_gbuffer(float4 base_color_roughness, float4 metallic_specular) {
+  pg_material m;
+  m.base_color = pg_float4_xyz(base_color_roughness);
+  m.roughness = base_color_roughness.w;
+  m.metallic = metallic_specular.x;
+  m.specular = metallic_specular.y;
+  return m;
+}
+
+PG_NAMESPACE_END
+
+#endif

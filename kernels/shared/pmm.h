@@ -1,0 +1,309 @@
+/* The per-pixel parametric mixture model of the paper (eq. 2):
+ *   D(w) = pi * N(M^-1(w); mu, Sigma) / (2 pi) + (1 - pi) * p_bsdf(w)
+ * its density, its sampler, the online (stepwise) EM step that trains it from VPLs
+ * (paper 3.2, DESIGN.md section 3) and the change of hemisphere frame used by reprojection.
+ *
+ * State, 8 floats per pixel (paper 3.1): running averages of the EM sufficient statistics
+ *   s0 = (W, S0, Sx, Sy)   W = E[a], S0 = E[a gamma], (Sx, Sy) = E[a gamma u]
+ *   s1 = (Sxx, Syy, Sxy, k) second moments E[a gamma u u^T] and the epoch count k
+ * with a = lum(L_i f_r cos) / r (importance weight of a training sample), gamma the
+ * Gaussian's responsibility and u = M^-1(w) in the unit square. The model follows:
+ *   pi = clamp(S0 / W), mu = S1 / S0, Sigma = S2 / S0 - mu mu^T + eps I.
+ * k = 0 means "no model": the pixel samples its BSDF only (paper 3.1, invalid history). */
+#ifndef RTPG_SHARED_PMM_H
+#define RTPG_SHARED_PMM_H
+
+#include "shared/bsdf.h"
+#include "shared/compat.h"
+#include "shared/mapping.h"
+
+PG_NAMESPACE_BEGIN
+
+/* Every tunable of the guiding step, passed to the kernels by value. Plain 4-byte fields
+ * only, so host and device agree on the layout (checked by static_assert on the host). */
+typedef struct {
+  float pi_min;            /* clamp of the mixing weight (paper: 0.05) */
+  float pi_max;            /* (paper: 0.95) */
+  float pi_init;           /* weight of a new model (paper: 0.05) */
+  float k_max;             /* epochs after which the step size stops shrinking */
+  float step_alpha;        /* eta_k = max((k+1)^-alpha, 1/(k_max+1)) */
+  float sigma_eps;         /* added to Sigma's diagonal: keeps it positive definite */
+  float max_correlation;   /* |rho| bound: keeps the Cholesky factor well conditioned */
+  float roughness_skip;    /* no guiding where roughness is at or below this */
+  float n_min;             /* N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2) */
+  float n_max;
+  float max_weight;        /* training weights above this are treated as absurd input */
+  float reproject_depth;   /* relative position difference that rejects history */
+  float reproject_normal;  /* cosine below which normals reject history */
+  float sigma_prior;       /* prior variance added as sigma_prior / (k + 1) */
+  float reseed_ratio;      /* a sample with a > reseed_ratio * W outside the lobe re-seeds */
+  float weight_clamp;      /* training weights are clamped to weight_clamp * W (0 = off) */
+  int apron;               /* neighbourhood radius in pixels (window 2*apron+1 squared) */
+  int stride;              /* step through the window, coprime with its size */
+} pg_guiding_params;
+
+typedef struct {
+  float4 s0; /* W, S0, Sx, Sy */
+  float4 s1; /* Sxx, Syy, Sxy, k */
+} pg_pmm_state;
+
+typedef struct {
+  int valid;        /* k > 0 and the statistics are usable */
+  float pi;         /* mixing weight of the Gaussian */
+  float mx, my;     /* mean in the square */
+  float l11, l21, l22; /* Cholesky factor of Sigma */
+} pg_pmm_model;
+
+PG_FN pg_pmm_state pg_pmm_initial_state(void) {
+  pg_pmm_state s;
+  s.s0 = pg_make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+  s.s1 = pg_make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+  return s;
+}
+
+PG_FN int pg_pmm_state_finite(pg_pmm_state s) {
+  return isfinite(s.s0.x) && isfinite(s.s0.y) && isfinite(s.s0.z) && isfinite(s.s0.w) &&
+         isfinite(s.s1.x) && isfinite(s.s1.y) && isfinite(s.s1.z) && isfinite(s.s1.w);
+}
+
+/* Covariance of the statistics before regularisation: S2/S0 - mu mu^T. */
+PG_FN float3 pg_pmm_raw_covariance(pg_pmm_state s, float mx, float my) {
+  float inv = 1.0f / s.s0.y;
+  return pg_make_float3(s.s1.x * inv - mx * mx, s.s1.y * inv - my * my, s.s1.z * inv - mx * my);
+}
+
+PG_FN pg_pmm_model pg_pmm_model_from_state(pg_pmm_state s, pg_guiding_params p) {
+  pg_pmm_model m;
+  m.valid = 0;
+  m.pi = 0.0f;
+  m.mx = 0.5f;
+  m.my = 0.5f;
+  m.l11 = 1.0f;
+  m.l21 = 0.0f;
+  m.l22 = 1.0f;
+  if (!(s.s1.w > 0.0f) || !(s.s0.x > 0.0f) || !(s.s0.y > 0.0f) || !pg_pmm_state_finite(s)) return m;
+  m.pi = clamp(s.s0.y / s.s0.x, p.pi_min, p.pi_max);
+  m.mx = clamp(s.s0.z / s.s0.y, 0.0f, 1.0f);
+  m.my = clamp(s.s0.w / s.s0.y, 0.0f, 1.0f);
+  float3 c = pg_pmm_raw_covariance(s, m.mx, m.my);
+  /* Variances: non-negative, regularised, and no wider than the square needs. */
+  /* A prior variance that fades as epochs accumulate keeps a model seeded from a few
+   * samples from collapsing onto them (in the spirit of the MAP prior of Vorba et al.). */
+  float prior = p.sigma_eps + p.sigma_prior / (s.s1.w + 1.0f);
+  float sxx = clamp(c.x, 0.0f, 1.0f) + prior;
+  float syy = clamp(c.y, 0.0f, 1.0f) + prior;
+  float lim = p.max_correlation * sqrt(sxx * syy);
+  float sxy = clamp(c.z, -lim, lim);
+  m.l11 = sqrt(sxx);
+  m.l21 = sxy / m.l11;
+  m.l22 = pg_safe_sqrt(syy - m.l21 * m.l21);
+  if (!(m.l22 > 0.0f) || !isfinite(m.l21)) return m;
+  m.valid = 1;
+  return m;
+}
+
+/* Gaussian density over the unit square's plane at u (not renormalised to the square). */
+PG_FN float pg_pmm_gaussian_pdf(pg_pmm_model m, float2 u) {
+  float z1 = (u.x - m.mx) / m.l11;
+  float z2 = (u.y - m.my - m.l21 * z1) / m.l22;
+  float q = z1 * z1 + z2 * z2;
+  return exp(-0.5f * q) / (PG_TWO_PI * m.l11 * m.l22);
+}
+
+/* D(w) for a local direction wi (z = shading normal). */
+PG_FN float pg_pmm_pdf(pg_pmm_model m, pg_lobes lobes, float3 wo, float3 wi) {
+  float bsdf = pg_bsdf_pdf(lobes, wo, wi);
+  if (!m.valid) return bsdf;
+  if (wi.z <= 0.0f) return 0.0f;
+  float g = pg_pmm_gaussian_pdf(m, pg_hemisphere_to_square(wi)) * PG_INV_TWO_PI;
+  return m.pi * g + (1.0f - m.pi) * bsdf;
+}
+
+#define PG_STRATEGY_NONE 0u
+#define PG_STRATEGY_BSDF 1u
+#define PG_STRATEGY_GUIDE 2u
+
+typedef struct {
+  float3 wi;     /* local direction */
+  float pdf;     /* D(wi); 0 = no sample (a Gaussian sample outside the square) */
+  uint strategy; /* PG_STRATEGY_* */
+} pg_pmm_sample_t;
+
+/* One-sample MIS over the two components (paper 3.1): xi < pi picks the Gaussian (Box-Muller
+ * then the Cholesky factor, then M), else the BSDF. Either way the sample's weight is
+ * f cos / D(w) with the full mixture density. */
+PG_FN pg_pmm_sample_t pg_pmm_sample(pg_pmm_model m, pg_lobes lobes, float3 wo, float xi,
+                                    float u1, float u2) {
+  pg_pmm_sample_t s;
+  s.wi = pg_make_float3(0.0f, 0.0f, 1.0f);
+  s.pdf = 0.0f;
+  s.strategy = PG_STRATEGY_NONE;
+  if (m.valid && xi < m.pi) {
+    s.strategy = PG_STRATEGY_GUIDE;
+    float r = sqrt(-2.0f * log(fmax(1.0f - u1, 1e-30f)));
+    float phi = PG_TWO_PI * u2;
+    float z1 = r * cos(phi), z2 = r * sin(phi);
+    float ux = m.mx + m.l11 * z1;
+    float uy = m.my + m.l21 * z1 + m.l22 * z2;
+    if (!(ux >= 0.0f && ux <= 1.0f && uy >= 0.0f && uy <= 1.0f)) return s; /* left the square */
+    s.wi = pg_square_to_hemisphere(pg_make_float2(ux, uy));
+    if (s.wi.z <= 0.0f) return s;
+  } else {
+    s.strategy = PG_STRATEGY_BSDF;
+    /* Reuse xi's position above pi as the lobe choice: one fewer random number. */
+    float u_lobe = m.valid ? (xi - m.pi) / (1.0f - m.pi) : xi;
+    pg_bsdf_sample_t b = pg_bsdf_sample(lobes, wo, clamp(u_lobe, 0.0f, 0.99999994f), u1, u2);
+    if (b.pdf <= 0.0f) return s;
+    s.wi = b.wi;
+  }
+  s.pdf = pg_pmm_pdf(m, lobes, wo, s.wi);
+  return s;
+}
+
+/* Sums over one frame's training samples (mergeable: add fields). */
+typedef struct {
+  float a, ag, agx, agy, agxx, agyy, agxy; /* E-step weighted sums */
+  float ax, ay, axx, ayy, axy;             /* plain weighted moments (to seed a model) */
+  float count;
+  int reseed; /* a sample far brighter than the model's history fell outside its lobe */
+} pg_pmm_batch;
+
+PG_FN pg_pmm_batch pg_pmm_batch_empty(void) {
+  pg_pmm_batch b;
+  b.a = b.ag = b.agx = b.agy = b.agxx = b.agyy = b.agxy = 0.0f;
+  b.ax = b.ay = b.axx = b.ayy = b.axy = 0.0f;
+  b.count = 0.0f;
+  b.reseed = 0;
+  return b;
+}
+
+/* E-step for one sample: weight a (>= 0), square point u, direction wi, BSDF density of wi.
+ * A model that does not exist yet takes every sample at the initial weight (so its first
+ * M-step gives the weighted moments and pi = pi_init). */
+PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_guiding_params p, float a,
+                                    float2 u, float bsdf_pdf, float history_weight) {
+  if (!(a >= 0.0f) || !(a <= p.max_weight)) return b; /* NaN, negative or absurd: dropped */
+  /* VPL radiance is a one-path estimate with a heavy tail: a single firefly would drag the
+   * lobe to a random direction. Training (not rendering) clamps weights to a multiple of the
+   * running mean once a model exists. */
+  if (m.valid && p.weight_clamp > 0.0f) a = fmin(a, p.weight_clamp * history_weight);
+  float gamma = p.pi_init;
+  if (m.valid) {
+    float g = m.pi * pg_pmm_gaussian_pdf(m, u) * PG_INV_TWO_PI;
+    float d = g + (1.0f - m.pi) * bsdf_pdf;
+    gamma = d > 0.0f ? g / d : 0.0f;
+    if (!isfinite(gamma)) return b;
+    /* A narrow lobe gives far-away evidence gamma ~ 0 (G underflows), so EM alone could
+     * never move it: a sample much brighter than the history re-seeds the model. */
+    if (gamma < 1e-3f && a > p.reseed_ratio * history_weight) b.reseed = 1;
+  }
+  b.ax += a * u.x;
+  b.ay += a * u.y;
+  b.axx += a * u.x * u.x;
+  b.ayy += a * u.y * u.y;
+  b.axy += a * u.x * u.y;
+  float ag = a * gamma;
+  b.a += a;
+  b.ag += ag;
+  b.agx += ag * u.x;
+  b.agy += ag * u.y;
+  b.agxx += ag * u.x * u.x;
+  b.agyy += ag * u.y * u.y;
+  b.agxy += ag * u.x * u.y;
+  b.count += 1.0f;
+  return b;
+}
+
+/* Number of neighbour VPLs a pixel trains on at epoch k (paper 4.2). */
+PG_FN int pg_pmm_neighbour_count(float k, pg_guiding_params p) {
+  float t = clamp(1.0f - k / p.k_max, 0.0f, 1.0f);
+  return (int)(t * (p.n_max - p.n_min) + p.n_min + 0.5f);
+}
+
+/* M-step: blend this frame's statistics into the running ones (stepwise EM, Cappe and
+ * Moulines 2009). target_count is the number of samples asked for: fewer kept samples make
+ * a proportionally smaller step, so a starved frame cannot overwrite the history.
+ * *updated is set to 1 when the state changed. */
+PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_guiding_params p,
+                                 float target_count, PG_PRIVATE int* updated) {
+  *updated = 0;
+  if (!(b.count > 0.0f) || !(b.a > 0.0f)) return s;
+  float inv = 1.0f / b.count;
+  float k = s.s1.w;
+  pg_pmm_state batch;
+  if (k <= 0.0f || b.reseed) {
+    /* A new model: the plain weighted moments of the batch at weight pi_init. */
+    float w = p.pi_init * inv;
+    batch.s0 = pg_make_float4(b.a * inv, b.a * w, b.ax * w, b.ay * w);
+    batch.s1 = pg_make_float4(b.axx * w, b.ayy * w, b.axy * w, 0.0f);
+    k = 0.0f;
+  } else {
+    /* Skip a batch that gives the Gaussian nothing: at eta = 1 it would zero S0. */
+    if (!(b.ag > 0.0f)) return s;
+    batch.s0 = pg_make_float4(b.a * inv, b.ag * inv, b.agx * inv, b.agy * inv);
+    batch.s1 = pg_make_float4(b.agxx * inv, b.agyy * inv, b.agxy * inv, 0.0f);
+  }
+  if (!pg_pmm_state_finite(batch)) return s;
+  float eta = 1.0f;
+  if (k > 0.0f) {
+    eta = fmax(exp(-p.step_alpha * log(k + 1.0f)), 1.0f / (p.k_max + 1.0f));
+    eta *= clamp(b.count / fmax(target_count, 1.0f), 0.0f, 1.0f);
+  }
+  pg_pmm_state out;
+  out.s0 = s.s0 + (batch.s0 - s.s0) * eta;
+  out.s1 = s.s1 + (batch.s1 - s.s1) * eta;
+  out.s1.w = fmin(k + 1.0f, p.k_max);
+  if (!pg_pmm_state_finite(out) || !(out.s0.y > 0.0f)) return s;
+  *updated = 1;
+  return out;
+}
+
+/* Carries a state from the hemisphere frame `from` to the frame `to` (reprojection onto a
+ * pixel whose normal differs): the mean moves with its direction, the covariance with the
+ * Jacobian of the change of frame at the mean (by central differences). A mean that ends up
+ * below the new horizon cannot be carried: the initial state is returned. */
+PG_FN float2 pg_pmm_reframe_point(float2 u, pg_frame from, pg_frame to, PG_PRIVATE int* ok) {
+  float3 w = pg_to_local(to, pg_to_world(from, pg_square_to_hemisphere(u)));
+  if (w.z <= 1e-4f) *ok = 0;
+  return pg_hemisphere_to_square(w);
+}
+
+PG_FN pg_pmm_state pg_pmm_reframe(pg_pmm_state s, pg_frame from, pg_frame to) {
+  if (!(s.s1.w > 0.0f) || !(s.s0.y > 0.0f)) return s;
+  float mx = clamp(s.s0.z / s.s0.y, 0.0f, 1.0f), my = clamp(s.s0.w / s.s0.y, 0.0f, 1.0f);
+  float3 c = pg_pmm_raw_covariance(s, mx, my);
+  int ok = 1;
+  float2 m2 = pg_pmm_reframe_point(pg_make_float2(mx, my), from, to, &ok);
+  if (!ok) return pg_pmm_initial_state();
+  /* Jacobian columns; probe inside the square, on the side away from its border. */
+  float h = 1e-3f;
+  float hx = mx < 0.5f ? h : -h, hy = my < 0.5f ? h : -h;
+  int okx = 1, oky = 1;
+  float2 px = pg_pmm_reframe_point(pg_make_float2(mx + hx, my), from, to, &okx);
+  float2 py = pg_pmm_reframe_point(pg_make_float2(mx, my + hy), from, to, &oky);
+  float j11 = 1.0f, j12 = 0.0f, j21 = 0.0f, j22 = 1.0f;
+  if (okx && oky) {
+    j11 = (px.x - m2.x) / hx;
+    j21 = (px.y - m2.y) / hx;
+    j12 = (py.x - m2.x) / hy;
+    j22 = (py.y - m2.y) / hy;
+  }
+  /* Sigma' = J Sigma J^T */
+  float a = c.x, b = c.z, d = c.y;
+  float nxx = j11 * (j11 * a + j12 * b) + j12 * (j11 * b + j12 * d);
+  float nxy = j21 * (j11 * a + j12 * b) + j22 * (j11 * b + j12 * d);
+  float nyy = j21 * (j21 * a + j22 * b) + j22 * (j21 * b + j22 * d);
+  pg_pmm_state out = s;
+  float s0 = s.s0.y;
+  out.s0.z = m2.x * s0;
+  out.s0.w = m2.y * s0;
+  out.s1.x = (nxx + m2.x * m2.x) * s0;
+  out.s1.y = (nyy + m2.y * m2.y) * s0;
+  out.s1.z = (nxy + m2.x * m2.y) * s0;
+  if (!pg_pmm_state_finite(out)) return pg_pmm_initial_state();
+  return out;
+}
+
+PG_NAMESPACE_END
+
+#endif

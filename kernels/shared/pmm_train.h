@@ -1,0 +1,65 @@
+/* One pixel's training step (paper 3.2 and 4.2), shared by both variants of the train kernel
+ * (VPL tile in local memory, or VPLs read from global memory) and by host tests: take N
+ * neighbouring VPLs from the (2*apron+1)^2 window, turn each into an importance-weighted
+ * sample of L_i f_r cos at this pixel's point, and run one online EM step. */
+#ifndef RTPG_SHARED_PMM_TRAIN_H
+#define RTPG_SHARED_PMM_TRAIN_H
+
+#include "shared/bsdf.h"
+#include "shared/compat.h"
+#include "shared/guiding_pixel.h"
+#include "shared/pmm.h"
+#include "shared/rng.h"
+#include "shared/vpl.h"
+
+PG_NAMESPACE_BEGIN
+
+/* What one pixel knows about itself while training. */
+typedef struct {
+  float3 x;       /* surface point */
+  pg_frame frame; /* shading frame: the model's hemisphere */
+  float3 wo;      /* local view direction */
+  pg_lobes lobes;
+  pg_pmm_model model;
+  float history_weight; /* W of the state: the running mean training weight */
+} pg_train_pixel;
+
+/* Adds one VPL (position_pdf, normal, radiance with the info bits in w) to the batch. */
+PG_FN pg_pmm_batch pg_train_add_vpl(pg_pmm_batch b, pg_train_pixel px, pg_guiding_params p,
+                                    float4 position_pdf, float4 normal, float4 radiance_info) {
+  uint info = (uint)radiance_info.w;
+  if ((info & PG_VPL_VALID) == 0u || pg_vpl_strategy(info) != PG_STRATEGY_BSDF) return b;
+  float3 w;
+  float r; /* density of w as seen from this pixel */
+  if ((info & PG_VPL_DISTANT) != 0u) {
+    w = pg_float4_xyz(position_pdf);
+    r = position_pdf.w;
+  } else {
+    float3 to = pg_float4_xyz(position_pdf) - px.x;
+    float d2 = dot(to, to);
+    if (!(d2 > 0.0f)) return b;
+    w = to * (1.0f / sqrt(d2));
+    /* The VPL's density is in area measure at y: to this pixel's solid angle. */
+    float cos_y = -dot(pg_float4_xyz(normal), w);
+    if (cos_y <= 1e-4f) return b; /* y faces away from x */
+    r = position_pdf.w * d2 / cos_y;
+  }
+  if (!(r > 0.0f) || !isfinite(r)) return b;
+  float3 wl = pg_to_local(px.frame, w);
+  if (wl.z <= 0.0f) return b;
+  float3 f = pg_bsdf_eval(px.lobes, px.wo, wl) * wl.z;
+  float a = pg_luminance(pg_float4_xyz(radiance_info) * f) / r;
+  return pg_pmm_batch_add(b, px.model, p, a, pg_hemisphere_to_square(wl),
+                          pg_bsdf_pdf(px.lobes, px.wo, wl), px.history_weight);
+}
+
+/* The window offset of the s-th neighbour of this frame's walk through the window. */
+PG_FN int pg_train_window_index(uint start, int s, pg_guiding_params p) {
+  int side = 2 * p.apron + 1;
+  int size = side * side;
+  return (int)((start + (uint)(s * p.stride)) % (uint)size);
+}
+
+PG_NAMESPACE_END
+
+#endif

@@ -1,0 +1,91 @@
+/* Online EM training of every pixel's mixture from the VPLs of its neighbourhood (paper 3.2,
+ * 4.2). Built in two variants (build option PG_TRAIN_LOCAL_TILE): 1 loads the work-group's
+ * VPL tile plus an apron of `apron` pixels into local memory first (what GPUs need); 0 reads
+ * the same VPLs straight from global memory (faster on PoCL's CPU device, DESIGN.md 7).
+ * Both give identical results. trained[i] is 1 where the state changed. */
+#include "shared/pmm_train.h"
+
+#ifndef PG_TRAIN_LOCAL_TILE
+#define PG_TRAIN_LOCAL_TILE 1
+#endif
+
+__kernel void train(__global const float4* state0, __global const float4* state1,
+                    __global float4* out_state0, __global float4* out_state1,
+                    __global const float4* position_depth, __global const float4* shading_normal,
+                    __global const float4* view_dir, __global const float4* base_color_roughness,
+                    __global const float4* metallic_specular, __global const uint* flags,
+                    __global const float4* vpl_position, __global const float4* vpl_normal,
+                    __global const float4* vpl_radiance_info, __global uchar* trained, uint width,
+                    uint height, uint seed, uint frame, pg_guiding_params params,
+                    __local float4* tile_position, __local float4* tile_normal,
+                    __local float4* tile_radiance) {
+  int x = (int)get_global_id(0), y = (int)get_global_id(1);
+  int apron = params.apron;
+#if PG_TRAIN_LOCAL_TILE
+  int lw = (int)get_local_size(0), lh = (int)get_local_size(1);
+  int tw = lw + 2 * apron, th = lh + 2 * apron;
+  int ox = (int)(get_group_id(0) * get_local_size(0)) - apron;
+  int oy = (int)(get_group_id(1) * get_local_size(1)) - apron;
+  for (int t = (int)(get_local_id(1) * get_local_size(0) + get_local_id(0)); t < tw * th;
+       t += lw * lh) {
+    int sx = ox + t % tw, sy = oy + t / tw;
+    if (sx >= 0 && sy >= 0 && sx < (int)width && sy < (int)height) {
+      int j = sy * (int)width + sx;
+      tile_position[t] = vpl_position[j];
+      tile_normal[t] = vpl_normal[j];
+      tile_radiance[t] = vpl_radiance_info[j];
+    } else {
+      tile_position[t] = (float4)(0.0f);
+      tile_normal[t] = (float4)(0.0f);
+      tile_radiance[t] = (float4)(0.0f); /* info 0: not a VPL */
+    }
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+#endif
+  if (x >= (int)width || y >= (int)height) return;
+  int i = y * (int)width + x;
+  float4 s0 = state0[i], s1 = state1[i];
+  uint f = flags[i];
+  float4 bcr = base_color_roughness[i];
+  uchar changed = 0;
+  if (pg_guiding_applies(f, bcr.w, params)) {
+    pg_pmm_state state;
+    state.s0 = s0;
+    state.s1 = s1;
+    pg_train_pixel px;
+    px.x = position_depth[i].xyz;
+    px.frame = pg_frame_from_normal(shading_normal[i].xyz);
+    px.wo = pg_to_local(px.frame, view_dir[i].xyz);
+    px.lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), px.wo);
+    px.model = pg_pmm_model_from_state(state, params);
+    px.history_weight = s0.x;
+    int side = 2 * apron + 1;
+    int n = min(pg_pmm_neighbour_count(s1.w, params), side * side);
+    pg_rng rng = pg_rng_make(seed, (uint)i, frame, 0u, 3u);
+    uint start = pg_rng_next_uint(&rng) % (uint)(side * side);
+    pg_pmm_batch batch = pg_pmm_batch_empty();
+    for (int s = 0; s < n; ++s) {
+      int w = pg_train_window_index(start, s, params);
+      int dx = w % side - apron, dy = w / side - apron;
+#if PG_TRAIN_LOCAL_TILE
+      int t = ((int)get_local_id(1) + apron + dy) * tw + (int)get_local_id(0) + apron + dx;
+      batch = pg_train_add_vpl(batch, px, params, tile_position[t], tile_normal[t],
+                               tile_radiance[t]);
+#else
+      int sx = x + dx, sy = y + dy;
+      if (sx < 0 || sy < 0 || sx >= (int)width || sy >= (int)height) continue;
+      int j = sy * (int)width + sx;
+      batch = pg_train_add_vpl(batch, px, params, vpl_position[j], vpl_normal[j],
+                               vpl_radiance_info[j]);
+#endif
+    }
+    int updated = 0;
+    state = pg_pmm_update(state, batch, params, (float)n, &updated);
+    s0 = state.s0;
+    s1 = state.s1;
+    changed = (uchar)updated;
+  }
+  out_state0[i] = s0;
+  out_state1[i] = s1;
+  trained[i] = changed;
+}
