@@ -57,30 +57,29 @@ __kernel void train(__global const float4* state0, __global const float4* state1
     px.frame = pg_frame_from_normal(shading_normal[i].xyz);
     px.wo = pg_to_local(px.frame, view_dir[i].xyz);
     px.lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), px.wo);
-    px.model = pg_pmm_model_from_state(state, params);
-    px.history_weight = s0.x;
     int side = 2 * apron + 1;
-    int n = min(pg_pmm_neighbour_count(s1.w, params), side * side);
+    int n = min(min(pg_pmm_neighbour_count(s1.w, params), side * side), PG_MAX_TRAIN_SAMPLES);
     pg_rng rng = pg_rng_make(seed, (uint)i, frame, 0u, 3u);
     uint start = pg_rng_next_uint(&rng) % (uint)(side * side);
-    pg_pmm_batch batch = pg_pmm_batch_empty();
+    float4 samples[PG_MAX_TRAIN_SAMPLES];
+    int kept = 0;
     for (int s = 0; s < n; ++s) {
       int w = pg_train_window_index(start, s, params);
       int dx = w % side - apron, dy = w / side - apron;
 #if PG_TRAIN_LOCAL_TILE
       int t = ((int)get_local_id(1) + apron + dy) * tw + (int)get_local_id(0) + apron + dx;
-      batch = pg_train_add_vpl(batch, px, params, tile_position[t], tile_normal[t],
-                               tile_radiance[t]);
+      kept += pg_train_sample_from_vpl(px, tile_position[t], tile_normal[t], tile_radiance[t],
+                                       &samples[kept]);
 #else
       int sx = x + dx, sy = y + dy;
       if (sx < 0 || sy < 0 || sx >= (int)width || sy >= (int)height) continue;
       int j = sy * (int)width + sx;
-      batch = pg_train_add_vpl(batch, px, params, vpl_position[j], vpl_normal[j],
-                               vpl_radiance_info[j]);
+      kept += pg_train_sample_from_vpl(px, vpl_position[j], vpl_normal[j], vpl_radiance_info[j],
+                                       &samples[kept]);
 #endif
     }
     int updated = 0;
-    state = pg_pmm_update(state, batch, params, (float)n, &updated);
+    state = pg_pmm_train(state, samples, kept, params, (float)n, params.em_passes, &updated);
     s0 = state.s0;
     s1 = state.s1;
     changed = (uchar)updated;

@@ -21,6 +21,7 @@
 #include "scene/scene_loader.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/stderr_capture.h"
 
 #ifndef RTPG_SOURCE_DIR
 #define RTPG_SOURCE_DIR "."
@@ -39,22 +40,28 @@ std::string extension_of(const std::string& path) {
   return ext;
 }
 
+// Every output's folder is checked before any work, so that a bad path fails before an
+// earlier output of the same run has been written.
+void check_output_folder(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent))
+    throw InputError(path, "folder '" + parent.string() + "' does not exist");
+}
+
 void check_output_path(const std::string& path, const char* flag, bool png_allowed) {
   if (path.empty()) return;
   const std::string ext = extension_of(path);
   if (ext != ".exr" && !(png_allowed && ext == ".png"))
     throw InputError(flag, "output must end in .exr" + std::string(png_allowed ? " or .png" : "") +
                                ", got '" + path + "'");
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty() && !fs::is_directory(parent))
-    throw InputError(path, "folder '" + parent.string() + "' does not exist");
+  check_output_folder(path);
 }
 
 Scene load(const CommonOptions& common) {
   const std::string path = common.scene.empty() ? default_scene_path() : common.scene;
   SceneLoadOptions options;
   options.asset_root = common.asset_root;
-  return load_scene(path, options);
+  return load_quietly([&] { return load_scene(path, options); });
 }
 
 double median(std::vector<double> v) {
@@ -85,6 +92,13 @@ void write_output(const std::string& path, const ImageRgb& image, ClRuntime& cl,
   }
 }
 
+// The flag wins, then the scene's integrator setting, then the renderer's default.
+int bounces_for(const Scene& scene, int flag) {
+  if (flag < 0) throw InputError("--max-bounces", "must be at least 1");
+  if (flag > 0) return flag;
+  return scene.max_bounces > 0 ? scene.max_bounces : PathTracerSettings{}.max_bounces;
+}
+
 }  // namespace
 
 std::string default_scene_path() {
@@ -94,10 +108,12 @@ std::string default_scene_path() {
 
 int run_render(const RenderOptions& options) {
   check_output_path(options.output, "--output", true);
+  if (!options.stats_json.empty()) check_output_folder(options.stats_json);
   if (options.frames <= 0) throw InputError("--frames", "must be at least 1");
+  if (options.max_bounces < 0) throw InputError("--max-bounces", "must be at least 1");
   ImageRgb reference;
   if (!options.reference.empty()) {
-    reference = read_image(options.reference);
+    reference = load_quietly([&] { return read_image(options.reference); });
     if (reference.width != options.settings.width || reference.height != options.settings.height)
       throw InputError(options.reference,
                        fmt::format("reference is {}x{}, the render is {}x{}", reference.width,
@@ -106,7 +122,9 @@ int run_render(const RenderOptions& options) {
   const std::string scene_path = options.common.scene.empty() ? default_scene_path() : options.common.scene;
   const Scene scene = load(options.common);
   ClRuntime cl(options.common.device);
-  Renderer renderer(scene, options.settings);
+  RenderSettings settings = options.settings;
+  settings.path_tracer.max_bounces = bounces_for(scene, options.max_bounces);
+  Renderer renderer(scene, settings);
   if (options.guiding == "pmm")
     renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(
         cl, options.settings.width, options.settings.height, options.guiding_config));
@@ -153,6 +171,7 @@ int run_render(const RenderOptions& options) {
                                   {"seed", options.settings.seed},
                                   {"jitter", options.settings.jitter},
                                   {"guiding", options.guiding},
+                                  {"max_bounces", settings.path_tracer.max_bounces},
                                   {"device", cl.info().device_name},
                                   {"threads", static_cast<int>(std::thread::hardware_concurrency())},
                                   {"bvh_build_ms", renderer.tracer().build_seconds() * 1e3},
@@ -175,12 +194,13 @@ int run_render(const RenderOptions& options) {
 int run_reference(const ReferenceOptions& options) {
   check_output_path(options.output, "--output", false);
   if (options.spp <= 0) throw InputError("--spp", "must be at least 1");
+  if (options.max_bounces < 0) throw InputError("--max-bounces", "must be at least 1");
   const Scene scene = load(options.common);
   RenderSettings settings;
   settings.width = options.width;
   settings.height = options.height;
   settings.seed = options.seed;
-  settings.path_tracer = options.path_tracer;
+  settings.path_tracer.max_bounces = bounces_for(scene, options.max_bounces);
   // Several samples share a G-buffer; new jitter per pass gives the pixel filter's integral.
   settings.spp = options.spp % 4 == 0 ? 4 : 1;
   const int passes = options.spp / settings.spp;

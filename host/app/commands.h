@@ -20,6 +20,7 @@ struct RenderOptions {
   CommonOptions common;
   RenderSettings settings;
   int frames = 1;
+  int max_bounces = 0;     // 0 = the scene's integrator.max_bounces, else the default
   std::string output;      // .exr or .png; "" = none
   std::string reference;   // EXR to compute relMSE against
   std::string stats_json;  // "" = none
@@ -32,7 +33,7 @@ struct ReferenceOptions {
   CommonOptions common;
   int width = 640, height = 360, spp = 1024;
   std::uint32_t seed = 0;
-  PathTracerSettings path_tracer;
+  int max_bounces = 0;  // 0 = the scene's, else the default
   std::string output;
 };
 

@@ -41,6 +41,7 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderOptions& r) {
   grp->add_option("--pg-sigma-eps", g.sigma_eps, "Regularisation of the covariance diagonal")->capture_default_str();
   grp->add_option("--pg-sigma-prior", g.sigma_prior, "Prior variance, added as sigma-prior / (k + 1)")->capture_default_str();
   grp->add_option("--pg-reseed-ratio", g.reseed_ratio, "Re-seed a lobe on a sample this many times brighter than its history")->capture_default_str();
+  grp->add_option("--pg-em-passes", g.em_passes, "E-step passes over each frame's training samples")->capture_default_str();
   grp->add_option("--pg-weight-clamp", g.weight_clamp, "Clamp training weights to this multiple of the running mean (0 = off)")->capture_default_str();
   grp->add_option("--pg-reproject-position", g.reproject_position, "Relative position change that rejects history")->capture_default_str();
   grp->add_option("--pg-reproject-normal", g.reproject_normal, "Normal cosine below which history is rejected")->capture_default_str();
@@ -78,14 +79,15 @@ int main(int argc, char** argv) {
   render_cmd->add_flag("--no-jitter", [&](std::int64_t) { render.settings.jitter = false; },
                        "Sample pixel centres (no sub-pixel jitter)");
   render_cmd->add_option("--camera-path", render.settings.camera_path, "Named camera path of the scene");
-  render_cmd->add_option("--max-bounces", render.settings.path_tracer.max_bounces,
-                         "Path vertices after the primary hit")->capture_default_str();
+  render_cmd->add_option("--max-bounces", render.max_bounces,
+                         "Path vertices after the primary hit (default: the scene's integrator.max_bounces, else 8)");
   render_cmd->add_flag("--no-nee", [&](std::int64_t) { render.settings.path_tracer.next_event = false; },
                        "BSDF sampling only (no next-event estimation)");
   render_cmd->add_option("-o,--output", render.output, "Last frame: .exr (linear) or .png (tonemapped)");
   render_cmd->add_option("--reference", render.reference, "Reference EXR: relMSE per frame");
   render_cmd->add_option("--stats-json", render.stats_json, "Write per-frame statistics as JSON");
   add_guiding_options(render_cmd, render);
+
 
   rtpg::ReferenceOptions reference;
   std::string reference_res = "640x360";
@@ -95,8 +97,8 @@ int main(int argc, char** argv) {
   reference_cmd->add_option("--spp", reference.spp, "Samples per pixel")->capture_default_str();
   reference_cmd->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
   reference_cmd->add_option("-o,--output", reference.output, "Output EXR")->required();
-  reference_cmd->add_option("--max-bounces", reference.path_tracer.max_bounces,
-                            "Path vertices after the primary hit")->capture_default_str();
+  reference_cmd->add_option("--max-bounces", reference.max_bounces,
+                            "Path vertices after the primary hit (default: the scene's, else 8)");
 
   rtpg::CommonOptions info;
   auto* info_cmd = app.add_subcommand("info", "Describe a scene");

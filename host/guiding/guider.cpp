@@ -10,7 +10,7 @@ namespace rtpg {
 namespace {
 
 using shared::pg_guiding_params;
-static_assert(sizeof(pg_guiding_params) == 18 * 4, "pg_guiding_params: 18 plain 4-byte fields, no padding");
+static_assert(sizeof(pg_guiding_params) == 19 * 4, "pg_guiding_params: 19 plain 4-byte fields, no padding");
 static_assert(sizeof(shared::pg_pmm_state) == 32, "8 floats of state per pixel");
 
 // A step through the neighbourhood window that visits every cell once: coprime with its size.
@@ -33,6 +33,8 @@ void validate(const GuidingConfig& c, int width, int height) {
   if (!(c.reseed_ratio > 0.0f)) fail("reseed_ratio must be positive");
   if (!(c.max_correlation > 0.0f && c.max_correlation < 1.0f)) fail("max_correlation must be in (0, 1)");
   if (c.n_min < 1 || c.n_max < c.n_min) fail("need 1 <= n_min <= n_max");
+  if (c.n_max > 32) fail("n_max must be at most 32 (PG_MAX_TRAIN_SAMPLES)");
+  if (c.em_passes < 1 || c.em_passes > 8) fail("em_passes must be in [1, 8]");
   if (c.apron < 0 || c.apron > 8) fail("apron must be in [0, 8]");
   if (c.local_x < 1 || c.local_y < 1) fail("local size must be positive");
 }
@@ -58,6 +60,7 @@ shared::pg_guiding_params make_guiding_params(const GuidingConfig& c) {
   p.sigma_prior = c.sigma_prior;
   p.reseed_ratio = c.reseed_ratio;
   p.weight_clamp = c.weight_clamp;
+  p.em_passes = c.em_passes;
   p.apron = c.apron;
   p.stride = window_stride(c.apron);
   return p;

@@ -299,10 +299,11 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
       ++nonfinite;
     }
     if (vpls) {
-      if (!is_finite(p.vpl_radiance) || !(vpls->position[i].w > 0.0f) || !std::isfinite(vpls->position[i].w))
+      const glm::vec3 vpl_l = p.vpl_radiance;
+      if (!is_finite(vpl_l) || !(vpls->position[i].w > 0.0f) || !std::isfinite(vpls->position[i].w))
         vpls->info[i] &= ~PG_VPL_VALID;
       // The kernels read the info bits from radiance.w (exact: small integers).
-      vpls->radiance[i] = glm::vec4(is_finite(p.vpl_radiance) ? p.vpl_radiance : glm::vec3(0.0f),
+      vpls->radiance[i] = glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f),
                                     static_cast<float>(vpls->info[i]));
     }
   }

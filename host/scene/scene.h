@@ -79,6 +79,7 @@ struct Scene {
   SunLight sun;
   Environment environment;
   CameraSetup camera;
+  int max_bounces = 0;  // the scene's "integrator.max_bounces"; 0 = the renderer's default
 
   std::size_t triangle_count() const;
   glm::vec3 bounds_min() const;

@@ -118,7 +118,7 @@ class SceneBuilder {
 
   void build(const JsonNode& root) {
     root.check_object({"description", "camera", "camera_paths", "meshes", "shapes", "materials",
-                       "material_overrides", "sun", "environment"});
+                       "material_overrides", "sun", "environment", "integrator"});
     if (root.has("description")) root.child("description").string();
     scene_.camera.view = read_camera(root.child("camera"));
     if (root.has("camera_paths"))
@@ -138,6 +138,7 @@ class SceneBuilder {
     }
     if (root.has("sun")) read_sun(root.child("sun"));
     if (root.has("environment")) read_environment(root.child("environment"));
+    if (root.has("integrator")) read_integrator(root.child("integrator"));
     if (scene_.meshes.empty())
       throw InputError(path_, "the scene has no geometry (meshes, shapes)");
     if (!has_light())
@@ -157,6 +158,17 @@ class SceneBuilder {
     if (assets_.asset_root().empty())
       hint = " (no asset root: set RTPG_ASSET_ROOT or SceneLoadOptions::asset_root)";
     value.fail("file '" + written + "' not found; looked in: " + where + hint);
+  }
+
+  // Render defaults the scene asks for (as pbrt's Integrator directive); flags override them.
+  void read_integrator(const JsonNode& node) {
+    node.check_object({"max_bounces"});
+    if (node.has("max_bounces")) {
+      const JsonNode value = node.child("max_bounces");
+      const int bounces = value.integer();
+      if (bounces < 1 || bounces > 64) value.fail("expected an integer in [1, 64]");
+      scene_.max_bounces = bounces;
+    }
   }
 
   std::string context(const JsonNode& value) const { return value.path() + " in " + path_; }

@@ -39,9 +39,10 @@ struct GuidingConfig {
   int k_max = 32;         // epochs; the step size stops shrinking after k_max updates
   float step_alpha = 1.0f;  // eta_k = max((k+1)^-alpha, 1/(k_max+1)): 1 = plain mean until k_max
   float sigma_eps = 1e-4f;  // regularisation of Sigma's diagonal (square units^2)
-  float sigma_prior = 1e-2f;  // prior variance, added as sigma_prior / (k + 1)
+  float sigma_prior = 5e-2f;  // prior variance, added as sigma_prior / (k + 1)
   float reseed_ratio = 10.0f;  // a sample with weight > ratio * W outside the lobe re-seeds it
   float weight_clamp = 0.0f;   // training weights clamped to weight_clamp * W (0 = no clamp)
+  int em_passes = 3;           // E-step passes over each frame's samples
   float max_correlation = 0.95f;
   float roughness_skip = 0.05f;  // roughness at or below: BSDF only, no training
   int n_min = 5, n_max = 20;     // N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2);

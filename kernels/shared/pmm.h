@@ -38,6 +38,7 @@ typedef struct {
   float sigma_prior;       /* prior variance added as sigma_prior / (k + 1) */
   float reseed_ratio;      /* a sample with a > reseed_ratio * W outside the lobe re-seeds */
   float weight_clamp;      /* training weights are clamped to weight_clamp * W (0 = off) */
+  int em_passes;           /* E-step passes over a frame's samples (pg_pmm_train) */
   int apron;               /* neighbourhood radius in pixels (window 2*apron+1 squared) */
   int stride;              /* step through the window, coprime with its size */
 } pg_guiding_params;
@@ -100,6 +101,13 @@ PG_FN pg_pmm_model pg_pmm_model_from_state(pg_pmm_state s, pg_guiding_params p) 
   if (!(m.l22 > 0.0f) || !isfinite(m.l21)) return m;
   m.valid = 1;
   return m;
+}
+
+/* Squared Mahalanobis distance of u from the Gaussian's mean. */
+PG_FN float pg_pmm_mahalanobis2(pg_pmm_model m, float2 u) {
+  float z1 = (u.x - m.mx) / m.l11;
+  float z2 = (u.y - m.my - m.l21 * z1) / m.l22;
+  return z1 * z1 + z2 * z2;
 }
 
 /* Gaussian density over the unit square's plane at u (not renormalised to the square). */
@@ -194,8 +202,10 @@ PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_guiding_p
     gamma = d > 0.0f ? g / d : 0.0f;
     if (!isfinite(gamma)) return b;
     /* A narrow lobe gives far-away evidence gamma ~ 0 (G underflows), so EM alone could
-     * never move it: a sample much brighter than the history re-seeds the model. */
-    if (gamma < 1e-3f && a > p.reseed_ratio * history_weight) b.reseed = 1;
+     * never move it: a sample far outside the lobe (beyond 5 standard deviations, where
+     * gamma is negligible) and much brighter than the history re-seeds the model. Samples
+     * nearer than that move the lobe through the ordinary M-step. */
+    if (pg_pmm_mahalanobis2(m, u) > 25.0f && a > p.reseed_ratio * history_weight) b.reseed = 1;
   }
   b.ax += a * u.x;
   b.ay += a * u.y;
@@ -255,6 +265,35 @@ PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_guiding_para
   out.s1.w = fmin(k + 1.0f, p.k_max);
   if (!pg_pmm_state_finite(out) || !(out.s0.y > 0.0f)) return s;
   *updated = 1;
+  return out;
+}
+
+/* Largest neighbour count a pixel trains on in one frame (bounds the private sample array). */
+#define PG_MAX_TRAIN_SAMPLES 32
+
+/* One frame's training of one pixel from its n samples (x = weight a, y/z = square point u,
+ * w = BSDF density), with `passes` E-step passes: each pass re-evaluates the responsibilities
+ * under the model the previous pass's M-step would give, so a lobe that sits off its target
+ * moves there within the frame instead of over many frames (DESIGN.md section 3 notes that a
+ * single pass converges slowly). Only the last pass's statistics enter the state. */
+PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples, int n,
+                                pg_guiding_params p, float target_count, int passes,
+                                PG_PRIVATE int* updated) {
+  pg_pmm_model m = pg_pmm_model_from_state(s, p);
+  pg_pmm_state base = s, out = s;
+  *updated = 0;
+  for (int pass = 0; pass < passes; ++pass) {
+    pg_pmm_batch b = pg_pmm_batch_empty();
+    for (int j = 0; j < n; ++j)
+      b = pg_pmm_batch_add(b, m, p, samples[j].x, pg_make_float2(samples[j].y, samples[j].z),
+                           samples[j].w, s.s0.x);
+    /* A re-seed replaces the history: later passes refine the new model alone. */
+    if (b.reseed) base = pg_pmm_initial_state();
+    out = pg_pmm_update(base, b, p, target_count, updated);
+    if (!*updated) return s;
+    m = pg_pmm_model_from_state(out, p);
+    if (!m.valid) return out;
+  }
   return out;
 }
 

@@ -20,15 +20,15 @@ typedef struct {
   pg_frame frame; /* shading frame: the model's hemisphere */
   float3 wo;      /* local view direction */
   pg_lobes lobes;
-  pg_pmm_model model;
-  float history_weight; /* W of the state: the running mean training weight */
 } pg_train_pixel;
 
-/* Adds one VPL (position_pdf, normal, radiance with the info bits in w) to the batch. */
-PG_FN pg_pmm_batch pg_train_add_vpl(pg_pmm_batch b, pg_train_pixel px, pg_guiding_params p,
-                                    float4 position_pdf, float4 normal, float4 radiance_info) {
+/* One VPL (position_pdf, normal, radiance with the info bits in w) as a training sample of
+ * this pixel: x = weight a = lum(L f_r cos) / r, (y, z) = square point, w = BSDF density.
+ * Returns 0 when the VPL says nothing about this pixel's hemisphere. */
+PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float4 normal,
+                                   float4 radiance_info, PG_PRIVATE float4* sample) {
   uint info = (uint)radiance_info.w;
-  if ((info & PG_VPL_VALID) == 0u || pg_vpl_strategy(info) != PG_STRATEGY_BSDF) return b;
+  if ((info & PG_VPL_VALID) == 0u || pg_vpl_strategy(info) != PG_STRATEGY_BSDF) return 0;
   float3 w;
   float r; /* density of w as seen from this pixel */
   if ((info & PG_VPL_DISTANT) != 0u) {
@@ -37,20 +37,21 @@ PG_FN pg_pmm_batch pg_train_add_vpl(pg_pmm_batch b, pg_train_pixel px, pg_guidin
   } else {
     float3 to = pg_float4_xyz(position_pdf) - px.x;
     float d2 = dot(to, to);
-    if (!(d2 > 0.0f)) return b;
+    if (!(d2 > 0.0f)) return 0;
     w = to * (1.0f / sqrt(d2));
     /* The VPL's density is in area measure at y: to this pixel's solid angle. */
     float cos_y = -dot(pg_float4_xyz(normal), w);
-    if (cos_y <= 1e-4f) return b; /* y faces away from x */
+    if (cos_y <= 1e-4f) return 0; /* y faces away from x */
     r = position_pdf.w * d2 / cos_y;
   }
-  if (!(r > 0.0f) || !isfinite(r)) return b;
+  if (!(r > 0.0f) || !isfinite(r)) return 0;
   float3 wl = pg_to_local(px.frame, w);
-  if (wl.z <= 0.0f) return b;
+  if (wl.z <= 0.0f) return 0;
   float3 f = pg_bsdf_eval(px.lobes, px.wo, wl) * wl.z;
   float a = pg_luminance(pg_float4_xyz(radiance_info) * f) / r;
-  return pg_pmm_batch_add(b, px.model, p, a, pg_hemisphere_to_square(wl),
-                          pg_bsdf_pdf(px.lobes, px.wo, wl), px.history_weight);
+  float2 u = pg_hemisphere_to_square(wl);
+  *sample = pg_make_float4(a, u.x, u.y, pg_bsdf_pdf(px.lobes, px.wo, wl));
+  return 1;
 }
 
 /* The window offset of the s-th neighbour of this frame's walk through the window. */

@@ -12,7 +12,7 @@
 #include "cl/cl_runtime.h"
 #include "cl/device.h"
 #include "cl/image_kernels.h"
-#include "test_env.h"
+#include "support/test_env.h"
 #include "util/error.h"
 
 namespace rtpg {

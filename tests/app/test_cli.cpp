@@ -1,0 +1,474 @@
+// The rtpg program as a user meets it. Bad input of every kind must end with exit code 2 and
+// a one-line message on stderr naming the file or flag at fault, and must leave the output
+// folder exactly as it was: no new file, no temporary left behind, an existing output file
+// byte for byte unchanged. Good input must write valid images and statistics.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <sys/wait.h>
+
+#include <OpenImageIO/imageio.h>
+#include <nlohmann/json.hpp>
+
+#include "support/test_env.h"
+
+namespace fs = std::filesystem;
+
+namespace rtpg {
+namespace {
+
+std::string rtpg_binary() {
+  const char* env = std::getenv("RTPG_BINARY");
+  return env ? env : RTPG_BINARY_PATH;
+}
+
+std::string source_dir() {
+  const char* env = std::getenv("RTPG_SOURCE_DIR");
+  return env ? env : RTPG_SOURCE_DIR;
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void write_file(const fs::path& path, const std::string& content) {
+  std::ofstream(path, std::ios::binary) << content;
+}
+
+std::string random_bytes(std::size_t n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::string out(n, '\0');
+  for (char& c : out) c = static_cast<char>(rng() & 0xff);
+  return out;
+}
+
+struct RunResult {
+  bool exited = false;  // false: killed by a signal (a crash)
+  int exit_code = -1;
+  int signal = 0;
+  std::string out, err;
+};
+
+// Runs `rtpg ARGS` with `cwd` as working directory. stdout and stderr go to files in a
+// separate folder, so that the working directory holds only what rtpg itself writes.
+RunResult run_rtpg(const fs::path& cwd, const std::string& args) {
+  test::TempDir capture;
+  const fs::path out = capture.path() / "stdout", err = capture.path() / "stderr";
+  // exec: the shell becomes rtpg, so a crash shows as a signal rather than as exit code 128+n.
+  const std::string command = "cd " + shell_quote(cwd.string()) + " && exec " +
+                              shell_quote(rtpg_binary()) + " " + args + " >" +
+                              shell_quote(out.string()) + " 2>" + shell_quote(err.string());
+  const int status = std::system(command.c_str());
+  RunResult r;
+  r.exited = WIFEXITED(status);
+  r.exit_code = r.exited ? WEXITSTATUS(status) : -1;
+  r.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+  r.out = read_file(out);
+  r.err = read_file(err);
+  return r;
+}
+
+// Every file under `dir` (relative path -> bytes), hidden temporaries included.
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(dir))
+    if (entry.is_regular_file())
+      files[fs::relative(entry.path(), dir).string()] = read_file(entry.path());
+    else if (!entry.is_directory())
+      files[fs::relative(entry.path(), dir).string()] = "<not a regular file>";
+  return files;
+}
+
+std::string describe(const RunResult& r) {
+  return "exit " + (r.exited ? std::to_string(r.exit_code) : "signal " + std::to_string(r.signal)) +
+         "\n--- stderr ---\n" + r.err + "--- stdout ---\n" + r.out;
+}
+
+constexpr const char* kCamera =
+    R"("camera": {"position": [0, 1, 3], "look_at": [0, 1, 0], "fov": 40})";
+
+// A valid scene: an emissive quad and a second quad of material `material` (defined by
+// `material_json`), plus `extra` top-level keys (with their leading comma).
+std::string scene_with(const std::string& material_json, const std::string& extra = "") {
+  return std::string("{") + kCamera + R"(,
+  "materials": {"lamp": {"emission": [1, 1, 1]}, "surface": )" +
+         material_json + R"(},
+  "shapes": [
+    {"type": "quad", "corner": [-1, 2, -1], "edge1": [2, 0, 0], "edge2": [0, 0, 2], "material": "lamp"},
+    {"type": "quad", "corner": [-1, 0, -1], "edge1": [2, 0, 0], "edge2": [0, 2, 0], "material": "surface"}])" +
+         extra + "}";
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  const fs::path& dir() const { return dir_.path(); }
+  void write(const std::string& name, const std::string& content) const {
+    write_file(dir() / name, content);
+  }
+
+  // Runs rtpg with `args` twice: with the `outputs` absent, then with each present holding
+  // sentinel bytes. Both runs must exit with 2 and print one line naming `subject`, and
+  // leave the folder exactly as it was.
+  void expect_rejected(const std::string& args, const std::string& subject,
+                       const std::vector<std::string>& outputs = {"out.exr", "stats.json"}) {
+    for (const bool outputs_exist : {false, true}) {
+      SCOPED_TRACE(std::string("rtpg ") + args +
+                   (outputs_exist ? " (outputs exist)" : " (no outputs yet)"));
+      for (const auto& name : outputs) {
+        fs::remove(dir() / name);
+        if (outputs_exist) write(name, "precious bytes of " + name + " that must survive\n");
+      }
+      const auto before = snapshot(dir());
+      const RunResult r = run_rtpg(dir(), args);
+      ASSERT_TRUE(r.exited) << describe(r);
+      EXPECT_EQ(r.exit_code, 2) << describe(r);
+      EXPECT_FALSE(r.err.empty());
+      EXPECT_EQ(r.err.rfind("rtpg: ", 0), 0u) << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "not one line:\n" << r.err;
+      EXPECT_EQ(r.err.back(), '\n');
+      EXPECT_NE(r.err.find(subject), std::string::npos)
+          << "message does not name '" << subject << "': " << r.err;
+      const auto after = snapshot(dir());
+      EXPECT_EQ(after, before) << "the folder changed";
+      for (const auto& [name, bytes] : after)
+        EXPECT_EQ(before.count(name), 1u) << "new file " << name;
+    }
+  }
+
+  // The render flags of a bad-input run: tiny and fast where it gets that far.
+  static std::string render(const std::string& args) {
+    return "render " + args + " --spp 1 --guiding off -o out.exr --stats-json stats.json";
+  }
+
+ private:
+  test::TempDir dir_;
+};
+
+// ---- bad scenes and assets ----------------------------------------------------------------
+
+TEST_F(Cli, RejectsMissingSceneFile) {
+  expect_rejected(render("missing.json --res 16x16"), "missing.json");
+}
+
+TEST_F(Cli, RejectsMalformedJsonScene) {
+  write("broken.json", std::string("{") + kCamera + R"(, "materials": {"lamp": )");
+  expect_rejected(render("broken.json --res 16x16"), "broken.json");
+}
+
+TEST_F(Cli, RejectsSceneWithWrongKey) {
+  write("typo.json", scene_with(R"({"base_colour": [1, 0, 0]})"));
+  expect_rejected(render("typo.json --res 16x16"), "typo.json");
+}
+
+TEST_F(Cli, RejectsMissingMesh) {
+  write("scene.json",
+        scene_with("{}", R"(, "meshes": [{"file": "gone.ply", "material": "surface"}])"));
+  expect_rejected(render("scene.json --res 16x16"), "gone.ply");
+}
+
+TEST_F(Cli, RejectsGarbageMesh) {
+  write("garbage.ply", random_bytes(4096, 1));
+  write("scene.json",
+        scene_with("{}", R"(, "meshes": [{"file": "garbage.ply", "material": "surface"}])"));
+  expect_rejected(render("scene.json --res 16x16"), "garbage.ply");
+}
+
+TEST_F(Cli, RejectsTruncatedMesh) {
+  // A valid header that promises more vertices and faces than the file holds.
+  write("short.ply",
+        "ply\nformat ascii 1.0\nelement vertex 1000\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 10\nproperty list uchar int vertex_indices\n"
+        "end_header\n0 0 0\n1 0 0\n");
+  write("scene.json",
+        scene_with("{}", R"(, "meshes": [{"file": "short.ply", "material": "surface"}])"));
+  expect_rejected(render("scene.json --res 16x16"), "short.ply");
+}
+
+TEST_F(Cli, RejectsMissingTexture) {
+  write("scene.json", scene_with(R"({"base_color_texture": "gone.png"})"));
+  expect_rejected(render("scene.json --res 16x16"), "gone.png");
+}
+
+TEST_F(Cli, RejectsGarbageTexture) {
+  write("noise.png", random_bytes(4096, 2));
+  write("scene.json", scene_with(R"({"base_color_texture": "noise.png"})"));
+  expect_rejected(render("scene.json --res 16x16"), "noise.png");
+}
+
+TEST_F(Cli, RejectsTextureWithPngSignatureAndGarbage) {
+  // Gets past the signature check into libpng's chunk reader, which reports on stderr itself.
+  write("fake.png", std::string("\x89PNG\r\n\x1a\n", 8) + random_bytes(4096, 3));
+  write("scene.json", scene_with(R"({"base_color_texture": "fake.png"})"));
+  expect_rejected(render("scene.json --res 16x16"), "fake.png");
+}
+
+TEST_F(Cli, RejectsMissingEnvironmentMap) {
+  write("scene.json", scene_with("{}", R"(, "environment": {"file": "gone.hdr"})"));
+  expect_rejected(render("scene.json --res 16x16"), "gone.hdr");
+}
+
+TEST_F(Cli, RejectsGarbageEnvironmentMap) {
+  write("noise.hdr", random_bytes(4096, 4));
+  write("scene.json", scene_with("{}", R"(, "environment": {"file": "noise.hdr"})"));
+  expect_rejected(render("scene.json --res 16x16"), "noise.hdr");
+}
+
+// ---- bad flags -----------------------------------------------------------------------------
+
+TEST_F(Cli, RejectsUnknownFlag) {
+  expect_rejected(render("--res 16x16 --bogus"), "--bogus");
+}
+
+TEST_F(Cli, RejectsZeroResolution) {
+  expect_rejected(render("--res 0x0"), "--res");
+}
+
+TEST_F(Cli, RejectsNonNumericResolution) {
+  expect_rejected(render("--res abc"), "--res");
+}
+
+TEST_F(Cli, RejectsResolutionWithTrailingGarbage) {
+  expect_rejected(render("--res 16x16x"), "--res");
+}
+
+TEST_F(Cli, RejectsZeroSamplesPerPixel) {
+  expect_rejected("render --res 16x16 --spp 0 --guiding off -o out.exr --stats-json stats.json",
+                  "--spp");
+}
+
+TEST_F(Cli, RejectsZeroFrames) {
+  expect_rejected(render("--res 16x16 --frames 0"), "--frames");
+}
+
+TEST_F(Cli, RejectsNegativeMaxBounces) {
+  expect_rejected(render("--res 16x16 --max-bounces -1"), "--max-bounces");
+}
+
+TEST_F(Cli, RejectsUnknownGuidingMode) {
+  expect_rejected("render --res 16x16 --spp 1 --guiding magic -o out.exr", "--guiding",
+                  {"out.exr"});
+}
+
+TEST_F(Cli, RejectsResolutionTooLargeForMemory) {
+  expect_rejected(render("--res 100000x100000"), "--res");
+}
+
+// ---- bad outputs and references -------------------------------------------------------------
+
+TEST_F(Cli, RejectsOutputExtensionOtherThanExrOrPng) {
+  expect_rejected("render --res 16x16 --spp 1 --guiding off -o out.jpg", "out.jpg", {"out.jpg"});
+}
+
+TEST_F(Cli, RejectsOutputInMissingFolder) {
+  expect_rejected("render --res 16x16 --spp 1 --guiding off -o nowhere/out.exr", "nowhere");
+}
+
+TEST_F(Cli, RejectsStatsJsonInMissingFolderBeforeWritingTheImage) {
+  expect_rejected(
+      "render --res 16x16 --spp 1 --guiding off -o out.exr --stats-json nowhere/stats.json",
+      "nowhere");
+}
+
+TEST_F(Cli, RejectsReferenceOfWrongSize) {
+  const RunResult made =
+      run_rtpg(dir(), "render --res 16x8 --spp 1 --guiding off -q -o reference.exr");
+  ASSERT_EQ(made.exit_code, 0) << describe(made);
+  expect_rejected(render("--res 32x32 --reference reference.exr"), "reference.exr");
+}
+
+TEST_F(Cli, RejectsMissingReference) {
+  expect_rejected(render("--res 16x16 --reference gone.exr"), "gone.exr");
+}
+
+TEST_F(Cli, RejectsCorruptReference) {
+  write("noise.exr", std::string("\x76\x2f\x31\x01", 4) + random_bytes(4096, 5));
+  expect_rejected(render("--res 16x16 --reference noise.exr"), "noise.exr");
+}
+
+TEST_F(Cli, ReferenceCommandRejectsPngOutput) {
+  expect_rejected("reference " + shell_quote(source_dir() + "/scenes/cornell-box.json") +
+                      " --res 16x16 --spp 4 -o ref.png",
+                  "ref.png", {"ref.png"});
+}
+
+TEST_F(Cli, ReferenceCommandRejectsZeroSamples) {
+  expect_rejected("reference " + shell_quote(source_dir() + "/scenes/cornell-box.json") +
+                      " --res 16x16 --spp 0 -o ref.exr",
+                  "--spp", {"ref.exr"});
+}
+
+// ---- good input ------------------------------------------------------------------------------
+
+struct ExrImage {
+  int width = 0, height = 0, channels = 0;
+  std::vector<float> pixels;
+  std::map<std::string, std::string> metadata;
+};
+
+ExrImage read_exr(const fs::path& path) {
+  ExrImage image;
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) return image;
+  const OIIO::ImageSpec& spec = in->spec();
+  image.width = spec.width;
+  image.height = spec.height;
+  image.channels = spec.nchannels;
+  image.pixels.resize(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+    image.pixels.clear();
+  for (const auto& attribute : spec.extra_attribs)
+    if (attribute.type() == OIIO::TypeDesc::STRING)
+      image.metadata[attribute.name().string()] = attribute.get_string();
+  return image;
+}
+
+TEST_F(Cli, RenderOfDefaultSceneWritesExrAndStatistics) {
+  const RunResult r = run_rtpg(
+      dir(), "render --res 32x32 --spp 2 --frames 2 --seed 7 -o out.exr --stats-json stats.json");
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  EXPECT_TRUE(r.err.empty()) << r.err;
+
+  const ExrImage image = read_exr(dir() / "out.exr");
+  ASSERT_EQ(image.width, 32);
+  ASSERT_EQ(image.height, 32);
+  ASSERT_GE(image.channels, 3);
+  ASSERT_EQ(image.pixels.size(), 32u * 32u * image.channels);
+  double sum = 0.0;
+  for (float v : image.pixels) {
+    ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << v;
+    sum += v;
+  }
+  EXPECT_GT(sum, 0.0) << "a black image";
+  EXPECT_EQ(image.metadata.count("rtpg:spp") ? image.metadata.at("rtpg:spp") : "", "2");
+
+  const nlohmann::json stats = nlohmann::json::parse(read_file(dir() / "stats.json"));
+  for (const char* key : {"scene", "width", "height", "spp", "seed", "device", "frames"})
+    EXPECT_TRUE(stats.contains(key)) << "stats.json lacks '" << key << "'";
+  EXPECT_NE(stats.value("scene", std::string()).find("cornell-box.json"), std::string::npos);
+  EXPECT_EQ(stats.value("width", 0), 32);
+  EXPECT_EQ(stats.value("height", 0), 32);
+  EXPECT_EQ(stats.value("spp", 0), 2);
+  EXPECT_EQ(stats.value("seed", 0), 7);
+  EXPECT_FALSE(stats.value("device", std::string()).empty());
+  ASSERT_TRUE(stats["frames"].is_array());
+  ASSERT_EQ(stats["frames"].size(), 2u);
+  for (std::size_t f = 0; f < 2; ++f) {
+    const nlohmann::json& frame = stats["frames"][f];
+    EXPECT_EQ(frame.value("index", -1), static_cast<int>(f));
+    ASSERT_TRUE(frame.contains("time_ms") && frame["time_ms"].is_object());
+    for (const char* stage : {"total", "primary", "trace", "shade"}) {
+      ASSERT_TRUE(frame["time_ms"].contains(stage)) << "frame " << f << " lacks time_ms." << stage;
+      EXPECT_TRUE(frame["time_ms"][stage].is_number());
+      EXPECT_GE(frame["time_ms"][stage].get<double>(), 0.0);
+    }
+    EXPECT_GE(frame["time_ms"]["total"].get<double>(), frame["time_ms"]["primary"].get<double>());
+    ASSERT_TRUE(frame.contains("nonfinite_samples"));
+    EXPECT_EQ(frame["nonfinite_samples"].get<long long>(), 0);
+    EXPECT_FALSE(frame.contains("relmse")) << "relmse without a reference";
+  }
+  EXPECT_EQ(snapshot(dir()).size(), 2u) << "only out.exr and stats.json";
+}
+
+TEST_F(Cli, RenderWritesTonemappedPng) {
+  const RunResult r = run_rtpg(dir(), "render --res 32x32 --spp 2 --guiding off -q -o out.png");
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  auto in = OIIO::ImageInput::open((dir() / "out.png").string());
+  ASSERT_TRUE(in) << OIIO::geterror();
+  EXPECT_EQ(in->format_name(), std::string("png"));
+  const OIIO::ImageSpec spec = in->spec();
+  ASSERT_EQ(spec.width, 32);
+  ASSERT_EQ(spec.height, 32);
+  ASSERT_GE(spec.nchannels, 3);
+  std::vector<std::uint8_t> pixels(32 * 32 * spec.nchannels);
+  ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data()));
+  const auto [lo, hi] = std::minmax_element(pixels.begin(), pixels.end());
+  EXPECT_LT(*lo, *hi) << "a flat image";
+}
+
+TEST_F(Cli, StatisticsCarryRelMseAgainstReference) {
+  const std::string common = "render --res 32x32 --spp 2 --seed 3 --guiding off -q";
+  RunResult r = run_rtpg(dir(), common + " -o reference.exr");
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+
+  // The same settings and seed reproduce the image exactly (the EXR holds 32-bit floats).
+  r = run_rtpg(dir(), common + " --reference reference.exr --stats-json same.json");
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  const nlohmann::json same = nlohmann::json::parse(read_file(dir() / "same.json"));
+  ASSERT_EQ(same["frames"].size(), 1u);
+  ASSERT_TRUE(same["frames"][0].contains("relmse"));
+  EXPECT_EQ(same["frames"][0]["relmse"].get<double>(), 0.0);
+
+  // Another seed: new noise, a positive and finite error in every frame.
+  r = run_rtpg(dir(),
+               "render --res 32x32 --spp 2 --seed 4 --guiding off -q --frames 2 "
+               "--reference reference.exr --stats-json other.json");
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  const nlohmann::json other = nlohmann::json::parse(read_file(dir() / "other.json"));
+  ASSERT_EQ(other["frames"].size(), 2u);
+  for (const auto& frame : other["frames"]) {
+    ASSERT_TRUE(frame.contains("relmse"));
+    const double relmse = frame["relmse"].get<double>();
+    EXPECT_TRUE(std::isfinite(relmse) && relmse > 0.0) << relmse;
+  }
+}
+
+TEST_F(Cli, InfoCountsMatchTheSceneFile) {
+  const std::string scene_path = source_dir() + "/scenes/cornell-box.json";
+  const nlohmann::json scene = nlohmann::json::parse(read_file(scene_path));
+  // Triangles per shape as scenes/README.md defines them.
+  std::size_t triangles = 0, emissive_triangles = 0;
+  for (const auto& shape : scene["shapes"]) {
+    const std::string type = shape["type"];
+    const std::size_t n = type == "quad"  ? 2
+                          : type == "box" ? 12
+                                          : 20u << (2 * shape.value("subdivisions", 4));
+    triangles += n;
+    const auto& material = scene["materials"][shape["material"].get<std::string>()];
+    bool emissive = false;
+    if (material.contains("emission"))
+      for (const auto& c : material["emission"]) emissive = emissive || c.get<double>() > 0.0;
+    if (emissive) emissive_triangles += n;
+  }
+  ASSERT_FALSE(scene.contains("meshes")) << "the counts above cover shapes only";
+
+  const RunResult r = run_rtpg(dir(), "info " + shell_quote(scene_path));
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  std::map<std::string, std::string> lines;
+  std::istringstream text(r.out);
+  for (std::string line; std::getline(text, line);) {
+    const auto colon = line.find(": ");
+    if (colon != std::string::npos) lines[line.substr(0, colon)] = line.substr(colon + 2);
+  }
+  EXPECT_EQ(lines["triangles"], std::to_string(triangles)) << r.out;
+  EXPECT_EQ(lines["materials"], std::to_string(scene["materials"].size())) << r.out;
+  EXPECT_EQ(lines["lights"].rfind(std::to_string(emissive_triangles) + " emissive triangles", 0),
+            0u)
+      << r.out;
+}
+
+TEST_F(Cli, DevicesListsAtLeastOneDevice) {
+  const RunResult r = run_rtpg(dir(), "devices");
+  ASSERT_TRUE(r.exited) << describe(r);
+  EXPECT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_FALSE(r.out.empty());
+}
+
+}  // namespace
+}  // namespace rtpg

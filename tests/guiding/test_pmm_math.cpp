@@ -1,0 +1,647 @@
+// The guiding mixture's shared math (kernels/shared/pmm.h) on the host: its sampler against
+// its density (chi-square, pbrt-v4 bsdfs_test.cpp style), recovery of known targets by the
+// online EM step, robustness of the step against junk input, and the change of hemisphere
+// frame used by reprojection. Properties only: no test pins an internal number of the EM step.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "guiding/guiding_params.h"
+#include "shared/bsdf.h"
+#include "shared/mapping.h"
+#include "shared/pmm.h"
+#include "shared/rng.h"
+#include "support/chi_square.h"
+
+using namespace rtpg::shared;
+
+namespace {
+
+pg_guiding_params default_params() {
+  return rtpg::make_guiding_params(rtpg::GuidingConfig{});
+}
+
+// A state whose model has mean (mx, my), raw covariance (sxx, syy, sxy) (before the model's
+// regularisation), mixing weight pi = S0 / W and epoch count k (pmm.h: Sigma = S2/S0 - mu mu^T).
+pg_pmm_state make_state(float mx, float my, float sxx, float syy, float sxy, float pi, float k,
+                        float s0 = 1.0f) {
+  pg_pmm_state s;
+  s.s0 = float4(s0 / pi, s0, s0 * mx, s0 * my);
+  s.s1 = float4(s0 * (sxx + mx * mx), s0 * (syy + my * my), s0 * (sxy + mx * my), k);
+  return s;
+}
+
+float3 direction(float theta_deg, float phi_deg) {
+  const float t = theta_deg * PG_PI / 180.0f, p = phi_deg * PG_PI / 180.0f;
+  return float3(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t));
+}
+
+// Sigma = L L^T of a model.
+struct Cov {
+  double xx, yy, xy;
+};
+Cov model_covariance(const pg_pmm_model& m) {
+  return {double(m.l11) * m.l11, double(m.l21) * m.l21 + double(m.l22) * m.l22,
+          double(m.l11) * m.l21};
+}
+
+// The model's properties every state must give: a usable Cholesky factor, pi within its
+// clamps and the mean inside the square.
+::testing::AssertionResult model_is_sane(const pg_pmm_model& m, const pg_guiding_params& p) {
+  if (!m.valid) return ::testing::AssertionSuccess();
+  if (!(m.l11 > 0.0f) || !(m.l22 > 0.0f) || !std::isfinite(m.l11) || !std::isfinite(m.l22) ||
+      !std::isfinite(m.l21))
+    return ::testing::AssertionFailure()
+           << "Cholesky factor l11=" << m.l11 << " l21=" << m.l21 << " l22=" << m.l22;
+  if (!(m.pi >= p.pi_min && m.pi <= p.pi_max))
+    return ::testing::AssertionFailure() << "pi=" << m.pi;
+  if (!(m.mx >= 0.0f && m.mx <= 1.0f && m.my >= 0.0f && m.my <= 1.0f))
+    return ::testing::AssertionFailure() << "mean " << m.mx << "," << m.my;
+  return ::testing::AssertionSuccess();
+}
+
+// ---- sampler against density -------------------------------------------------------------
+
+struct SamplerCase {
+  std::string name;
+  pg_pmm_state state;
+  pg_material material;
+  float3 wo;
+  pg_guiding_params params;
+};
+
+std::vector<SamplerCase> sampler_cases() {
+  const pg_guiding_params p = default_params();
+  const pg_material lambert{float3(0.8f), 1.0f, 0.0f, 0.0f};
+  const pg_material plastic{float3(0.3f, 0.5f, 0.7f), 0.5f, 0.0f, 0.04f};
+  const pg_material metal{float3(0.9f, 0.7f, 0.4f), 0.3f, 1.0f, 0.04f};
+  std::vector<SamplerCase> c;
+  c.push_back({"central_isotropic", make_state(0.5f, 0.5f, 0.01f, 0.01f, 0.0f, 0.5f, 8.0f), lambert,
+               direction(0.0f, 0.0f), p});
+  c.push_back({"correlated_plastic", make_state(0.3f, 0.6f, 0.01f, 0.02f, 0.008f, 0.3f, 4.0f),
+               plastic, direction(40.0f, 30.0f), p});
+  // Raw correlation 0.9999: the model clamps it to max_correlation (0.95).
+  c.push_back({"near_singular_clamped",
+               make_state(0.45f, 0.55f, 0.02f, 0.02f, 0.019998f, 0.6f, 32.0f), lambert,
+               direction(20.0f, 100.0f), p});
+  // A thin ridge: correlation bound raised to 0.999, no prior (minor std 0.006 in the square).
+  pg_guiding_params ridge = p;
+  ridge.max_correlation = 0.999f;
+  ridge.sigma_prior = 0.0f;
+  c.push_back({"near_singular_ridge", make_state(0.4f, 0.5f, 0.02f, 0.02f, -0.019999f, 0.7f, 32.0f),
+               lambert, direction(10.0f, 0.0f), ridge});
+  c.push_back({"mean_on_edge", make_state(0.5f, 0.0f, 0.01f, 0.005f, 0.0f, 0.5f, 8.0f), plastic,
+               direction(30.0f, 200.0f), p});
+  c.push_back({"mean_on_corner", make_state(1.0f, 1.0f, 0.02f, 0.02f, 0.005f, 0.5f, 8.0f), lambert,
+               direction(50.0f, 45.0f), p});
+  c.push_back({"mean_on_opposite_corner", make_state(0.0f, 0.0f, 0.03f, 0.01f, -0.01f, 0.8f, 2.0f),
+               metal, direction(35.0f, 225.0f), p});
+  // Raw variance 5 (clamped to 1 by the model): most of the Gaussian falls outside the square.
+  c.push_back({"large_sigma", make_state(0.5f, 0.5f, 5.0f, 5.0f, 0.0f, 0.5f, 8.0f), lambert,
+               direction(60.0f, 10.0f), p});
+  c.push_back({"pi_at_max_clamp", make_state(0.6f, 0.4f, 0.008f, 0.01f, 0.002f, 1.0f, 16.0f),
+               plastic, direction(25.0f, 300.0f), p});
+  c.push_back({"pi_at_min_clamp", make_state(0.6f, 0.4f, 0.008f, 0.01f, 0.002f, 0.001f, 16.0f),
+               plastic, direction(25.0f, 300.0f), p});
+  // Zero raw covariance: the lobe is as narrow as the regularisation allows.
+  c.push_back({"regularised_only", make_state(0.35f, 0.7f, 0.0f, 0.0f, 0.0f, 0.5f, 32.0f), lambert,
+               direction(15.0f, 80.0f), p});
+  c.push_back({"glossy_metal_grazing", make_state(0.7f, 0.3f, 0.01f, 0.01f, 0.0f, 0.5f, 12.0f),
+               metal, direction(75.0f, 120.0f), p});
+  c.push_back({"no_model_k0", pg_pmm_initial_state(), plastic, direction(45.0f, 0.0f), p});
+  // Random configurations from a fixed seed.
+  std::mt19937 gen(20240611);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int i = 0; i < 8; ++i) {
+    const float mx = -0.05f + 1.1f * u(gen), my = -0.05f + 1.1f * u(gen);  // model clamps
+    const float sx = 0.03f + 0.25f * u(gen), sy = 0.03f + 0.25f * u(gen);
+    const float rho = -0.98f + 1.96f * u(gen);
+    const float pi = 0.02f + 0.96f * u(gen);
+    const pg_material m{float3(u(gen), u(gen), u(gen)), 0.3f + 0.7f * u(gen), u(gen),
+                        u(gen) < 0.5f ? 0.04f : 0.0f};
+    c.push_back({"random_" + std::to_string(i),
+                 make_state(std::clamp(mx, 0.0f, 1.0f), std::clamp(my, 0.0f, 1.0f), sx * sx,
+                            sy * sy, rho * sx * sy, pi, 1.0f + std::floor(31.0f * u(gen))),
+                 m, direction(80.0f * u(gen), 360.0f * u(gen)), p});
+  }
+  return c;
+}
+
+}  // namespace
+
+// Every produced direction must be distributed as pg_pmm_pdf says (a defective density: a
+// Gaussian sample that leaves the square produces nothing). 1e6 attempts per case, cells
+// pooled below 5 expected samples, each case at the Sidak-corrected level of an overall 0.01.
+TEST(PmmSampler, MatchesPdfChiSquare) {
+  const auto all = sampler_cases();
+  ASSERT_GE(all.size(), 12u);
+  const double alpha = rtpg::test::sidak_alpha(0.01, static_cast<int>(all.size()));
+  const std::size_t n = 1000000;
+  for (const SamplerCase& c : all) {
+    const pg_pmm_model model = pg_pmm_model_from_state(c.state, c.params);
+    ASSERT_TRUE(model_is_sane(model, c.params)) << c.name;
+    const pg_lobes lobes = pg_make_lobes(c.material, c.wo);
+    const auto result = rtpg::test::chi_square_test(
+        [&](std::size_t i, glm::vec3& d) {
+          pg_rng rng = pg_rng_make(17u, static_cast<uint>(i), 0u, 0u, 5u);
+          const float xi = pg_rng_next(&rng), u1 = pg_rng_next(&rng), u2 = pg_rng_next(&rng);
+          const pg_pmm_sample_t s = pg_pmm_sample(model, lobes, c.wo, xi, u1, u2);
+          if (!(s.pdf > 0.0f)) return false;
+          d = s.wi;
+          return true;
+        },
+        [&](const glm::vec3& wi) {
+          return static_cast<double>(pg_pmm_pdf(model, lobes, c.wo, wi));
+        },
+        n, 40, 80, 16);
+    EXPECT_GT(result.p_value, alpha) << c.name << ": " << result.describe();
+    // The density integrates to the probability that an attempt produces a direction. The
+    // measured fraction is binomial: 5 standard deviations (two-sided 6e-7 per case) plus
+    // 1e-3 for the midpoint quadrature of the expected counts (16x16 points per cell; the
+    // measured differences are all within 2 standard deviations, at most 9e-4).
+    const double f = result.sample_fraction;
+    const double sd = std::sqrt(std::max(f * (1.0 - f), 1e-12) / static_cast<double>(n));
+    EXPECT_NEAR(result.pdf_integral, f, 5.0 * sd + 1e-3) << c.name << ": " << result.describe();
+    EXPECT_LE(result.pdf_integral, 1.0 + 2e-3) << c.name << ": " << result.describe();
+  }
+}
+
+// Every produced sample carries the pdf that pg_pmm_pdf gives for its direction, and a valid
+// strategy; the BSDF strategy is used exactly when the model does not exist or xi >= pi.
+TEST(PmmSampler, ReportsItsOwnPdfAndStrategy) {
+  for (const SamplerCase& c : sampler_cases()) {
+    const pg_pmm_model model = pg_pmm_model_from_state(c.state, c.params);
+    const pg_lobes lobes = pg_make_lobes(c.material, c.wo);
+    for (uint i = 0; i < 20000; ++i) {
+      pg_rng rng = pg_rng_make(3u, i, 0u, 0u, 5u);
+      const float xi = pg_rng_next(&rng), u1 = pg_rng_next(&rng), u2 = pg_rng_next(&rng);
+      const pg_pmm_sample_t s = pg_pmm_sample(model, lobes, c.wo, xi, u1, u2);
+      const uint expected = model.valid && xi < model.pi ? PG_STRATEGY_GUIDE : PG_STRATEGY_BSDF;
+      ASSERT_EQ(s.strategy, expected) << c.name;
+      ASSERT_GE(s.pdf, 0.0f) << c.name;
+      if (s.pdf > 0.0f) {
+        ASSERT_NEAR(length(s.wi), 1.0f, 1e-5f) << c.name;
+        ASSERT_GT(s.wi.z, 0.0f) << c.name;
+        ASSERT_EQ(s.pdf, pg_pmm_pdf(model, lobes, c.wo, s.wi)) << c.name;
+      }
+    }
+  }
+}
+
+// The chi-square test has power: the same sampler against the density of a model whose mean is
+// off by 0.02 in the square (a sixth of its standard deviation), or whose correlation has the
+// wrong sign, is rejected far below any reasonable level.
+TEST(PmmSampler, ChiSquareRejectsAWrongDensity) {
+  const pg_guiding_params p = default_params();
+  const pg_material plastic{float3(0.3f, 0.5f, 0.7f), 0.5f, 0.0f, 0.04f};
+  const float3 wo = direction(40.0f, 30.0f);
+  const pg_lobes lobes = pg_make_lobes(plastic, wo);
+  const pg_pmm_model model =
+      pg_pmm_model_from_state(make_state(0.3f, 0.6f, 0.01f, 0.02f, 0.008f, 0.5f, 4.0f), p);
+  pg_pmm_model shifted = model, flipped = model;
+  shifted.mx += 0.02f;
+  flipped.l21 = -flipped.l21;
+  for (const pg_pmm_model& wrong : {shifted, flipped}) {
+    const auto result = rtpg::test::chi_square_test(
+        [&](std::size_t i, glm::vec3& d) {
+          pg_rng rng = pg_rng_make(18u, static_cast<uint>(i), 0u, 0u, 5u);
+          const float xi = pg_rng_next(&rng), u1 = pg_rng_next(&rng), u2 = pg_rng_next(&rng);
+          const pg_pmm_sample_t s = pg_pmm_sample(model, lobes, wo, xi, u1, u2);
+          if (!(s.pdf > 0.0f)) return false;
+          d = s.wi;
+          return true;
+        },
+        [&](const glm::vec3& wi) { return static_cast<double>(pg_pmm_pdf(wrong, lobes, wo, wi)); },
+        1000000, 40, 80, 16);
+    EXPECT_LT(result.p_value, 1e-6) << result.describe();
+  }
+}
+
+// ---- EM recovery ---------------------------------------------------------------------------
+
+namespace {
+
+// A Gaussian density over the plane of the square.
+struct Gauss2 {
+  double mx, my, sxx, syy, sxy;
+  double operator()(double x, double y) const {
+    const double det = sxx * syy - sxy * sxy;
+    const double dx = x - mx, dy = y - my;
+    const double q = (syy * dx * dx - 2.0 * sxy * dx * dy + sxx * dy * dy) / det;
+    return std::exp(-0.5 * q) / (2.0 * 3.14159265358979323846 * std::sqrt(det));
+  }
+};
+
+// Runs `epochs` EM steps of `per_epoch` samples each from the uniform density on the square
+// (solid-angle density 1/(2 pi)), weighted by a = target / proposal with `target` a density
+// over solid angle, as train.cl does for VPLs.
+template <typename Target>
+pg_pmm_state run_em(const pg_guiding_params& p, const pg_lobes& lobes, float3 wo,
+                    const Target& target, int epochs, int per_epoch, uint seed) {
+  pg_pmm_state s = pg_pmm_initial_state();
+  for (int e = 0; e < epochs; ++e) {
+    const pg_pmm_model m = pg_pmm_model_from_state(s, p);
+    pg_pmm_batch b = pg_pmm_batch_empty();
+    for (int j = 0; j < per_epoch; ++j) {
+      pg_rng rng = pg_rng_make(seed, static_cast<uint>(j), static_cast<uint>(e), 0u, 7u);
+      const float2 u(pg_rng_next(&rng), pg_rng_next(&rng));
+      const float3 wi = pg_square_to_hemisphere(u);
+      if (!(wi.z > 0.0f)) continue;
+      const float a = static_cast<float>(target(u, wi) * 2.0 * 3.14159265358979323846);
+      b = pg_pmm_batch_add(b, m, p, a, u, pg_bsdf_pdf(lobes, wo, wi), s.s0.x);
+    }
+    int updated = 0;
+    s = pg_pmm_update(s, b, p, static_cast<float>(per_epoch), &updated);
+  }
+  return s;
+}
+
+}  // namespace
+
+// Target: one Gaussian in the square (6 standard deviations from every edge, so its mass
+// inside the square is 1 - 1e-9). Without the prior, the model must find its mean and
+// covariance. Tolerances: the state averages about k_max = 32 epochs of 2000 uniform samples,
+// of which about 2% land within 2 sigma of the lobe: ~1300 effective samples give a standard
+// error of the mean of sigma/36 = 0.002 and of each covariance entry about 4%; the lobe's far
+// tails (beyond ~2.5 sigma) are partly explained by the BSDF lobe at pi = pi_max, which
+// shrinks Sigma by a few percent. Hence 0.008 on the mean and 15% on Sigma (plus sigma_eps).
+TEST(PmmEm, RecoversAGaussianTarget) {
+  rtpg::GuidingConfig config;
+  config.sigma_prior = 0.0f;
+  const pg_guiding_params p = rtpg::make_guiding_params(config);
+  const pg_material lambert{float3(0.8f), 1.0f, 0.0f, 0.0f};
+  const float3 wo = direction(30.0f, 0.0f);
+  const pg_lobes lobes = pg_make_lobes(lambert, wo);
+  const Gauss2 truth[] = {{0.4, 0.6, 0.004, 0.003, 0.0015},
+                          {0.62, 0.35, 0.002, 0.005, -0.002},
+                          {0.3, 0.3, 0.0025, 0.0025, 0.0}};
+  uint seed = 100;
+  for (const Gauss2& g : truth) {
+    const auto target = [&](float2 u, float3) {
+      return g(u.x, u.y) / (2.0 * 3.14159265358979323846);
+    };
+    const pg_pmm_state s = run_em(p, lobes, wo, target, 300, 2000, seed++);
+    ASSERT_TRUE(pg_pmm_state_finite(s));
+    const pg_pmm_model m = pg_pmm_model_from_state(s, p);
+    ASSERT_TRUE(m.valid);
+    EXPECT_NEAR(m.mx, g.mx, 0.008) << "mu.x";
+    EXPECT_NEAR(m.my, g.my, 0.008) << "mu.y";
+    const Cov c = model_covariance(m);
+    const double scale = std::sqrt(g.sxx * g.syy);
+    EXPECT_NEAR(c.xx, g.sxx + p.sigma_eps, 0.15 * g.sxx) << "Sigma_xx";
+    EXPECT_NEAR(c.yy, g.syy + p.sigma_eps, 0.15 * g.syy) << "Sigma_yy";
+    EXPECT_NEAR(c.xy, g.sxy, 0.15 * scale) << "Sigma_xy";
+    // A pure Gaussian target: the Gaussian explains (almost) everything, pi at its upper clamp.
+    EXPECT_NEAR(m.pi, p.pi_max, 0.03);
+  }
+}
+
+// Target: w * Gaussian / (2 pi) + (1 - w) * p_bsdf, a member of the model's family. EM's fixed
+// point is then the truth, and pi = E[a gamma] / E[a] estimates w, the Gaussian's share of the
+// target. This needs a BSDF density that integrates to 1 over the hemisphere (Lambert, and a
+// rough plastic whose GGX part loses ~1% below the horizon): with a lobe that loses mass there
+// (a glossy metal at 50%), pi estimates the share w / (w + (1 - w) P_valid) instead. The prior
+// variance is off (sigma_prior = 0): it widens the lobe so that it claims some of the BSDF's
+// mass (+0.01 to +0.03 on pi measured at the default). 1000 epochs: the step size's floor
+// 1/(k_max + 1) makes each epoch a 1/33 step of plain EM, which converges slowly when the
+// Gaussian's share is small (at w = 0.1, 300 epochs still left pi = 0.123 and Sigma 2.4x too
+// wide; 1000 epochs give pi = 0.105-0.108). Tolerance 0.03: measured deviations are 0.0-0.013
+// (the state averages ~k_max = 32 epochs of 2000 samples; the Monte Carlo standard deviation
+// of pi is about 0.003).
+TEST(PmmEm, MixingWeightConvergesToTheTargetsShare) {
+  rtpg::GuidingConfig config;
+  config.sigma_prior = 0.0f;
+  const pg_guiding_params p = rtpg::make_guiding_params(config);
+  struct Case {
+    float w;
+    pg_material material;
+    float3 wo;
+  };
+  const Case cases[] = {{0.3f, {float3(0.8f), 1.0f, 0.0f, 0.0f}, direction(30.0f, 0.0f)},
+                        {0.7f, {float3(0.8f), 1.0f, 0.0f, 0.0f}, direction(0.0f, 0.0f)},
+                        {0.1f, {float3(0.8f), 1.0f, 0.0f, 0.0f}, direction(60.0f, 90.0f)},
+                        {0.5f, {float3(0.5f), 0.5f, 0.0f, 0.04f}, direction(40.0f, 180.0f)}};
+  const Gauss2 g{0.65, 0.4, 0.003, 0.003, 0.001};
+  uint seed = 200;
+  for (const Case& c : cases) {
+    const pg_lobes lobes = pg_make_lobes(c.material, c.wo);
+    const auto target = [&](float2 u, float3 wi) {
+      return c.w * g(u.x, u.y) / (2.0 * 3.14159265358979323846) +
+             (1.0 - c.w) * static_cast<double>(pg_bsdf_pdf(lobes, c.wo, wi));
+    };
+    const pg_pmm_state s = run_em(p, lobes, c.wo, target, 1000, 2000, seed++);
+    const pg_pmm_model m = pg_pmm_model_from_state(s, p);
+    ASSERT_TRUE(m.valid) << c.w;
+    EXPECT_NEAR(m.pi, c.w, 0.03) << "w=" << c.w;
+    EXPECT_NEAR(m.mx, g.mx, 0.008) << "w=" << c.w;
+    EXPECT_NEAR(m.my, g.my, 0.008) << "w=" << c.w;
+  }
+}
+
+// ---- adversarial input ---------------------------------------------------------------------
+
+namespace {
+
+pg_pmm_state update_with(const pg_pmm_state& s, const pg_guiding_params& p,
+                         const std::vector<std::pair<float, float2>>& samples, int* updated) {
+  const pg_pmm_model m = pg_pmm_model_from_state(s, p);
+  const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
+  pg_pmm_batch b = pg_pmm_batch_empty();
+  for (const auto& [a, u] : samples)
+    b = pg_pmm_batch_add(b, m, p, a, u,
+                         pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(u)), s.s0.x);
+  return pg_pmm_update(s, b, p, static_cast<float>(samples.size()), updated);
+}
+
+bool same_state(const pg_pmm_state& a, const pg_pmm_state& b) {
+  return a.s0 == b.s0 && a.s1 == b.s1;
+}
+
+}  // namespace
+
+// A batch made only of unusable weights (zero, NaN, +-Inf, negative, above max_weight) must
+// leave the state as it was, whether or not a model exists.
+TEST(PmmEm, UnusableWeightsLeaveTheStateUnchanged) {
+  const pg_guiding_params p = default_params();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  const float bad[] = {0.0f, nan, inf, -inf, -1.0f, p.max_weight * 2.0f, 3e38f};
+  for (const pg_pmm_state& s0 :
+       {pg_pmm_initial_state(), make_state(0.4f, 0.5f, 0.01f, 0.02f, 0.0f, 0.5f, 7.0f)}) {
+    for (float a : bad) {
+      std::vector<std::pair<float, float2>> batch;
+      for (int i = 0; i < 20; ++i) batch.push_back({a, float2(0.05f * i, 1.0f - 0.05f * i)});
+      int updated = 1;
+      const pg_pmm_state s = update_with(s0, p, batch, &updated);
+      EXPECT_EQ(updated, 0) << "a=" << a;
+      EXPECT_TRUE(same_state(s, s0)) << "a=" << a;
+    }
+    // An empty batch too.
+    int updated = 1;
+    EXPECT_TRUE(same_state(update_with(s0, p, {}, &updated), s0));
+    EXPECT_EQ(updated, 0);
+  }
+}
+
+// pg_pmm_batch_add documents that NaN, negative and absurd weights are dropped: mixed into a
+// good batch they change nothing (compared to the good batch alone, up to float rounding).
+TEST(PmmEm, UnusableWeightsMixedIntoAGoodBatchAreDropped) {
+  const pg_guiding_params p = default_params();
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const float junk[] = {std::numeric_limits<float>::quiet_NaN(), -2.0f,
+                        -std::numeric_limits<float>::infinity(),
+                        std::numeric_limits<float>::infinity(), p.max_weight * 10.0f};
+  for (const pg_pmm_state& s0 :
+       {pg_pmm_initial_state(), make_state(0.5f, 0.5f, 0.02f, 0.02f, 0.0f, 0.5f, 3.0f)}) {
+    std::vector<std::pair<float, float2>> good, mixed;
+    for (int i = 0; i < 12; ++i) {
+      good.push_back({0.5f + u(gen), float2(0.3f + 0.4f * u(gen), 0.3f + 0.4f * u(gen))});
+      mixed.push_back(good.back());
+      mixed.push_back({junk[i % 5], float2(u(gen), u(gen))});
+    }
+    int ug = 0, um = 0;
+    // Same target count, so that only the junk differs.
+    const pg_pmm_model m = pg_pmm_model_from_state(s0, p);
+    const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
+    pg_pmm_batch bg = pg_pmm_batch_empty(), bm = pg_pmm_batch_empty();
+    for (const auto& [a, v] : good)
+      bg = pg_pmm_batch_add(
+          bg, m, p, a, v, pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), s0.s0.x);
+    for (const auto& [a, v] : mixed)
+      bm = pg_pmm_batch_add(
+          bm, m, p, a, v, pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), s0.s0.x);
+    const pg_pmm_state sg = pg_pmm_update(s0, bg, p, 12.0f, &ug);
+    const pg_pmm_state sm = pg_pmm_update(s0, bm, p, 12.0f, &um);
+    EXPECT_EQ(ug, 1);
+    EXPECT_EQ(um, 1);
+    for (int c = 0; c < 4; ++c) {
+      EXPECT_NEAR(sm.s0[c], sg.s0[c], 1e-6f * std::fabs(sg.s0[c])) << c;
+      EXPECT_NEAR(sm.s1[c], sg.s1[c], 1e-6f * std::fabs(sg.s1[c])) << c;
+    }
+  }
+}
+
+// One sample repeated (and the square's corners and edge midpoints, where the map M has its
+// kinks and the mean sits on the clamp): the empirical covariance is exactly zero, yet the
+// model keeps a positive definite Sigma and its mean at the sample.
+TEST(PmmEm, RepeatedSamplesAndCornersKeepSigmaPositiveDefinite) {
+  const pg_guiding_params p = default_params();
+  const float2 points[] = {float2(0.37f, 0.81f), float2(0, 0),      float2(1, 0),
+                           float2(0, 1),         float2(1, 1),      float2(0.5f, 0),
+                           float2(1, 0.5f),      float2(0.5f, 0.5f)};
+  for (const float2 u0 : points) {
+    pg_pmm_state s = pg_pmm_initial_state();
+    for (int e = 0; e < 100; ++e) {
+      std::vector<std::pair<float, float2>> batch(15, {1.0f, u0});
+      int updated = 0;
+      s = update_with(s, p, batch, &updated);
+      ASSERT_TRUE(pg_pmm_state_finite(s)) << u0.x << "," << u0.y << " epoch " << e;
+      const pg_pmm_model m = pg_pmm_model_from_state(s, p);
+      ASSERT_TRUE(m.valid) << u0.x << "," << u0.y << " epoch " << e;
+      ASSERT_TRUE(model_is_sane(m, p)) << u0.x << "," << u0.y << " epoch " << e;
+    }
+    const pg_pmm_model m = pg_pmm_model_from_state(s, p);
+    EXPECT_NEAR(m.mx, u0.x, 1e-4f);
+    EXPECT_NEAR(m.my, u0.y, 1e-4f);
+    // The density at the sample is finite and positive: the sampler can use this model.
+    const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
+    const float3 w = pg_square_to_hemisphere(
+        float2(std::clamp(u0.x, 0.01f, 0.99f), std::clamp(u0.y, 0.01f, 0.99f)));
+    const float d = pg_pmm_pdf(m, lobes, float3(0, 0, 1), w);
+    EXPECT_TRUE(std::isfinite(d) && d > 0.0f) << d;
+  }
+}
+
+// 1e5 consecutive updates from junk: weights log-uniform over 60 decades and every special
+// value, points on corners, edges and repeated, BSDF densities from 0 to 1e30, target counts
+// below and above the batch size. After every step the state is finite, k stays in [0, k_max],
+// a state with k > 0 gives a valid model with a positive definite Sigma, and the model's
+// sampler and density produce finite values.
+TEST(PmmEm, SurvivesAHundredThousandJunkUpdates) {
+  const pg_guiding_params p = default_params();
+  std::mt19937 gen(77);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  auto junk_weight = [&]() -> float {
+    const float r = u(gen);
+    if (r < 0.55f) return std::pow(10.0f, -30.0f + 60.0f * u(gen));
+    if (r < 0.62f) return 0.0f;
+    if (r < 0.66f) return nan;
+    if (r < 0.70f) return inf;
+    if (r < 0.72f) return -inf;
+    if (r < 0.76f) return -u(gen);
+    if (r < 0.80f) return 1e-40f * u(gen);  // denormal
+    if (r < 0.84f) return p.max_weight;
+    if (r < 0.88f) return std::nextafter(p.max_weight, inf);
+    return 1.0f + u(gen);
+  };
+  float2 repeated(u(gen), u(gen));
+  auto junk_point = [&]() -> float2 {
+    const float r = u(gen);
+    if (r < 0.4f) return float2(u(gen), u(gen));
+    if (r < 0.6f) return float2(std::round(u(gen)), std::round(u(gen)));  // corners
+    if (r < 0.7f) return float2(std::round(u(gen)), u(gen));              // edges
+    if (r < 0.9f) return repeated;
+    return float2(1.0f - 1e-7f * u(gen), 1e-7f * u(gen));
+  };
+  auto junk_pdf = [&]() -> float {
+    const float r = u(gen);
+    if (r < 0.6f) return std::pow(10.0f, -3.0f + 5.0f * u(gen));
+    if (r < 0.7f) return 0.0f;
+    if (r < 0.8f) return 1e30f * u(gen);
+    if (r < 0.9f) return 1e-38f * u(gen);
+    return u(gen);
+  };
+  pg_pmm_state s = pg_pmm_initial_state();
+  int valid_steps = 0;
+  for (int step = 0; step < 100000; ++step) {
+    if (u(gen) < 0.01f) repeated = float2(u(gen), u(gen));
+    const pg_pmm_model m = pg_pmm_model_from_state(s, p);
+    pg_pmm_batch b = pg_pmm_batch_empty();
+    const int count = static_cast<int>(26.0f * u(gen));
+    for (int j = 0; j < count; ++j)
+      b = pg_pmm_batch_add(b, m, p, junk_weight(), junk_point(), junk_pdf(), s.s0.x);
+    int updated = 0;
+    s = pg_pmm_update(s, b, p, std::floor(1.0f + 30.0f * u(gen)), &updated);
+    ASSERT_TRUE(pg_pmm_state_finite(s)) << "step " << step;
+    ASSERT_GE(s.s1.w, 0.0f) << "step " << step;
+    ASSERT_LE(s.s1.w, p.k_max) << "step " << step;
+    const pg_pmm_model n = pg_pmm_model_from_state(s, p);
+    if (s.s1.w > 0.0f) {
+      ASSERT_TRUE(n.valid) << "step " << step;
+      ++valid_steps;
+    }
+    ASSERT_TRUE(model_is_sane(n, p)) << "step " << step;
+    if (step % 64 == 0 && n.valid) {
+      const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
+      const pg_pmm_sample_t smp = pg_pmm_sample(n, lobes, float3(0, 0, 1), 0.0f, u(gen), u(gen));
+      ASSERT_TRUE(std::isfinite(smp.pdf) && smp.pdf >= 0.0f) << "step " << step;
+      ASSERT_TRUE(std::isfinite(pg_pmm_pdf(n, lobes, float3(0, 0, 1), smp.wi))) << "step " << step;
+    }
+  }
+  // The junk must not simply have been rejected throughout: most steps held a model.
+  EXPECT_GT(valid_steps, 50000);
+}
+
+// ---- change of frame -----------------------------------------------------------------------
+
+namespace {
+
+float3 random_unit(std::mt19937& gen) {
+  std::normal_distribution<float> n(0.0f, 1.0f);
+  return normalize(float3(n(gen), n(gen), n(gen)));
+}
+
+// The world direction of a state's mean in frame f.
+float3 mean_direction(const pg_pmm_state& s, pg_frame f) {
+  const float2 mu(std::clamp(s.s0.z / s.s0.y, 0.0f, 1.0f), std::clamp(s.s0.w / s.s0.y, 0.0f, 1.0f));
+  return pg_to_world(f, pg_square_to_hemisphere(mu));
+}
+
+// The covariance the statistics hold (pmm.h: S2/S0 - mu mu^T), before the model regularises it.
+Cov raw_covariance(const pg_pmm_state& s) {
+  const double s0 = s.s0.y, mx = s.s0.z / s0, my = s.s0.w / s0;
+  return {s.s1.x / s0 - mx * mx, s.s1.y / s0 - my * my, s.s1.z / s0 - mx * my};
+}
+
+double angle(float3 a, float3 b) {
+  return std::atan2(static_cast<double>(length(cross(a, b))), static_cast<double>(dot(a, b)));
+}
+
+}  // namespace
+
+// The same frame on both sides: the state comes back. W, S0 and k are untouched; the mean
+// survives the M^-1(M(u)) round trip (float error near the pole ~ sqrt(ulp) = 3e-4 in u, much
+// less elsewhere); the covariance goes through a Jacobian by central differences of step 1e-3,
+// whose float error is ~1e-7 / 1e-3 = 1e-4 relative per entry, and of the map's kinks along the
+// square's diagonals when the mean is within 1e-3 of one.
+TEST(PmmReframe, IdentityFrameKeepsTheState) {
+  const pg_guiding_params p = default_params();
+  std::mt19937 gen(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int checked = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const float mx = 0.02f + 0.96f * u(gen), my = 0.02f + 0.96f * u(gen);
+    // Away from the diagonals of the square (kinks of M): see above.
+    if (std::fabs(std::fabs(mx - 0.5f) - std::fabs(my - 0.5f)) < 2e-3f) continue;
+    if (std::fabs(mx - 0.5f) < 2e-3f && std::fabs(my - 0.5f) < 2e-3f) continue;
+    const float sx = 0.02f + 0.1f * u(gen), sy = 0.02f + 0.1f * u(gen), rho = -0.9f + 1.8f * u(gen);
+    const float s0 = std::pow(10.0f, -2.0f + 4.0f * u(gen));
+    const pg_pmm_state s = make_state(mx, my, sx * sx, sy * sy, rho * sx * sy, 0.2f + 0.6f * u(gen),
+                                      1.0f + std::floor(31.0f * u(gen)), s0);
+    const pg_frame f = pg_frame_from_normal(random_unit(gen));
+    const pg_pmm_state r = pg_pmm_reframe(s, f, f);
+    ASSERT_EQ(r.s0.x, s.s0.x);
+    ASSERT_EQ(r.s0.y, s.s0.y);
+    ASSERT_EQ(r.s1.w, s.s1.w);
+    ASSERT_NEAR(r.s0.z / r.s0.y, mx, 5e-4f);
+    ASSERT_NEAR(r.s0.w / r.s0.y, my, 5e-4f);
+    ASSERT_TRUE(pg_pmm_model_from_state(r, p).valid);
+    const Cov ca = raw_covariance(s), cb = raw_covariance(r);
+    const double scale = std::sqrt(ca.xx * ca.yy);
+    EXPECT_NEAR(cb.xx, ca.xx, 2e-2 * scale) << i;
+    EXPECT_NEAR(cb.yy, ca.yy, 2e-2 * scale) << i;
+    EXPECT_NEAR(cb.xy, ca.xy, 2e-2 * scale) << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 1900);
+  // No model: nothing to carry.
+  const pg_frame f = pg_frame_from_normal(float3(0, 0, 1));
+  EXPECT_TRUE(same_state(pg_pmm_reframe(pg_pmm_initial_state(), f, f), pg_pmm_initial_state()));
+}
+
+// A change of frame keeps the lobe's mean pointing at the same world direction (up to the
+// M^-1 round trip, 2e-3 rad), and a mean that falls below the new horizon gives the initial
+// state. The reframed covariance stays a covariance (positive definite model), and its
+// determinant is kept (M and rotations preserve area, so det J = 1): checked by the median of
+// the relative change, since central differences across M's kinks spoil single cases.
+TEST(PmmReframe, RotationKeepsTheMeansWorldDirection) {
+  const pg_guiding_params p = default_params();
+  std::mt19937 gen(12);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  int carried = 0, dropped = 0;
+  std::vector<double> det_change;
+  for (int i = 0; i < 5000; ++i) {
+    const float3 n1 = random_unit(gen);
+    // The new normal: tilted from n1 by up to 60 degrees.
+    const float3 t = normalize(cross(n1, random_unit(gen)));
+    const float tilt = 60.0f * PG_PI / 180.0f * u(gen);
+    const float3 n2 = normalize(n1 * std::cos(tilt) + t * std::sin(tilt));
+    const pg_frame f1 = pg_frame_from_normal(n1), f2 = pg_frame_from_normal(n2);
+    const float mx = 0.05f + 0.9f * u(gen), my = 0.05f + 0.9f * u(gen);
+    const float sx = 0.01f + 0.05f * u(gen), sy = 0.01f + 0.05f * u(gen),
+                rho = -0.8f + 1.6f * u(gen);
+    const pg_pmm_state s = make_state(mx, my, sx * sx, sy * sy, rho * sx * sy, 0.5f, 5.0f);
+    const float3 d = mean_direction(s, f1);
+    const float z2 = dot(d, n2);
+    const pg_pmm_state r = pg_pmm_reframe(s, f1, f2);
+    ASSERT_TRUE(pg_pmm_state_finite(r));
+    if (z2 < -1e-3f) {
+      EXPECT_TRUE(same_state(r, pg_pmm_initial_state())) << i << " z=" << z2;
+      ++dropped;
+      continue;
+    }
+    if (z2 < 1e-2f) continue;  // at the horizon either outcome is right
+    ++carried;
+    ASSERT_EQ(r.s1.w, s.s1.w);
+    EXPECT_LT(angle(mean_direction(r, f2), d), 2e-3) << i;
+    const pg_pmm_model mb = pg_pmm_model_from_state(r, p);
+    ASSERT_TRUE(model_is_sane(mb, p));
+    ASSERT_TRUE(mb.valid);
+    const Cov ca = raw_covariance(s), cb = raw_covariance(r);
+    const double deta = ca.xx * ca.yy - ca.xy * ca.xy, detb = cb.xx * cb.yy - cb.xy * cb.xy;
+    det_change.push_back(std::fabs(detb / deta - 1.0));
+  }
+  EXPECT_GT(carried, 2500);
+  EXPECT_GT(dropped, 100);
+  std::nth_element(det_change.begin(), det_change.begin() + det_change.size() / 2,
+                   det_change.end());
+  EXPECT_LT(det_change[det_change.size() / 2], 0.05);
+}
