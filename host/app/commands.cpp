@@ -94,7 +94,7 @@ void write_output(const std::string& path, const ImageRgb& image, ClRuntime& cl,
 
 // The flag wins, then the scene's integrator setting, then the renderer's default.
 int bounces_for(const Scene& scene, int flag) {
-  if (flag < 0) throw InputError("--max-bounces", "must be at least 1");
+  if (flag < 0) throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
   if (flag > 0) return flag;
   return scene.max_bounces > 0 ? scene.max_bounces : PathTracerSettings{}.max_bounces;
 }
@@ -110,7 +110,7 @@ int run_render(const RenderOptions& options) {
   check_output_path(options.output, "--output", true);
   if (!options.stats_json.empty()) check_output_folder(options.stats_json);
   if (options.frames <= 0) throw InputError("--frames", "must be at least 1");
-  if (options.max_bounces < 0) throw InputError("--max-bounces", "must be at least 1");
+  if (options.max_bounces < 0) throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
   ImageRgb reference;
   if (!options.reference.empty()) {
     reference = load_quietly([&] { return read_image(options.reference); });
@@ -194,7 +194,7 @@ int run_render(const RenderOptions& options) {
 int run_reference(const ReferenceOptions& options) {
   check_output_path(options.output, "--output", false);
   if (options.spp <= 0) throw InputError("--spp", "must be at least 1");
-  if (options.max_bounces < 0) throw InputError("--max-bounces", "must be at least 1");
+  if (options.max_bounces < 0) throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
   const Scene scene = load(options.common);
   RenderSettings settings;
   settings.width = options.width;

@@ -4,7 +4,9 @@
 // byte for byte unchanged. Good input must write valid images and statistics.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>

@@ -237,26 +237,28 @@ struct Gauss2 {
   }
 };
 
-// Runs `epochs` EM steps of `per_epoch` samples each from the uniform density on the square
-// (solid-angle density 1/(2 pi)), weighted by a = target / proposal with `target` a density
-// over solid angle, as train.cl does for VPLs.
+// Runs `epochs` training steps (pg_pmm_train: the E-step passes and M-step that train.cl runs)
+// of `per_epoch` samples each from the uniform density on the square (solid-angle density
+// 1/(2 pi)), weighted by a = target / proposal with `target` a density over solid angle, as
+// train.cl does for VPLs.
 template <typename Target>
 pg_pmm_state run_em(const pg_guiding_params& p, const pg_lobes& lobes, float3 wo,
                     const Target& target, int epochs, int per_epoch, uint seed) {
   pg_pmm_state s = pg_pmm_initial_state();
+  std::vector<float4> samples;
   for (int e = 0; e < epochs; ++e) {
-    const pg_pmm_model m = pg_pmm_model_from_state(s, p);
-    pg_pmm_batch b = pg_pmm_batch_empty();
+    samples.clear();
     for (int j = 0; j < per_epoch; ++j) {
       pg_rng rng = pg_rng_make(seed, static_cast<uint>(j), static_cast<uint>(e), 0u, 7u);
       const float2 u(pg_rng_next(&rng), pg_rng_next(&rng));
       const float3 wi = pg_square_to_hemisphere(u);
       if (!(wi.z > 0.0f)) continue;
       const float a = static_cast<float>(target(u, wi) * 2.0 * 3.14159265358979323846);
-      b = pg_pmm_batch_add(b, m, p, a, u, pg_bsdf_pdf(lobes, wo, wi), s.s0.x);
+      samples.push_back(float4(a, u.x, u.y, pg_bsdf_pdf(lobes, wo, wi)));
     }
     int updated = 0;
-    s = pg_pmm_update(s, b, p, static_cast<float>(per_epoch), &updated);
+    s = pg_pmm_train(s, samples.data(), static_cast<int>(samples.size()), p,
+                     static_cast<float>(per_epoch), p.em_passes, &updated);
   }
   return s;
 }
@@ -308,9 +310,10 @@ TEST(PmmEm, RecoversAGaussianTarget) {
 // (a glossy metal at 50%), pi estimates the share w / (w + (1 - w) P_valid) instead. The prior
 // variance is off (sigma_prior = 0): it widens the lobe so that it claims some of the BSDF's
 // mass (+0.01 to +0.03 on pi measured at the default). 1000 epochs: the step size's floor
-// 1/(k_max + 1) makes each epoch a 1/33 step of plain EM, which converges slowly when the
-// Gaussian's share is small (at w = 0.1, 300 epochs still left pi = 0.123 and Sigma 2.4x too
-// wide; 1000 epochs give pi = 0.105-0.108). Tolerance 0.03: measured deviations are 0.0-0.013
+// 1/(k_max + 1) makes each epoch a 1/33 step towards the EM update (several E-step passes do
+// not change that), which converges slowly when the Gaussian's share is small (at w = 0.1,
+// 300 epochs still left pi = 0.123-0.127 and Sigma 2.3x too wide with 1 or 3 passes; 1000
+// epochs give pi = 0.105-0.108). Tolerance 0.03: measured deviations are 0.0-0.013
 // (the state averages ~k_max = 32 epochs of 2000 samples; the Monte Carlo standard deviation
 // of pi is about 0.003).
 TEST(PmmEm, MixingWeightConvergesToTheTargetsShare) {
@@ -501,15 +504,28 @@ TEST(PmmEm, SurvivesAHundredThousandJunkUpdates) {
   };
   pg_pmm_state s = pg_pmm_initial_state();
   int valid_steps = 0;
+  std::vector<float4> samples;
   for (int step = 0; step < 100000; ++step) {
     if (u(gen) < 0.01f) repeated = float2(u(gen), u(gen));
-    const pg_pmm_model m = pg_pmm_model_from_state(s, p);
-    pg_pmm_batch b = pg_pmm_batch_empty();
+    samples.clear();
     const int count = static_cast<int>(26.0f * u(gen));
-    for (int j = 0; j < count; ++j)
-      b = pg_pmm_batch_add(b, m, p, junk_weight(), junk_point(), junk_pdf(), s.s0.x);
+    for (int j = 0; j < count; ++j) {
+      const float a = junk_weight();
+      const float2 v = junk_point();
+      samples.push_back(float4(a, v.x, v.y, junk_pdf()));
+    }
+    // Alternately the building blocks (one E-step) and the kernels' step with 1-3 passes.
     int updated = 0;
-    s = pg_pmm_update(s, b, p, std::floor(1.0f + 30.0f * u(gen)), &updated);
+    const float target = std::floor(1.0f + 30.0f * u(gen));
+    if (step % 2 == 0) {
+      const pg_pmm_model m = pg_pmm_model_from_state(s, p);
+      pg_pmm_batch b = pg_pmm_batch_empty();
+      for (const float4& x : samples)
+        b = pg_pmm_batch_add(b, m, p, x.x, float2(x.y, x.z), x.w, s.s0.x);
+      s = pg_pmm_update(s, b, p, target, &updated);
+    } else {
+      s = pg_pmm_train(s, samples.data(), count, p, target, 1 + (step / 2) % 3, &updated);
+    }
     ASSERT_TRUE(pg_pmm_state_finite(s)) << "step " << step;
     ASSERT_GE(s.s1.w, 0.0f) << "step " << step;
     ASSERT_LE(s.s1.w, p.k_max) << "step " << step;
