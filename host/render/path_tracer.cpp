@@ -197,7 +197,9 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
           const float w = nee ? power_heuristic(p.prev_pdf, lights_.pdf_escaped(dir)) : 1.0f;
           p.radiance += p.throughput * le * w;
           if (depth == 1) {
-            p.vpl_radiance += le;
+            // With next-event estimation at x0 the light's own direction is NEE's job: the
+            // guide learns only what arrives indirectly (emission at y stays out).
+            if (!nee) p.vpl_radiance += le;
             if (vpls) {
               vpls->position[i] = glm::vec4(dir, vpls->position[i].w);
               vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
@@ -215,7 +217,11 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
                                                                      sp.geometric_normal))
                               : 1.0f;
           p.radiance += p.throughput * sp.emission * w;
-          p.vpl_radiance += depth == 1 ? sp.emission : p.vpl_throughput * sp.emission * w;
+          if (depth > 1) {
+            p.vpl_radiance += p.vpl_throughput * sp.emission * w;
+          } else if (!nee) {
+            p.vpl_radiance += sp.emission;  // see the escaped case above
+          }
         }
         if (depth == 1 && vpls) {
           // Density in area measure at y: solid angle at x0 times cos(theta_y) / d^2.

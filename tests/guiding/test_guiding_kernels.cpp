@@ -262,12 +262,17 @@ std::vector<float> host_reproject(const std::vector<float>& prev_state, const Ho
   return out;
 }
 
-// sample.cl.
+// sample.cl. pdf_spread[i] is how much the mixture pdf changes when the sampled direction
+// moves by 2e-6 rad (about 30 ulp of a unit vector's components): near a sharp GGX peak
+// (alpha down to 4e-4) D(h) depends on h.z through 1 - h.z^2 (1 - alpha^2), so a direction
+// that is a few ulp off changes the pdf by tens of percent. That is conditioning, not error.
 void host_sample(const std::vector<float>& state, const HostGBuffer& g, std::uint32_t seed,
                  std::uint32_t frame, std::uint32_t sample_index, const sh::pg_guiding_params& p,
-                 std::vector<float4>& direction_pdf, std::vector<std::uint32_t>& strategy) {
+                 std::vector<float4>& direction_pdf, std::vector<std::uint32_t>& strategy,
+                 std::vector<float>& pdf_spread) {
   direction_pdf.assign(g.n(), float4(0.0f));
   strategy.assign(g.n(), 0u);
+  pdf_spread.assign(g.n(), 0.0f);
   for (std::size_t i = 0; i < g.n(); ++i) {
     if ((g.flags[i] & PG_GBUF_SKY) != 0u) {
       direction_pdf[i] = float4(0.0f, 0.0f, 1.0f, 0.0f);
@@ -288,6 +293,14 @@ void host_sample(const std::vector<float>& state, const HostGBuffer& g, std::uin
     const float3 w = sh::pg_to_world(frame_x, smp.wi);
     direction_pdf[i] = float4(w.x, w.y, w.z, smp.pdf);
     strategy[i] = smp.strategy;
+    if (smp.pdf > 0.0f) {
+      const sh::pg_frame around = sh::pg_frame_from_normal(smp.wi);
+      for (const float3 d : {around.t, around.b, -around.t, -around.b}) {
+        const float3 moved = sh::normalize(smp.wi + d * 2e-6f);
+        const float change = std::fabs(sh::pg_pmm_pdf(model, lobes, wo, moved) - smp.pdf);
+        pdf_spread[i] = std::max(pdf_spread[i], change);
+      }
+    }
   }
 }
 
@@ -488,14 +501,15 @@ TEST(GuidingKernels, ReprojectMatchesHostReference) {
 
 // Device and host agree on every pixel's direction (1e-4 per component: sin/cos/log/sqrt of
 // the Gaussian and GGX samplers may be a few ulp off) and mixture pdf (1e-4 relative: exp of
-// a quadratic form q changes by q * few ulp), and the strategy is the same. The strategy can
+// a quadratic form q changes by q * few ulp; plus twice the pdf's change under a 2e-6 rad move
+// of the direction, see host_sample), and the strategy is the same. The strategy can
 // differ only where xi is within ulps of pi or where a Gaussian sample lies within ulps of the
 // square's border (pdf 0 on one side): both have probability ~1e-6 per pixel, so the test
 // allows one such pixel in all the images.
 TEST(GuidingKernels, SampleMatchesHostReference) {
   ClRuntime rt;
   Random r(202);
-  std::size_t pixels = 0, guided = 0, near_threshold = 0;
+  std::size_t pixels = 0, guided = 0, near_threshold = 0, ill_conditioned = 0;
   for (const KernelCase& kc : kernel_cases(rt)) {
     GuidingConfig config;
     config.local_x = kc.local_x;
@@ -513,9 +527,10 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
       guider.sample(dg, seed, frame, frame % 2u, {dir, strat});
       std::vector<float4> got_dir(g.n()), want_dir;
       std::vector<std::uint32_t> got_strategy(g.n()), want_strategy;
+      std::vector<float> spread;
       rt.queue().enqueueReadBuffer(dir, CL_TRUE, 0, g.n() * 16, got_dir.data());
       rt.queue().enqueueReadBuffer(strat, CL_TRUE, 0, g.n() * 4, got_strategy.data());
-      host_sample(state, g, seed, frame, frame % 2u, p, want_dir, want_strategy);
+      host_sample(state, g, seed, frame, frame % 2u, p, want_dir, want_strategy, spread);
       for (std::size_t i = 0; i < g.n(); ++i) {
         const float4 a = want_dir[i], b = got_dir[i];
         const bool pdf_zero_differs = (a.w > 0.0f) != (b.w > 0.0f);
@@ -530,15 +545,20 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
         EXPECT_NEAR(b.x, a.x, 1e-4f) << what;
         EXPECT_NEAR(b.y, a.y, 1e-4f) << what;
         EXPECT_NEAR(b.z, a.z, 1e-4f) << what;
-        EXPECT_NEAR(b.w, a.w, 1e-4f * a.w) << what;
+        EXPECT_NEAR(b.w, a.w, 1e-4f * a.w + 2.0f * spread[i]) << what;
+        ill_conditioned += spread[i] > 1e-4f * a.w;
       }
       pixels += g.n();
     }
   }
   EXPECT_LE(near_threshold, 1u) << "of " << pixels << " pixels";
   EXPECT_GT(guided, pixels / 10);  // the Gaussian branch was exercised
-  std::printf("[ info     ] sample: %zu pixels, %zu guided, %zu near a threshold\n", pixels, guided,
-              near_threshold);
+  // The spread allowance is for sharp lobes only, not a blanket tolerance.
+  EXPECT_LT(ill_conditioned * 10, pixels);
+  std::printf(
+      "[ info     ] sample: %zu pixels, %zu guided, %zu near a threshold, %zu with an "
+      "ill-conditioned pdf\n",
+      pixels, guided, near_threshold, ill_conditioned);
 }
 
 // ---- train ---------------------------------------------------------------------------------
