@@ -133,9 +133,36 @@ int run_render(const RenderOptions& options) {
   std::vector<double> totals;
   double last_relmse = -1.0;
   std::uint64_t nonfinite = 0;
+  // --accumulate: the running mean of all frames, kept on the device (kernels/accumulate.cl).
+  std::unique_ptr<Accumulator> accumulator;
+  if (options.accumulate)
+    accumulator = std::make_unique<Accumulator>(cl, settings.width, settings.height);
+  std::vector<glm::vec3> previous;  // last frame, for the temporal flicker metric
+  std::vector<glm::vec4> frame_rgba;
+  ImageRgb accumulated{settings.width, settings.height, {}};
   for (int f = 0; f < options.frames; ++f) {
     FrameStats stats = renderer.render_frame(f);
     totals.push_back(stats.time_ms["total"]);
+    const std::vector<glm::vec3>& image = renderer.image();
+    double flicker = -1.0;
+    if (!previous.empty()) {
+      // Temporal flicker (DESIGN.md 5): MSE between consecutive frames over pixels and channels.
+      double sum = 0.0;
+      for (std::size_t i = 0; i < image.size(); ++i) {
+        const glm::vec3 d = image[i] - previous[i];
+        sum += static_cast<double>(glm::dot(d, d));
+      }
+      flicker = sum / (3.0 * static_cast<double>(image.size()));
+    }
+    previous = image;
+    if (accumulator) {
+      frame_rgba.resize(image.size());
+      for (std::size_t i = 0; i < image.size(); ++i) frame_rgba[i] = glm::vec4(image[i], 1.0f);
+      const auto t = std::chrono::steady_clock::now();
+      accumulator->add(frame_rgba).wait();
+      stats.time_ms["accumulate_kernel"] =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+    }
     nonfinite += stats.nonfinite_samples;
     nlohmann::json frame = {{"index", f},
                             {"time_ms", stats.time_ms},
@@ -144,9 +171,16 @@ int run_render(const RenderOptions& options) {
                                       {"secondary", stats.secondary_rays},
                                       {"shadow", stats.shadow_rays}}}};
     for (const auto& [key, value] : stats.extra) frame[key] = value;
+    if (flicker >= 0.0) frame["flicker_mse"] = flicker;
     if (!options.reference.empty()) {
       last_relmse = relative_mse(to_image(renderer), reference);
       frame["relmse"] = last_relmse;
+      if (accumulator) {
+        const std::vector<glm::vec4> mean = accumulator->read();
+        accumulated.pixels.resize(mean.size());
+        for (std::size_t i = 0; i < mean.size(); ++i) accumulated.pixels[i] = glm::vec3(mean[i]);
+        frame["relmse_accumulated"] = relative_mse(accumulated, reference);
+      }
     }
     frames.push_back(frame);
     if (!options.common.quiet && options.frames > 1)
@@ -155,11 +189,17 @@ int run_render(const RenderOptions& options) {
   }
 
   if (!options.output.empty()) {
-    write_output(options.output, to_image(renderer), cl,
+    ImageRgb out = to_image(renderer);
+    if (accumulator) {
+      const std::vector<glm::vec4> mean = accumulator->read();
+      for (std::size_t i = 0; i < mean.size(); ++i) out.pixels[i] = glm::vec3(mean[i]);
+    }
+    write_output(options.output, out, cl,
                  {{"scene", scene_path},
                   {"spp", std::to_string(options.settings.spp)},
                   {"seed", std::to_string(options.settings.seed)},
                   {"frame", std::to_string(options.frames - 1)},
+                  {"accumulated_frames", std::to_string(accumulator ? options.frames : 1)},
                   {"render_time_ms", fmt::format("{:.3f}", totals.back())},
                   {"guiding", options.guiding}});
   }
@@ -170,6 +210,8 @@ int run_render(const RenderOptions& options) {
                                   {"spp", options.settings.spp},
                                   {"seed", options.settings.seed},
                                   {"jitter", options.settings.jitter},
+                                  {"accumulate", options.accumulate},
+                                  {"camera_path", options.settings.camera_path},
                                   {"guiding", options.guiding},
                                   {"max_bounces", settings.path_tracer.max_bounces},
                                   {"device", cl.info().device_name},
@@ -201,6 +243,9 @@ int run_reference(const ReferenceOptions& options) {
   settings.height = options.height;
   settings.seed = options.seed;
   settings.path_tracer.max_bounces = bounces_for(scene, options.max_bounces);
+  settings.camera_path = options.camera_path;
+  if (options.frame < 0) throw InputError("--frame", "must not be negative");
+  settings.camera_frame = options.frame;
   // Several samples share a G-buffer; new jitter per pass gives the pixel filter's integral.
   settings.spp = options.spp % 4 == 0 ? 4 : 1;
   const int passes = options.spp / settings.spp;

@@ -85,6 +85,8 @@ int main(int argc, char** argv) {
                        "BSDF sampling only (no next-event estimation)");
   render_cmd->add_option("-o,--output", render.output, "Last frame: .exr (linear) or .png (tonemapped)");
   render_cmd->add_option("--reference", render.reference, "Reference EXR: relMSE per frame");
+  render_cmd->add_flag("--accumulate", render.accumulate,
+                       "Output the running mean of all frames (static camera); adds relmse_accumulated");
   render_cmd->add_option("--stats-json", render.stats_json, "Write per-frame statistics as JSON");
   add_guiding_options(render_cmd, render);
 
@@ -97,6 +99,9 @@ int main(int argc, char** argv) {
   reference_cmd->add_option("--spp", reference.spp, "Samples per pixel")->capture_default_str();
   reference_cmd->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
   reference_cmd->add_option("-o,--output", reference.output, "Output EXR")->required();
+  reference_cmd->add_option("--camera-path", reference.camera_path, "Named camera path of the scene");
+  reference_cmd->add_option("--frame", reference.frame, "Frame of the camera path (its time is frame / fps)")
+      ->capture_default_str();
   reference_cmd->add_option("--max-bounces", reference.max_bounces,
                             "Path vertices after the primary hit (default: the scene's, else 8)");
 

@@ -54,7 +54,8 @@ void Renderer::set_first_bounce_sampler(std::unique_ptr<FirstBounceSampler> samp
 CameraView Renderer::camera_at(int frame) const {
   if (settings_.camera_path.empty()) return scene_.camera.view;
   const CameraPath& path = scene_.camera.paths.at(settings_.camera_path);
-  return path.at(static_cast<float>(frame) / path.fps);
+  const int at = settings_.camera_frame >= 0 ? settings_.camera_frame : frame;
+  return path.at(static_cast<float>(at) / path.fps);
 }
 
 void Renderer::build_gbuffer(int frame, FrameStats& stats) {

@@ -26,6 +26,7 @@ struct RenderSettings {
   std::uint32_t seed = 0;
   bool jitter = true;         // sub-pixel jitter of the camera ray, new every frame
   std::string camera_path;    // "" = static camera
+  int camera_frame = -1;      // >= 0: the camera stays at this frame of the path (references)
   PathTracerSettings path_tracer;
 };
 

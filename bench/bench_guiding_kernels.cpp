@@ -1,0 +1,562 @@
+// The guiding kernels alone (reproject, sample, train through the Guider) on synthetic but
+// realistic inputs: a G-buffer of planes with random normals and materials seen through a
+// pinhole camera (a few sky and emitter patches), last frame's G-buffer as the same image two
+// pixels away (motion vectors with sub-pixel noise, a few disocclusions), one VPL per pixel
+// from a cosine bounce (positions, normals, area densities, radiance with rare bright hits,
+// 20% guide-strategy and 10% escaped ones) and trained-like states (k spread over 0..kMax).
+//
+//   bench_guiding_kernels               1280x720 local-size sweep, 1920x1080 at 16x16, TBB
+//   bench_guiding_kernels --rtpg_full   also the local-size sweep at 1920x1080
+//
+// Time is the kernel's OpenCL profiling-event time (manual time); every configuration's first
+// launch (program build, PoCL's work-group function for that local size) happens before the
+// timed loop. Counters:
+//   items_per_second     pixels per second (MP/s = this / 1e6)
+//   bytes_per_second     bytes the kernel must move per pixel (below) / kernel time
+//   copy_bw              what copy_float4 (kernels/copy_float4.cl, 64 MiB each way) reaches,
+//                        launched in the same iteration as the kernel
+//   copy_fraction        bytes_per_second / copy_bw
+// Bytes per pixel, counted from the inputs along each pixel's path through the kernel (each
+// buffer element counted once, at its full width; a pixel's neighbours' VPLs are the same
+// memory as its own, so the VPL buffers count 48 bytes per pixel):
+//   reproject  flags 4 + base_color_roughness 16 + state out 32; guided pixels + motion 8;
+//              inside the image + position_depth 2x16 + normal 2x16 + material 2x4;
+//              accepted + last frame's state 32
+//   sample     flags 4 + direction_pdf/strategy out 20; surfaces + bcr, normal, view,
+//              metallic 4x16; guided + state 32
+//   train      state in 32 + out 32 + flags 4 + bcr 16 + trained 1 + VPLs 48; guided +
+//              position, normal, view, metallic 4x16
+// TrainTbb runs train.cl's loop (global-memory variant) as plain C++ over TBB on the same
+// inputs, calling the same shared functions, and reports kernel_over_tbb = kernel ms / TBB ms
+// from both run in every iteration.
+#include "bench_common.h"
+
+#include <map>
+#include <random>
+#include <tuple>
+
+#include <tbb/task_arena.h>
+
+#include "cl/cl_runtime.h"
+#include "guiding/guiding_params.h"
+#include "rtpg/guider.h"
+#include "shared/gbuffer.h"
+#include "shared/guiding_pixel.h"
+#include "shared/pmm.h"
+#include "shared/pmm_train.h"
+#include "shared/vpl.h"
+
+namespace rtpg::bench {
+namespace {
+
+namespace sh = rtpg::shared;
+using sh::float2;
+using sh::float3;
+using sh::float4;
+
+ClRuntime& runtime() {
+  static ClRuntime rt;
+  return rt;
+}
+
+// ---- synthetic inputs ------------------------------------------------------------------------
+
+struct HostGBuffer {
+  std::vector<float4> position_depth, shading_normal, view_dir, base_color_roughness, metallic_specular;
+  std::vector<std::uint32_t> flags, material;
+  std::vector<float2> motion;
+  void resize(std::size_t n) {
+    for (auto* v : {&position_depth, &shading_normal, &view_dir, &base_color_roughness, &metallic_specular})
+      v->assign(n, float4(0.0f));
+    flags.assign(n, 0u);
+    material.assign(n, 0u);
+    motion.assign(n, float2(0.0f));
+  }
+};
+
+struct Inputs {
+  int w = 0, h = 0;
+  std::size_t n = 0;
+  HostGBuffer cur, prev;
+  std::vector<float4> vpl_position, vpl_normal, vpl_radiance;
+  std::vector<float> state;  // 8 floats per pixel
+  GuiderGBuffer d_cur, d_prev;
+  GuiderVpls d_vpls;
+  GuiderSamples d_samples;
+  double reproject_bytes = 0, sample_bytes = 0, train_bytes = 0;
+};
+
+float3 tilt(std::mt19937& g, float3 n, float max_deg) {
+  std::normal_distribution<float> nd;
+  std::uniform_real_distribution<float> u;
+  float3 t = sh::cross(n, float3(nd(g), nd(g), nd(g)));
+  if (sh::dot(t, t) < 1e-12f) t = sh::cross(n, float3(1, 0, 0));
+  t = sh::normalize(t);
+  const float a = u(g) * max_deg * PG_PI / 180.0f;
+  return sh::normalize(n * std::cos(a) + t * std::sin(a));
+}
+
+template <typename T>
+cl::Buffer upload(const std::vector<T>& v) {
+  return cl::Buffer(runtime().context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
+                    const_cast<T*>(v.data()));
+}
+
+GuiderGBuffer upload(const HostGBuffer& g) {
+  GuiderGBuffer d;
+  d.position_depth = upload(g.position_depth);
+  d.shading_normal = upload(g.shading_normal);
+  d.view_dir = upload(g.view_dir);
+  d.base_color_roughness = upload(g.base_color_roughness);
+  d.metallic_specular = upload(g.metallic_specular);
+  d.flags = upload(g.flags);
+  d.material = upload(g.material);
+  d.motion = upload(g.motion);
+  return d;
+}
+
+// The image is split into patches of 32..160 pixels a side, each one plane with its own
+// normal (facing the camera within 70 degrees), distance and material out of 12.
+void make_gbuffer(Inputs& in, std::mt19937& g) {
+  const int w = in.w, h = in.h;
+  std::uniform_real_distribution<float> u;
+  struct Mat {
+    float4 bcr, ms;
+    bool emitter;
+  };
+  std::vector<Mat> mats;
+  for (int m = 0; m < 12; ++m) {
+    const float rough = m < 2 ? 0.02f : 0.1f + 0.9f * u(g);  // two near-specular (skipped)
+    const bool metal = u(g) < 0.25f;
+    mats.push_back({float4(u(g), u(g), u(g), rough), float4(metal ? 1.0f : 0.0f, u(g) < 0.5f ? 0.04f : 0.0f, 0, 0),
+                    m == 11});
+  }
+  const float tan_half = std::tan(30.0f * PG_PI / 180.0f), aspect = static_cast<float>(w) / h;
+  in.cur.resize(in.n);
+  std::vector<int> patch_of(in.n);
+  struct Patch {
+    float3 n, p0;
+    int mat;
+    bool sky;
+  };
+  std::vector<Patch> patches;
+  std::uniform_int_distribution<int> side(32, 160);
+  std::vector<int> xs{0}, ys{0};
+  while (xs.back() < w) xs.push_back(xs.back() + side(g));
+  while (ys.back() < h) ys.push_back(ys.back() + side(g));
+  for (std::size_t py = 0; py + 1 < ys.size(); ++py)
+    for (std::size_t px = 0; px + 1 < xs.size(); ++px) {
+      const float cx = (0.5f * (xs[px] + xs[px + 1]) / w * 2.0f - 1.0f) * tan_half * aspect;
+      const float cy = (1.0f - 0.5f * (ys[py] + ys[py + 1]) / h * 2.0f) * tan_half;
+      const float3 view = sh::normalize(float3(cx, cy, -1.0f));
+      Patch p;
+      p.n = tilt(g, -view, 70.0f);
+      p.p0 = view * (2.0f + 8.0f * u(g));
+      const float r = u(g);
+      p.sky = py == 0 && r < 0.5f;  // some of the top row is sky
+      p.mat = r < 0.03f ? 11 : static_cast<int>(u(g) * 10.99f);
+      const int id = static_cast<int>(patches.size());
+      patches.push_back(p);
+      for (int y = ys[py]; y < std::min(ys[py + 1], h); ++y)
+        for (int x = xs[px]; x < std::min(xs[px + 1], w); ++x) patch_of[static_cast<std::size_t>(y) * w + x] = id;
+    }
+  HostGBuffer& c = in.cur;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const Patch& p = patches[patch_of[i]];
+      const float3 dir = sh::normalize(float3(((x + 0.5f) / w * 2.0f - 1.0f) * tan_half * aspect,
+                                              (1.0f - (y + 0.5f) / h * 2.0f) * tan_half, -1.0f));
+      c.view_dir[i] = float4(-dir, 0.0f);
+      c.motion[i] = float2(-2.0f + 0.6f * (u(g) - 0.5f), -1.0f + 0.6f * (u(g) - 0.5f));
+      if (p.sky) {
+        c.flags[i] = PG_GBUF_SKY;
+        continue;
+      }
+      const float dn = sh::dot(dir, p.n);
+      float t = dn < -1e-3f ? sh::dot(p.p0, p.n) / dn : sh::length(p.p0);
+      if (!(t > 0.1f) || t > 100.0f) t = sh::length(p.p0);
+      const float3 pos = dir * t;
+      c.position_depth[i] = float4(pos, -pos.z);
+      const float3 ns = tilt(g, p.n, 8.0f);  // bumpy shading normals
+      c.shading_normal[i] = float4(ns, 0.0f);
+      const Mat& m = mats[p.mat];
+      c.base_color_roughness[i] = m.bcr;
+      c.metallic_specular[i] = m.ms;
+      c.material[i] = static_cast<std::uint32_t>(p.mat);
+      std::uint32_t f = 0;
+      if (m.emitter) f |= PG_GBUF_EMITTER;
+      if (m.bcr.w <= 0.05f) f |= PG_GBUF_DELTA;
+      c.flags[i] = f;
+    }
+  // Last frame: the same image two pixels right and one down; 3% disoccluded (another
+  // material), 10% with a slightly different normal (the state is carried across frames).
+  in.prev = in.cur;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t j = static_cast<std::size_t>(y) * w + x;
+      const int sx = x + 2, sy = y + 1;
+      if (sx >= w || sy >= h) continue;
+      const std::size_t i = static_cast<std::size_t>(sy) * w + sx;
+      in.prev.position_depth[j] = c.position_depth[i];
+      in.prev.shading_normal[j] = c.shading_normal[i];
+      in.prev.material[j] = c.material[i];
+      const float r = u(g);
+      if (r < 0.03f) in.prev.material[j] = c.material[i] + 1;
+      else if (r < 0.13f) in.prev.shading_normal[j] = float4(tilt(g, sh::pg_float4_xyz(c.shading_normal[i]), 3.0f), 0.0f);
+    }
+}
+
+// One VPL per surface pixel: a cosine bounce about the shading normal that hits a surface
+// 0.3..6 units away (normal facing back within 60 degrees), or escapes (10%).
+void make_vpls(Inputs& in, std::mt19937& g) {
+  std::uniform_real_distribution<float> u;
+  in.vpl_position.assign(in.n, float4(0.0f));
+  in.vpl_normal.assign(in.n, float4(0.0f));
+  in.vpl_radiance.assign(in.n, float4(0.0f));
+  for (std::size_t i = 0; i < in.n; ++i) {
+    if (in.cur.flags[i] & PG_GBUF_SKY) continue;
+    const float3 x = sh::pg_float4_xyz(in.cur.position_depth[i]);
+    const sh::pg_frame fr = sh::pg_frame_from_normal(sh::pg_float4_xyz(in.cur.shading_normal[i]));
+    const float u1 = u(g), u2 = u(g);
+    const float r = std::sqrt(u1), phi = 2.0f * PG_PI * u2, cz = std::sqrt(std::max(1e-4f, 1.0f - u1));
+    const float3 w = sh::pg_to_world(fr, float3(r * std::cos(phi), r * std::sin(phi), cz));
+    const float pdf = cz * PG_INV_PI;
+    const std::uint32_t strategy = u(g) < 0.8f ? PG_STRATEGY_BSDF : PG_STRATEGY_GUIDE;
+    std::uint32_t info = PG_VPL_VALID | (strategy << PG_VPL_STRATEGY_SHIFT);
+    const float bright = u(g) < 0.03f ? 50.0f : 1.0f;
+    if (u(g) < 0.1f) {
+      info |= PG_VPL_DISTANT;
+      in.vpl_position[i] = float4(w, pdf);
+    } else {
+      const float d = 0.3f + 5.7f * u(g);
+      const float3 ny = tilt(g, -w, 60.0f);
+      const float cos_y = std::max(1e-3f, -sh::dot(ny, w));
+      in.vpl_position[i] = float4(x + w * d, pdf * cos_y / (d * d));
+      in.vpl_normal[i] = float4(ny, 0.0f);
+    }
+    in.vpl_radiance[i] = float4(bright * u(g), bright * u(g), bright * u(g), static_cast<float>(info));
+  }
+}
+
+// Trained-like states: 10% without a model, 30% at kMax, the rest spread over 1..kMax; lobes
+// anywhere in the square, 0.02..0.3 wide, correlated, pi 0.05..0.95.
+void make_states(Inputs& in, std::mt19937& g, float k_max) {
+  std::uniform_real_distribution<float> u;
+  in.state.assign(in.n * 8, 0.0f);
+  for (std::size_t i = 0; i < in.n; ++i) {
+    const float c = u(g);
+    if (c < 0.1f) continue;
+    const float k = c < 0.4f ? k_max : std::floor(1.0f + u(g) * (k_max - 0.01f));
+    const float mx = 0.05f + 0.9f * u(g), my = 0.05f + 0.9f * u(g);
+    const float sx = 0.02f + 0.28f * u(g), sy = 0.02f + 0.28f * u(g), rho = 1.6f * u(g) - 0.8f;
+    const float pi = 0.05f + 0.9f * u(g), s0 = std::pow(10.0f, 2.0f * u(g) - 1.0f);
+    float* s = &in.state[8 * i];
+    s[0] = s0 / pi;
+    s[1] = s0;
+    s[2] = s0 * mx;
+    s[3] = s0 * my;
+    s[4] = s0 * (sx * sx + mx * mx);
+    s[5] = s0 * (sy * sy + my * my);
+    s[6] = s0 * (rho * sx * sy + mx * my);
+    s[7] = k;
+  }
+}
+
+void count_bytes(Inputs& in, const sh::pg_guiding_params& p) {
+  const int w = in.w, h = in.h;
+  in.reproject_bytes = in.sample_bytes = in.train_bytes = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const bool applies = sh::pg_guiding_applies(in.cur.flags[i], in.cur.base_color_roughness[i].w, p);
+      const bool sky = (in.cur.flags[i] & PG_GBUF_SKY) != 0u;
+      double r = 4 + 16 + 32;
+      if (applies) {
+        r += 8;
+        const float2 mv = in.cur.motion[i];
+        const int px = static_cast<int>(std::floor(x + 0.5f + mv.x)), py = static_cast<int>(std::floor(y + 0.5f + mv.y));
+        if (px >= 0 && py >= 0 && px < w && py < h) {
+          r += 2 * 16 + 2 * 16 + 2 * 4;
+          const std::size_t j = static_cast<std::size_t>(py) * w + px;
+          const float3 d = sh::pg_float4_xyz(in.cur.position_depth[i]) - sh::pg_float4_xyz(in.prev.position_depth[j]);
+          const float3 n = sh::pg_float4_xyz(in.cur.shading_normal[i]), m = sh::pg_float4_xyz(in.prev.shading_normal[j]);
+          if (std::sqrt(sh::dot(d, d)) <= p.reproject_depth * std::fmax(in.cur.position_depth[i].w, 1e-6f) &&
+              sh::dot(n, m) >= p.reproject_normal && in.prev.material[j] == in.cur.material[i] &&
+              in.prev.position_depth[j].w > 0.0f)
+            r += 32;
+        }
+      }
+      in.reproject_bytes += r;
+      in.sample_bytes += 4 + 20 + (sky ? 0 : 4 * 16) + (applies ? 32 : 0);
+      in.train_bytes += 32 + 32 + 4 + 16 + 1 + 48 + (applies ? 4 * 16 : 0);
+    }
+}
+
+Inputs& inputs_for(int w, int h) {
+  static std::map<std::pair<int, int>, std::unique_ptr<Inputs>> cache;
+  auto& slot = cache[{w, h}];
+  if (slot) return *slot;
+  slot = std::make_unique<Inputs>();
+  Inputs& in = *slot;
+  in.w = w;
+  in.h = h;
+  in.n = static_cast<std::size_t>(w) * h;
+  std::mt19937 g(1234u + static_cast<unsigned>(w));
+  const GuidingConfig config;
+  make_gbuffer(in, g);
+  make_vpls(in, g);
+  make_states(in, g, static_cast<float>(config.k_max));
+  count_bytes(in, make_guiding_params(config));
+  in.d_cur = upload(in.cur);
+  in.d_prev = upload(in.prev);
+  in.d_vpls = {upload(in.vpl_position), upload(in.vpl_normal), upload(in.vpl_radiance)};
+  in.d_samples.direction_pdf = cl::Buffer(runtime().context(), CL_MEM_READ_WRITE, in.n * 16);
+  in.d_samples.strategy = cl::Buffer(runtime().context(), CL_MEM_READ_WRITE, in.n * 4);
+  return in;
+}
+
+// ---- the copy yardstick ----------------------------------------------------------------------
+
+struct Copy {
+  static constexpr std::size_t kElements = 4u << 20;  // 64 MiB each way: far beyond the caches
+  cl::Kernel kernel;
+  cl::Buffer src, dst;
+  Copy() {
+    kernel = runtime().kernel("copy_float4.cl", "copy_float4");
+    src = cl::Buffer(runtime().context(), CL_MEM_READ_WRITE, kElements * 16);
+    dst = cl::Buffer(runtime().context(), CL_MEM_READ_WRITE, kElements * 16);
+    const cl_float4 one = {{1.0f, 2.0f, 3.0f, 4.0f}};
+    runtime().queue().enqueueFillBuffer(src, one, 0, kElements * 16);
+    runtime().queue().enqueueFillBuffer(dst, one, 0, kElements * 16);
+    kernel.setArg(0, src);
+    kernel.setArg(1, dst);
+    kernel.setArg(2, static_cast<cl_uint>(kElements));
+    run();  // first launch: compile the work-group function
+  }
+  static double bytes() { return 2.0 * kElements * 16; }
+  double run() {  // ms
+    cl::Event done;
+    runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(kElements), cl::NullRange, nullptr, &done);
+    done.wait();
+    return ClRuntime::event_ms(done);
+  }
+};
+
+Copy& copy() {
+  static Copy c;
+  return c;
+}
+
+void BM_CopyFloat4(benchmark::State& state) {
+  Copy& c = copy();
+  for (auto _ : state) state.SetIterationTime(c.run() * 1e-3);
+  state.SetBytesProcessed(static_cast<std::int64_t>(Copy::bytes()) * state.iterations());
+}
+
+// ---- the guiding kernels ---------------------------------------------------------------------
+
+enum class Kernel { Reproject, Sample, Train };
+
+// One guider alive at a time (the buffers of a 1080p guider take 130 MB): repetitions of one
+// benchmark run back to back and reuse it.
+Guider& guider_for(int w, int h, int lx, int ly, GuidingConfig::TrainMemory memory) {
+  static std::unique_ptr<Guider> guider;
+  static std::tuple<int, int, int, int, GuidingConfig::TrainMemory> key;
+  const auto want = std::make_tuple(w, h, lx, ly, memory);
+  if (!guider || key != want) {
+    guider.reset();
+    GuidingConfig config;
+    config.local_x = lx;
+    config.local_y = ly;
+    config.train_memory = memory;
+    guider = std::make_unique<Guider>(runtime(), w, h, config);
+    key = want;
+    Inputs& in = inputs_for(w, h);
+    guider->write_state(in.state);  // first launches of all three kernels, untimed
+    guider->reproject(in.d_cur, in.d_prev);
+    guider->sample(in.d_cur, 1u, 0u, 0u, in.d_samples);
+    guider->train(in.d_cur, in.d_vpls, 1u, 0u);
+  }
+  return *guider;
+}
+
+double launch(Guider& g, Inputs& in, Kernel k, std::uint32_t frame) {
+  switch (k) {
+    case Kernel::Reproject:
+      g.reproject(in.d_cur, in.d_prev);  // its cost does not depend on the state's values
+      return g.last_times().reproject_ms;
+    case Kernel::Sample:
+      g.sample(in.d_cur, 1u, frame, 0u, in.d_samples);
+      return g.last_times().sample_ms;
+    case Kernel::Train:
+      g.write_state(in.state);  // the same trained-like states every time (untimed)
+      g.train(in.d_cur, in.d_vpls, 1u, frame);
+      return g.last_times().train_ms;
+  }
+  return 0.0;
+}
+
+void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int lx, int ly,
+                      GuidingConfig::TrainMemory memory) {
+  Inputs& in = inputs_for(w, h);
+  Guider* g = nullptr;
+  try {
+    g = &guider_for(w, h, lx, ly, memory);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  Copy& c = copy();
+  double kernel_ms = 0.0, copy_ms = 0.0;
+  std::uint32_t frame = 1;
+  for (auto _ : state) {
+    const double ms = launch(*g, in, kernel, frame++);
+    state.SetIterationTime(ms * 1e-3);
+    kernel_ms += ms;
+    copy_ms += c.run();
+  }
+  const double bytes = kernel == Kernel::Reproject ? in.reproject_bytes
+                       : kernel == Kernel::Sample  ? in.sample_bytes
+                                                   : in.train_bytes;
+  const double it = static_cast<double>(state.iterations());
+  state.SetItemsProcessed(static_cast<std::int64_t>(in.n) * state.iterations());
+  state.SetBytesProcessed(static_cast<std::int64_t>(bytes) * state.iterations());
+  const double kernel_bw = bytes * it / (kernel_ms * 1e-3);
+  const double copy_bw = Copy::bytes() * it / (copy_ms * 1e-3);
+  state.counters["bytes_per_pixel"] = bytes / static_cast<double>(in.n);
+  state.counters["copy_bw"] = benchmark::Counter(copy_bw, benchmark::Counter::kDefaults, benchmark::Counter::kIs1024);
+  state.counters["copy_fraction"] = kernel_bw / copy_bw;
+  if (kernel == Kernel::Train) state.counters["local_tile"] = g->train_uses_local_memory() ? 1.0 : 0.0;
+}
+
+// ---- train as plain C++ over TBB -------------------------------------------------------------
+
+// train.cl with PG_TRAIN_LOCAL_TILE=0, one pixel per loop iteration, rows spread over TBB.
+void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint32_t seed, std::uint32_t frame,
+               std::vector<float>& out, std::vector<std::uint8_t>& trained) {
+  const int w = in.w, h = in.h;
+  tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y)
+      for (int x = 0; x < w; ++x) {
+        const int i = y * w + x;
+        const float* si = &in.state[8 * static_cast<std::size_t>(i)];
+        float4 s0(si[0], si[1], si[2], si[3]), s1(si[4], si[5], si[6], si[7]);
+        const std::uint32_t f = in.cur.flags[i];
+        const float4 bcr = in.cur.base_color_roughness[i];
+        std::uint8_t changed = 0;
+        if (sh::pg_guiding_applies(f, bcr.w, params)) {
+          sh::pg_pmm_state st;
+          st.s0 = s0;
+          st.s1 = s1;
+          sh::pg_train_pixel px;
+          px.x = sh::pg_float4_xyz(in.cur.position_depth[i]);
+          px.frame = sh::pg_frame_from_normal(sh::pg_float4_xyz(in.cur.shading_normal[i]));
+          px.wo = sh::pg_to_local(px.frame, sh::pg_float4_xyz(in.cur.view_dir[i]));
+          px.lobes = sh::pg_make_lobes(sh::pg_material_from_gbuffer(bcr, in.cur.metallic_specular[i]), px.wo);
+          const int apron = params.apron, side = 2 * apron + 1;
+          const int n = std::min(std::min(sh::pg_pmm_neighbour_count(s1.w, params), side * side), PG_MAX_TRAIN_SAMPLES);
+          sh::pg_rng rng = sh::pg_rng_make(seed, static_cast<sh::uint>(i), frame, 0u, 3u);
+          const sh::uint start = sh::pg_rng_next_uint(&rng) % static_cast<sh::uint>(side * side);
+          float4 samples[PG_MAX_TRAIN_SAMPLES];
+          int kept = 0;
+          for (int s = 0; s < n; ++s) {
+            const int wi = sh::pg_train_window_index(start, s, params);
+            const int sx = x + wi % side - apron, sy = y + wi / side - apron;
+            if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
+            const int j = sy * w + sx;
+            kept += sh::pg_train_sample_from_vpl(px, in.vpl_position[j], in.vpl_normal[j], in.vpl_radiance[j],
+                                                 &samples[kept]);
+          }
+          int updated = 0;
+          st = sh::pg_pmm_train(st, samples, kept, params, static_cast<float>(n), params.em_passes, &updated);
+          s0 = st.s0;
+          s1 = st.s1;
+          changed = static_cast<std::uint8_t>(updated);
+        }
+        float* so = &out[8 * static_cast<std::size_t>(i)];
+        for (int c = 0; c < 4; ++c) {
+          so[c] = s0[c];
+          so[4 + c] = s1[c];
+        }
+        trained[i] = changed;
+      }
+  });
+}
+
+void BM_TrainTbb(benchmark::State& state, int w, int h) {
+  Inputs& in = inputs_for(w, h);
+  Guider& g = guider_for(w, h, 16, 16, GuidingConfig::TrainMemory::Auto);
+  const sh::pg_guiding_params params = make_guiding_params(g.config());
+  std::vector<float> out(in.n * 8);
+  std::vector<std::uint8_t> trained(in.n);
+  tbb_train(in, params, 1u, 0u, out, trained);  // warm: pages touched, TBB arena up
+  double tbb_ms = 0.0, kernel_ms = 0.0;
+  std::uint32_t frame = 1;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    tbb_train(in, params, 1u, frame, out, trained);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    state.SetIterationTime(ms * 1e-3);
+    tbb_ms += ms;
+    kernel_ms += launch(g, in, Kernel::Train, frame);
+    ++frame;
+  }
+  // Same step, same inputs: the kernel's and TBB's k must agree (values to rounding).
+  std::vector<float> device;
+  g.read_state(device);
+  std::size_t same_k = 0, guided = 0;
+  for (std::size_t i = 0; i < in.n; ++i) {
+    same_k += device[8 * i + 7] == out[8 * i + 7];
+    guided += trained[i];
+  }
+  const double it = static_cast<double>(state.iterations());
+  state.SetItemsProcessed(static_cast<std::int64_t>(in.n) * state.iterations());
+  state.counters["kernel_ms"] = kernel_ms / it;
+  state.counters["tbb_ms"] = tbb_ms / it;
+  state.counters["kernel_over_tbb"] = kernel_ms / tbb_ms;
+  state.counters["k_agreement"] = static_cast<double>(same_k) / static_cast<double>(in.n);
+  state.counters["trained_fraction"] = static_cast<double>(guided) / static_cast<double>(in.n);
+  state.counters["tbb_threads"] = tbb::this_task_arena::max_concurrency();
+}
+
+// ---- registration ----------------------------------------------------------------------------
+
+void register_all(bool full) {
+  benchmark::AddCustomContext("opencl_device", runtime().info().device_name);
+  benchmark::RegisterBenchmark("CopyFloat4/64MiB", BM_CopyFloat4)->UseManualTime()->Unit(benchmark::kMillisecond);
+  using M = GuidingConfig::TrainMemory;
+  struct Local {
+    int x, y;
+  };
+  const std::vector<Local> sweep = {{8, 8}, {16, 16}, {32, 8}, {12, 6}};
+  const std::vector<std::pair<int, int>> sizes = {{1280, 720}, {1920, 1080}};
+  for (auto [w, h] : sizes) {
+    const bool sweep_here = w == 1280 || full;
+    for (const Local& l : sweep) {
+      if (!sweep_here && !(l.x == 16 && l.y == 16)) continue;
+      const std::string res = std::to_string(w) + "x" + std::to_string(h);
+      const std::string local = "/local:" + std::to_string(l.x) + "x" + std::to_string(l.y);
+      auto add = [&](const std::string& name, Kernel k, M memory) {
+        benchmark::RegisterBenchmark(name.c_str(), BM_GuidingKernel, k, w, h, l.x, l.y, memory)
+            ->UseManualTime()
+            ->Unit(benchmark::kMillisecond)
+            ->MinTime(0.2);
+      };
+      add("Reproject/" + res + local, Kernel::Reproject, M::Auto);
+      add("Sample/" + res + local, Kernel::Sample, M::Auto);
+      add("Train/" + res + local + "/memory:global", Kernel::Train, M::Global);
+      add("Train/" + res + local + "/memory:local", Kernel::Train, M::Local);
+    }
+  }
+  for (auto [w, h] : sizes)
+    benchmark::RegisterBenchmark(("TrainTbb/" + std::to_string(w) + "x" + std::to_string(h)).c_str(), BM_TrainTbb, w, h)
+        ->UseManualTime()
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.2);
+}
+
+}  // namespace
+}  // namespace rtpg::bench
+
+int main(int argc, char** argv) { return rtpg::bench::bench_main(argc, argv, rtpg::bench::register_all); }

@@ -1,0 +1,56 @@
+"""Error metrics of the suite (DESIGN.md section 5).
+
+- relMSE on linear radiance: mean over pixels and channels of (I - R)^2 / (R^2 + 0.01);
+- LDR-FLIP on the tonemapped sRGB image (the renderer's documented PNG transform, below) and
+  HDR-FLIP on linear radiance, both from NVIDIA's official implementation (flip-evaluator);
+- temporal flicker: mean MSE between consecutive frames of a static camera, jitter off.
+"""
+import numpy as np
+
+try:
+    import flip_evaluator as flip
+except ImportError:  # pragma: no cover - the setup script installs it
+    flip = None
+
+
+def load_exr(path):
+    """Linear RGB float32 array (H, W, 3) of an EXR written by rtpg."""
+    if flip is None:
+        raise RuntimeError("flip-evaluator is not installed (bash tools/setup.sh)")
+    return np.asarray(flip.load(str(path)), dtype=np.float32)[..., :3]
+
+
+def tonemap_srgb(radiance, exposure=1.0):
+    """The PNG transform of rtpg (kernels/shared/tonemap.h): exposure, Narkowicz's ACES fit,
+    sRGB transfer function; values in [0, 1]. Non-finite values become 0."""
+    x = np.nan_to_num(np.asarray(radiance, dtype=np.float64) * exposure, nan=0.0, posinf=0.0, neginf=0.0)
+    x = np.maximum(x, 0.0)
+    y = np.clip((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0)
+    return np.where(y <= 0.0031308, 12.92 * y, 1.055 * np.power(y, 1.0 / 2.4) - 0.055).astype(np.float32)
+
+
+def relmse(image, reference):
+    image = np.asarray(image, dtype=np.float64)
+    reference = np.asarray(reference, dtype=np.float64)
+    return float(np.mean((image - reference) ** 2 / (reference ** 2 + 0.01)))
+
+
+def flip_ldr(image, reference):
+    """Mean LDR-FLIP of the tonemapped images (0 = identical)."""
+    _, mean, _ = flip.evaluate(tonemap_srgb(reference), tonemap_srgb(image), "LDR")
+    return float(mean)
+
+
+def flip_hdr(image, reference):
+    """Mean HDR-FLIP of linear radiance (exposure range chosen by FLIP from the reference)."""
+    ref = np.nan_to_num(np.asarray(reference, dtype=np.float32))
+    img = np.nan_to_num(np.asarray(image, dtype=np.float32))
+    _, mean, _ = flip.evaluate(ref, img, "HDR")
+    return float(mean)
+
+
+def flicker(frames):
+    """Mean MSE between consecutive frames (list of arrays)."""
+    if len(frames) < 2:
+        return 0.0
+    return float(np.mean([np.mean((a.astype(np.float64) - b) ** 2) for a, b in zip(frames[1:], frames[:-1])]))

@@ -1,0 +1,100 @@
+"""Drives the rtpg binary: renders with statistics, cached references."""
+import hashlib
+import json
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+SOURCE_DIRS = ("host", "kernels", "include")
+
+
+def rtpg_binary():
+    return Path(os.environ.get("RTPG_BINARY", ROOT / "build" / "rtpg"))
+
+
+def renderer_source_hash():
+    """Hash of every source file of the renderer: a reference made by other code is stale."""
+    h = hashlib.sha256()
+    for d in SOURCE_DIRS:
+        for p in sorted((ROOT / d).rglob("*")):
+            if p.is_file() and p.suffix in (".h", ".hpp", ".cpp", ".cl"):
+                h.update(str(p.relative_to(ROOT)).encode())
+                h.update(p.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def run(args, quiet=True):
+    cmd = [str(rtpg_binary())] + [str(a) for a in args]
+    result = subprocess.run(cmd, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed ({result.returncode}): {result.stderr.strip()}")
+    return result.stdout
+
+
+def scene_path(name):
+    p = ROOT / "scenes" / f"{name}.json"
+    return str(p)
+
+
+def render(scene, res, frames, guiding, out_dir, tag, reference=None, extra=(), output_ext=".exr"):
+    """Renders; returns (stats dict, path of the last frame's image)."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stats = out_dir / f"{tag}.json"
+    image = out_dir / f"{tag}{output_ext}"
+    args = ["render", scene_path(scene), "--res", res, "--frames", frames, "--guiding", guiding,
+            "--stats-json", stats, "-o", image, "-q", *extra]
+    if reference:
+        args += ["--reference", reference]
+    run(args)
+    return json.loads(stats.read_text()), image
+
+
+class ReferenceCache:
+    """References cached on disk by scene, resolution, samples, seed, camera and a hash of the
+    renderer's sources (so a reference is never reused after the renderer changed)."""
+
+    def __init__(self, folder):
+        self.folder = Path(folder)
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.source_hash = renderer_source_hash()
+
+    def get(self, scene, res, spp, seed=1000, camera_path="", frame=0, max_bounces=0):
+        key = json.dumps([scene, res, spp, seed, camera_path, frame, max_bounces, self.source_hash])
+        digest = hashlib.sha256(key.encode()).hexdigest()[:20]
+        path = self.folder / f"{scene}-{res}-{spp}spp-{digest}.exr"
+        if path.exists():
+            return path
+        args = ["reference", scene_path(scene), "--res", res, "--spp", spp, "--seed", seed, "-o", path, "-q"]
+        if camera_path:
+            args += ["--camera-path", camera_path, "--frame", frame]
+        if max_bounces:
+            args += ["--max-bounces", max_bounces]
+        run(args)
+        (self.folder / f"{path.stem}.key.json").write_text(key + "\n")
+        return path
+
+
+def machine_info():
+    info = {"cpu": "", "cores": os.cpu_count()}
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                info["cpu"] = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    try:
+        info["devices"] = run(["devices"]).strip().splitlines()
+    except RuntimeError as e:
+        info["devices"] = [str(e)]
+    try:
+        info["git_commit"] = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True,
+                                            text=True).stdout.strip()
+        info["git_dirty"] = bool(subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--", *SOURCE_DIRS],
+                                                capture_output=True, text=True).stdout.strip())
+    except OSError:
+        info["git_commit"] = "unknown"
+    return info

@@ -1,0 +1,59 @@
+#!/usr/bin/env python3
+"""Checks of the metric wrappers on known cases (run by ctest)."""
+import sys
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from suite import metrics  # noqa: E402
+
+
+class MetricTests(unittest.TestCase):
+    def setUp(self):
+        rng = np.random.default_rng(1)
+        self.reference = rng.uniform(0.05, 2.0, size=(64, 96, 3)).astype(np.float32)
+
+    def test_identical_images_give_zero(self):
+        r = self.reference
+        self.assertEqual(metrics.relmse(r, r), 0.0)
+        self.assertEqual(metrics.flip_ldr(r, r), 0.0)
+        self.assertEqual(metrics.flip_hdr(r, r), 0.0)
+        self.assertEqual(metrics.flicker([r, r, r]), 0.0)
+
+    def test_known_perturbation_gives_expected_relmse(self):
+        # I = R + d everywhere: relMSE = mean(d^2 / (R^2 + 0.01)), computed independently here.
+        d = 0.1
+        expected = float(np.mean(d * d / (self.reference.astype(np.float64) ** 2 + 0.01)))
+        self.assertAlmostEqual(metrics.relmse(self.reference + d, self.reference), expected, places=6)
+        # Scaling by (1 + s) on a bright image: relMSE ~ s^2 R^2 / (R^2 + 0.01) < s^2.
+        self.assertLess(metrics.relmse(self.reference * 1.1, self.reference), 0.01)
+
+    def test_flip_rises_with_noise(self):
+        rng = np.random.default_rng(2)
+        previous = (0.0, 0.0)
+        for sigma in (0.02, 0.1, 0.4):
+            noisy = np.maximum(self.reference * (1.0 + sigma * rng.standard_normal(self.reference.shape)), 0.0)
+            now = (metrics.flip_ldr(noisy.astype(np.float32), self.reference),
+                   metrics.flip_hdr(noisy.astype(np.float32), self.reference))
+            self.assertGreater(now[0], previous[0])
+            self.assertGreater(now[1], previous[1])
+            previous = now
+
+    def test_flicker_is_mean_squared_difference(self):
+        a = np.zeros((4, 4, 3), np.float32)
+        b = np.full((4, 4, 3), 0.5, np.float32)
+        self.assertAlmostEqual(metrics.flicker([a, b, a]), 0.25)
+
+    def test_tonemap_matches_documented_curve(self):
+        # 0 -> 0, large -> 1, and the ACES fit at x = 1 (0.8038...) through the sRGB curve.
+        t = metrics.tonemap_srgb(np.array([[[0.0, 1.0, 1e6]]], np.float32))[0, 0]
+        aces1 = (2.51 + 0.03) / (2.43 + 0.59 + 0.14)
+        self.assertAlmostEqual(float(t[0]), 0.0)
+        self.assertAlmostEqual(float(t[1]), 1.055 * aces1 ** (1 / 2.4) - 0.055, places=5)
+        self.assertAlmostEqual(float(t[2]), 1.0, places=5)
+
+
+if __name__ == "__main__":
+    unittest.main()
