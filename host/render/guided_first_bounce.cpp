@@ -2,6 +2,10 @@
 
 #include <chrono>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include "cl/cl_runtime.h"
 #include "guiding/guiding_params.h"
 #include "render/path_tracer.h"
@@ -83,17 +87,33 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   readback_ms_ = ms_since(t);
   sample_ms_ = 0.0;
   const shared::pg_guiding_params p = make_guiding_params(guider_->config());
-  std::size_t surfaces = 0, guided = 0;
-  double pi_sum = 0.0;
-  for (std::size_t i = 0; i < g.pixel_count(); ++i) {
-    if (!g.has_surface(i)) continue;
-    ++surfaces;
-    if (!shared::pg_guiding_applies(g.flags[i], g.base_color_roughness[i].w, p)) continue;
-    const shared::pg_pmm_model m = shared::pg_pmm_model_from_state(state_at(state_, i), p);
-    if (!m.valid) continue;
-    ++guided;
-    pi_sum += m.pi;
-  }
+  // Share of surface pixels sampling a trained model, and their mean pi (statistics only).
+  struct Counts {
+    std::size_t surfaces = 0, guided = 0;
+    double pi_sum = 0.0;
+  };
+  const Counts counts = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, g.pixel_count(), 8192), Counts{},
+      [&](const tbb::blocked_range<std::size_t>& r, Counts c) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          if (!g.has_surface(i)) continue;
+          ++c.surfaces;
+          if (!shared::pg_guiding_applies(g.flags[i], g.base_color_roughness[i].w, p)) continue;
+          const shared::pg_pmm_model m = shared::pg_pmm_model_from_state(state_at(state_, i), p);
+          if (!m.valid) continue;
+          ++c.guided;
+          c.pi_sum += m.pi;
+        }
+        return c;
+      },
+      [](Counts a, const Counts& b) {
+        a.surfaces += b.surfaces;
+        a.guided += b.guided;
+        a.pi_sum += b.pi_sum;
+        return a;
+      });
+  const std::size_t surfaces = counts.surfaces, guided = counts.guided;
+  const double pi_sum = counts.pi_sum;
   guided_fraction_ = surfaces ? static_cast<double>(guided) / static_cast<double>(surfaces) : 0.0;
   mean_pi_ = guided ? pi_sum / static_cast<double>(guided) : 0.0;
   trained_fraction_ = 0.0;
@@ -111,14 +131,16 @@ void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
   runtime_.queue().enqueueReadBuffer(samples_.strategy, CL_TRUE, 0, n * 4, strategy_.data());
   readback_ms_ += ms_since(t);
   out.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const glm::vec4 d = direction_pdf_[i];
-    out[i].direction = glm::vec3(d);
-    out[i].pdf = d.w > 0.0f && std::isfinite(d.w) ? d.w : 0.0f;
-    out[i].strategy = strategy_[i] == PG_STRATEGY_GUIDE  ? kStrategyGuide
-                      : strategy_[i] == PG_STRATEGY_BSDF ? kStrategyBsdf
-                                                         : kStrategyNone;
-  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const glm::vec4 d = direction_pdf_[i];
+      out[i].direction = glm::vec3(d);
+      out[i].pdf = d.w > 0.0f && std::isfinite(d.w) ? d.w : 0.0f;
+      out[i].strategy = strategy_[i] == PG_STRATEGY_GUIDE  ? kStrategyGuide
+                        : strategy_[i] == PG_STRATEGY_BSDF ? kStrategyBsdf
+                                                           : kStrategyNone;
+    }
+  });
 }
 
 float GuidedFirstBounce::pdf(const GBuffer& g, std::size_t i, const glm::vec3& wi) const {

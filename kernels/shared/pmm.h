@@ -195,9 +195,14 @@ PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_guiding_p
    * lobe to a random direction. Training (not rendering) clamps weights to a multiple of the
    * running mean once a model exists. */
   if (m.valid && p.weight_clamp > 0.0f) a = fmin(a, p.weight_clamp * history_weight);
+  if (a == 0.0f) { /* adds nothing but its count: skip the arithmetic (most samples, often) */
+    b.count += 1.0f;
+    return b;
+  }
   float gamma = p.pi_init;
   if (m.valid) {
-    float g = m.pi * pg_pmm_gaussian_pdf(m, u) * PG_INV_TWO_PI;
+    float q = pg_pmm_mahalanobis2(m, u);
+    float g = m.pi * exp(-0.5f * q) / (PG_TWO_PI * m.l11 * m.l22) * PG_INV_TWO_PI;
     float d = g + (1.0f - m.pi) * bsdf_pdf;
     gamma = d > 0.0f ? g / d : 0.0f;
     if (!isfinite(gamma)) return b;
@@ -205,7 +210,7 @@ PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_guiding_p
      * never move it: a sample far outside the lobe (beyond 5 standard deviations, where
      * gamma is negligible) and much brighter than the history re-seeds the model. Samples
      * nearer than that move the lobe through the ordinary M-step. */
-    if (pg_pmm_mahalanobis2(m, u) > 25.0f && a > p.reseed_ratio * history_weight) b.reseed = 1;
+    if (q > 25.0f && a > p.reseed_ratio * history_weight) b.reseed = 1;
   }
   b.ax += a * u.x;
   b.ay += a * u.y;

@@ -47,8 +47,13 @@ PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float
   if (!(r > 0.0f) || !isfinite(r)) return 0;
   float3 wl = pg_to_local(px.frame, w);
   if (wl.z <= 0.0f) return 0;
+  float3 radiance = pg_float4_xyz(radiance_info);
+  if (pg_max3(radiance) <= 0.0f) { /* a dark VPL: weight 0, no need to map it */
+    *sample = pg_make_float4(0.0f, 0.5f, 0.5f, 0.0f);
+    return 1;
+  }
   float3 f = pg_bsdf_eval(px.lobes, px.wo, wl) * wl.z;
-  float a = pg_luminance(pg_float4_xyz(radiance_info) * f) / r;
+  float a = pg_luminance(radiance * f) / r;
   float2 u = pg_hemisphere_to_square(wl);
   *sample = pg_make_float4(a, u.x, u.y, pg_bsdf_pdf(px.lobes, px.wo, wl));
   return 1;
