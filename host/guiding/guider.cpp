@@ -112,15 +112,18 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingConfig& c
 Guider::~Guider() = default;
 
 void Guider::reset() {
+  // Zeros written from the host, not clEnqueueFillBuffer: Oclgrind 21.10 keeps treating filled
+  // memory as uninitialised even after a kernel has overwritten it, so every later kernel that
+  // reads the state is flagged under --uninitialized (a false positive hiding real findings).
   const std::size_t n = static_cast<std::size_t>(width_) * height_;
-  const cl_float4 zero = {{0.0f, 0.0f, 0.0f, 0.0f}};
+  const std::vector<float> zeros(n * 4, 0.0f);
   for (int b = 0; b < 2; ++b) {
-    runtime_.queue().enqueueFillBuffer(state0_[b], zero, 0, n * 16);
-    runtime_.queue().enqueueFillBuffer(state1_[b], zero, 0, n * 16);
+    runtime_.queue().enqueueWriteBuffer(state0_[b], CL_FALSE, 0, n * 16, zeros.data());
+    runtime_.queue().enqueueWriteBuffer(state1_[b], CL_FALSE, 0, n * 16, zeros.data());
   }
-  const cl_uchar none = 0;
-  runtime_.queue().enqueueFillBuffer(trained_, none, 0, n);
-  runtime_.queue().finish();
+  const std::vector<cl_uchar> none(n, 0);
+  runtime_.queue().enqueueWriteBuffer(trained_, CL_FALSE, 0, n, none.data());
+  runtime_.queue().finish();  // the host vectors must outlive the writes
 }
 
 void Guider::check_buffer(const cl::Buffer& b, std::size_t element_size, const std::string& name) const {

@@ -574,10 +574,11 @@ double angle(float3 a, float3 b) {
 }  // namespace
 
 // The same frame on both sides: the state comes back. W, S0 and k are untouched; the mean
-// survives the M^-1(M(u)) round trip (float error near the pole ~ sqrt(ulp) = 3e-4 in u, much
-// less elsewhere); the covariance goes through a Jacobian by central differences of step 1e-3,
-// whose float error is ~1e-7 / 1e-3 = 1e-4 relative per entry, and of the map's kinks along the
-// square's diagonals when the mean is within 1e-3 of one.
+// survives the M^-1(M(u)) round trip within 1e-4 (float error ~ sqrt(ulp) = 2.4e-4 only at the
+// pole itself, excluded here; 4e-6 measured); the covariance goes through a Jacobian by central
+// differences of step 1e-3, whose float error is ~1e-7 / 1e-3 = 1e-4 relative per entry, growing
+// where the probe crosses a kink of M (the square's diagonals, excluded within 2e-3): 2% of
+// sqrt(Sxx Syy) per entry (0.6% measured).
 TEST(PmmReframe, IdentityFrameKeepsTheState) {
   const pg_guiding_params p = default_params();
   std::mt19937 gen(11);
@@ -597,8 +598,8 @@ TEST(PmmReframe, IdentityFrameKeepsTheState) {
     ASSERT_EQ(r.s0.x, s.s0.x);
     ASSERT_EQ(r.s0.y, s.s0.y);
     ASSERT_EQ(r.s1.w, s.s1.w);
-    ASSERT_NEAR(r.s0.z / r.s0.y, mx, 5e-4f);
-    ASSERT_NEAR(r.s0.w / r.s0.y, my, 5e-4f);
+    ASSERT_NEAR(r.s0.z / r.s0.y, mx, 1e-4f);
+    ASSERT_NEAR(r.s0.w / r.s0.y, my, 1e-4f);
     ASSERT_TRUE(pg_pmm_model_from_state(r, p).valid);
     const Cov ca = raw_covariance(s), cb = raw_covariance(r);
     const double scale = std::sqrt(ca.xx * ca.yy);
@@ -613,11 +614,12 @@ TEST(PmmReframe, IdentityFrameKeepsTheState) {
   EXPECT_TRUE(same_state(pg_pmm_reframe(pg_pmm_initial_state(), f, f), pg_pmm_initial_state()));
 }
 
-// A change of frame keeps the lobe's mean pointing at the same world direction (up to the
-// M^-1 round trip, 2e-3 rad), and a mean that falls below the new horizon gives the initial
-// state. The reframed covariance stays a covariance (positive definite model), and its
-// determinant is kept (M and rotations preserve area, so det J = 1): checked by the median of
-// the relative change, since central differences across M's kinks spoil single cases.
+// A change of frame keeps the lobe's mean pointing at the same world direction (up to float
+// rounding through M, M^-1 and two frames: 1e-4 rad; 3e-6 measured), and a mean that falls
+// below the new horizon gives the initial state. The reframed covariance stays a covariance
+// (positive definite model), and its determinant is kept (M and rotations preserve area, so
+// det J = 1): the median relative change must be below 1% (0.12% measured; single cases are
+// off where the central differences straddle a kink of M, up to 2x).
 TEST(PmmReframe, RotationKeepsTheMeansWorldDirection) {
   const pg_guiding_params p = default_params();
   std::mt19937 gen(12);
@@ -647,7 +649,7 @@ TEST(PmmReframe, RotationKeepsTheMeansWorldDirection) {
     if (z2 < 1e-2f) continue;  // at the horizon either outcome is right
     ++carried;
     ASSERT_EQ(r.s1.w, s.s1.w);
-    EXPECT_LT(angle(mean_direction(r, f2), d), 2e-3) << i;
+    EXPECT_LT(angle(mean_direction(r, f2), d), 1e-4) << i;
     const pg_pmm_model mb = pg_pmm_model_from_state(r, p);
     ASSERT_TRUE(model_is_sane(mb, p));
     ASSERT_TRUE(mb.valid);
@@ -659,5 +661,5 @@ TEST(PmmReframe, RotationKeepsTheMeansWorldDirection) {
   EXPECT_GT(dropped, 100);
   std::nth_element(det_change.begin(), det_change.begin() + det_change.size() / 2,
                    det_change.end());
-  EXPECT_LT(det_change[det_change.size() / 2], 0.05);
+  EXPECT_LT(det_change[det_change.size() / 2], 0.01);
 }

@@ -1,0 +1,167 @@
+// The guider as a user sees it: include/rtpg/guider.h and a ClRuntime for the context, nothing
+// else (its own translation unit, so that no shared header is visible). Buffer layouts and
+// bit values are the ones the header documents (kernels/shared/gbuffer.h and vpl.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "cl/cl_runtime.h"
+#include "rtpg/guider.h"
+
+namespace {
+
+constexpr std::uint32_t kSky = 1u;              // PG_GBUF_SKY
+constexpr float kValidBsdfVpl = 1.0f + 256.0f;  // PG_VPL_VALID | PG_STRATEGY_BSDF << 8
+constexpr std::uint32_t kNone = 0u, kBsdf = 1u, kGuide = 2u;  // PG_STRATEGY_*
+
+template <typename T>
+cl::Buffer upload(rtpg::ClRuntime& rt, const std::vector<T>& v) {
+  return cl::Buffer(rt.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
+                    const_cast<T*>(v.data()));
+}
+
+// A rough floor (normal +z) seen from above; the first row is sky.
+rtpg::GuiderGBuffer floor_gbuffer(rtpg::ClRuntime& rt, int w, int h) {
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  std::vector<float> position(4 * n), normal(4 * n), view(4 * n), bcr(4 * n), ms(4 * n),
+      motion(2 * n, 0.0f);
+  std::vector<std::uint32_t> flags(n, 0u), material(n, 1u);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const float px = 0.1f * x, py = 0.1f * y;
+      const float v[4] = {-px, -py, 3.0f, 0.0f};
+      const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      for (int c = 0; c < 4; ++c) {
+        position[4 * i + c] = c == 0 ? px : c == 1 ? py : c == 2 ? 0.0f : len;
+        normal[4 * i + c] = c == 2 ? 1.0f : 0.0f;
+        view[4 * i + c] = v[c] / len;
+        bcr[4 * i + c] = c == 3 ? 0.6f : 0.7f;
+        ms[4 * i + c] = c == 1 ? 0.04f : 0.0f;
+      }
+      if (y == 0) flags[i] = kSky;
+    }
+  rtpg::GuiderGBuffer g;
+  g.position_depth = upload(rt, position);
+  g.shading_normal = upload(rt, normal);
+  g.view_dir = upload(rt, view);
+  g.base_color_roughness = upload(rt, bcr);
+  g.metallic_specular = upload(rt, ms);
+  g.flags = upload(rt, flags);
+  g.material = upload(rt, material);
+  g.motion = upload(rt, motion);
+  return g;
+}
+
+}  // namespace
+
+// Create, reset, write/read the state, reproject onto the same frame, sample, train: every
+// entry point of the header, checked for what it documents.
+TEST(GuiderApi, CreateResetReprojectSampleTrainAndStateRoundTrip) {
+  rtpg::ClRuntime rt;
+  const bool small = rt.info().platform_name.find("Oclgrind") != std::string::npos;
+  const int w = small ? 11 : 37, h = small ? 7 : 23;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  rtpg::Guider guider(rt, w, h);
+  EXPECT_EQ(guider.width(), w);
+  EXPECT_EQ(guider.height(), h);
+
+  // A new guider holds the initial state: all zeros.
+  std::vector<float> state;
+  guider.read_state(state);
+  ASSERT_EQ(state.size(), 8 * n);
+  for (float v : state) ASSERT_EQ(v, 0.0f);
+
+  // The state round-trips bit for bit, and reset() clears it.
+  std::mt19937 gen(9);
+  std::uniform_real_distribution<float> u(-10.0f, 10.0f);
+  std::vector<float> junk(8 * n);
+  for (float& v : junk) v = u(gen);
+  guider.write_state(junk);
+  guider.read_state(state);
+  ASSERT_EQ(std::memcmp(state.data(), junk.data(), junk.size() * sizeof(float)), 0);
+  guider.reset();
+  guider.read_state(state);
+  for (float v : state) ASSERT_EQ(v, 0.0f);
+
+  // A lobe straight up at every pixel (mean (0.5, 0.5): the normal), pi = 0.6, k = 5.
+  std::vector<float> lobe(8 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float s0 = 1.0f, pi = 0.6f, var = 0.004f;
+    const float v[8] = {
+        s0 / pi,    s0,  0.5f * s0, 0.5f * s0, s0 * (var + 0.25f), s0 * (var + 0.25f),
+        0.25f * s0, 5.0f};
+    std::memcpy(&lobe[8 * i], v, sizeof v);
+  }
+  guider.write_state(lobe);
+
+  // Reprojecting a static frame onto itself (zero motion) keeps every surface pixel's state
+  // bit for bit (same normal: no change of frame) and clears the sky.
+  const rtpg::GuiderGBuffer g = floor_gbuffer(rt, w, h);
+  guider.reproject(g, g);
+  guider.read_state(state);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 8; ++c)
+      ASSERT_EQ(state[8 * i + c], i < static_cast<std::size_t>(w) ? 0.0f : lobe[8 * i + c])
+          << i << "," << c;
+
+  // Sampling: sky pixels produce nothing; surface pixels a unit direction above the floor with a
+  // positive pdf (or pdf 0 for a Gaussian sample that left the square), by the Gaussian with
+  // probability pi = 0.6 (binomial: 5 standard deviations).
+  cl::Buffer dir(rt.context(), CL_MEM_READ_WRITE, n * 16);
+  cl::Buffer strategy(rt.context(), CL_MEM_READ_WRITE, n * 4);
+  std::size_t guided = 0, surface = 0;
+  for (std::uint32_t frame = 0; frame < 4; ++frame) {
+    guider.sample(g, 42u, frame, 0u, {dir, strategy});
+    std::vector<float> d(4 * n);
+    std::vector<std::uint32_t> st(n);
+    rt.queue().enqueueReadBuffer(dir, CL_TRUE, 0, n * 16, d.data());
+    rt.queue().enqueueReadBuffer(strategy, CL_TRUE, 0, n * 4, st.data());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i < static_cast<std::size_t>(w)) {
+        EXPECT_EQ(st[i], kNone);
+        EXPECT_EQ(d[4 * i + 3], 0.0f);
+        continue;
+      }
+      ASSERT_TRUE(st[i] == kBsdf || st[i] == kGuide) << st[i];
+      ++surface;
+      guided += st[i] == kGuide;
+      if (d[4 * i + 3] == 0.0f) continue;
+      EXPECT_GT(d[4 * i + 3], 0.0f);
+      EXPECT_NEAR(std::sqrt(d[4 * i] * d[4 * i] + d[4 * i + 1] * d[4 * i + 1] +
+                            d[4 * i + 2] * d[4 * i + 2]),
+                  1.0f, 1e-5f);
+      EXPECT_GT(d[4 * i + 2], 0.0f);
+    }
+  }
+  const double sd = std::sqrt(0.6 * 0.4 * surface);
+  EXPECT_NEAR(static_cast<double>(guided), 0.6 * surface, 5.0 * sd);
+  EXPECT_GE(guider.last_times().sample_ms, 0.0);
+
+  // Training from bright VPLs 2 units above every pixel (valid, BSDF strategy): every surface
+  // pixel takes an EM step (k: 5 -> 6); the sky does not.
+  std::vector<float> vp(4 * n), vn(4 * n), vr(4 * n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const float pos[4] = {0.1f * x + 0.3f, 0.1f * y, 2.0f, 1.0f};  // w: area density
+      const float nrm[4] = {0.0f, 0.0f, -1.0f, 0.0f};
+      const float rad[4] = {5.0f, 5.0f, 5.0f, y == 0 ? 0.0f : kValidBsdfVpl};
+      std::memcpy(&vp[4 * i], pos, sizeof pos);
+      std::memcpy(&vn[4 * i], nrm, sizeof nrm);
+      std::memcpy(&vr[4 * i], rad, sizeof rad);
+    }
+  guider.train(g, {upload(rt, vp), upload(rt, vn), upload(rt, vr)}, 42u, 4u);
+  EXPECT_EQ(guider.count_trained(), n - static_cast<std::size_t>(w));
+  guider.read_state(state);
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool sky = i < static_cast<std::size_t>(w);
+    EXPECT_EQ(state[8 * i + 7], sky ? 0.0f : 6.0f) << i;
+    for (int c = 0; c < 8; ++c) ASSERT_TRUE(std::isfinite(state[8 * i + c]));
+  }
+  EXPECT_GE(guider.last_times().train_ms, 0.0);
+}
