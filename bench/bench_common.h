@@ -65,7 +65,8 @@ inline const Scene* sponza_scene(std::string* why) {
     const std::string obj = sponza_obj_path();
     if (!std::filesystem::exists(obj)) {
       missing = "Crytek Sponza not found at " + obj +
-                " (../shared/scenes is missing; set RTPG_ASSET_ROOT to the folder holding crytek-sponza/)";
+                ": set RTPG_ASSET_ROOT to the folder holding crytek-sponza/ (default: ../shared/scenes"
+                " next to the source tree)";
     } else {
       const std::filesystem::path json =
           std::filesystem::temp_directory_path() / ("rtpg_bench_sponza_" + std::to_string(::getpid()) + ".json");

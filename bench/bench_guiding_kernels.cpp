@@ -5,8 +5,9 @@
 // from a cosine bounce (positions, normals, area densities, radiance with rare bright hits,
 // 20% guide-strategy and 10% escaped ones) and trained-like states (k spread over 0..kMax).
 //
-//   bench_guiding_kernels               1280x720 local-size sweep, 1920x1080 at 16x16, TBB
-//   bench_guiding_kernels --rtpg_full   also the local-size sweep at 1920x1080
+//   bench_guiding_kernels               1280x720 local-size sweep, 1920x1080 at 16x16,
+//                                       TBB train at 1280x720
+//   bench_guiding_kernels --rtpg_full   also the local-size sweep and TBB train at 1920x1080
 //
 // Time is the kernel's OpenCL profiling-event time (manual time); every configuration's first
 // launch (program build, PoCL's work-group function for that local size) happens before the
@@ -16,6 +17,10 @@
 //   copy_bw              what copy_float4 (kernels/copy_float4.cl, 64 MiB each way) reaches,
 //                        launched in the same iteration as the kernel
 //   copy_fraction        bytes_per_second / copy_bw
+//   vs_16x16_global      kernel time / the same kernel's time at 16x16 with VPLs read from
+//                        global memory, launched in the same iterations (1 for that one):
+//                        the local-size sweep and Local vs Global as ratios that host drift
+//                        does not disturb
 // Bytes per pixel, counted from the inputs along each pixel's path through the kernel (each
 // buffer element counted once, at its full width; a pixel's neighbours' VPLs are the same
 // memory as its own, so the VPL buffers count 48 bytes per pixel):
@@ -358,25 +363,47 @@ void BM_CopyFloat4(benchmark::State& state) {
 
 enum class Kernel { Reproject, Sample, Train };
 
-// One guider alive at a time (the buffers of a 1080p guider take 130 MB): repetitions of one
-// benchmark run back to back and reuse it.
+std::unique_ptr<Guider> make_guider(int w, int h, int lx, int ly, GuidingConfig::TrainMemory memory) {
+  GuidingConfig config;
+  config.local_x = lx;
+  config.local_y = ly;
+  config.train_memory = memory;
+  auto guider = std::make_unique<Guider>(runtime(), w, h, config);
+  Inputs& in = inputs_for(w, h);
+  guider->write_state(in.state);  // first launches of all three kernels, untimed
+  guider->reproject(in.d_cur, in.d_prev);
+  guider->sample(in.d_cur, 1u, 0u, 0u, in.d_samples);
+  guider->train(in.d_cur, in.d_vpls, 1u, 0u);
+  return guider;
+}
+
+// The configuration every other one is compared with, in the same iterations: 16x16 work-groups,
+// VPLs read from global memory (what GuidingConfig's Auto picks on CPU devices).
+constexpr int kRefX = 16, kRefY = 16;
+constexpr GuidingConfig::TrainMemory kRefMemory = GuidingConfig::TrainMemory::Global;
+
+Guider& reference_guider(int w, int h) {
+  static std::unique_ptr<Guider> guider;
+  static std::pair<int, int> key;
+  if (!guider || key != std::make_pair(w, h)) {
+    guider.reset();
+    guider = make_guider(w, h, kRefX, kRefY, kRefMemory);
+    key = {w, h};
+  }
+  return *guider;
+}
+
+// One other guider alive at a time (a 1080p guider's buffers take 130 MB): the repetitions of
+// one benchmark run back to back and reuse it.
 Guider& guider_for(int w, int h, int lx, int ly, GuidingConfig::TrainMemory memory) {
+  if (lx == kRefX && ly == kRefY && memory == kRefMemory) return reference_guider(w, h);
   static std::unique_ptr<Guider> guider;
   static std::tuple<int, int, int, int, GuidingConfig::TrainMemory> key;
   const auto want = std::make_tuple(w, h, lx, ly, memory);
   if (!guider || key != want) {
     guider.reset();
-    GuidingConfig config;
-    config.local_x = lx;
-    config.local_y = ly;
-    config.train_memory = memory;
-    guider = std::make_unique<Guider>(runtime(), w, h, config);
+    guider = make_guider(w, h, lx, ly, memory);
     key = want;
-    Inputs& in = inputs_for(w, h);
-    guider->write_state(in.state);  // first launches of all three kernels, untimed
-    guider->reproject(in.d_cur, in.d_prev);
-    guider->sample(in.d_cur, 1u, 0u, 0u, in.d_samples);
-    guider->train(in.d_cur, in.d_vpls, 1u, 0u);
   }
   return *guider;
 }
@@ -401,20 +428,24 @@ void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int 
                       GuidingConfig::TrainMemory memory) {
   Inputs& in = inputs_for(w, h);
   Guider* g = nullptr;
+  Guider* ref = nullptr;
   try {
+    ref = &reference_guider(w, h);
     g = &guider_for(w, h, lx, ly, memory);
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
     return;
   }
   Copy& c = copy();
-  double kernel_ms = 0.0, copy_ms = 0.0;
+  double kernel_ms = 0.0, copy_ms = 0.0, ref_ms = 0.0;
   std::uint32_t frame = 1;
   for (auto _ : state) {
-    const double ms = launch(*g, in, kernel, frame++);
+    const double ms = launch(*g, in, kernel, frame);
     state.SetIterationTime(ms * 1e-3);
     kernel_ms += ms;
     copy_ms += c.run();
+    ref_ms += g == ref ? ms : launch(*ref, in, kernel, frame);
+    ++frame;
   }
   const double bytes = kernel == Kernel::Reproject ? in.reproject_bytes
                        : kernel == Kernel::Sample  ? in.sample_bytes
@@ -427,6 +458,7 @@ void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int 
   state.counters["bytes_per_pixel"] = bytes / static_cast<double>(in.n);
   state.counters["copy_bw"] = benchmark::Counter(copy_bw, benchmark::Counter::kDefaults, benchmark::Counter::kIs1024);
   state.counters["copy_fraction"] = kernel_bw / copy_bw;
+  state.counters["vs_16x16_global"] = kernel_ms / ref_ms;
   if (kernel == Kernel::Train) state.counters["local_tile"] = g->train_uses_local_memory() ? 1.0 : 0.0;
 }
 
@@ -486,7 +518,7 @@ void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint3
 
 void BM_TrainTbb(benchmark::State& state, int w, int h) {
   Inputs& in = inputs_for(w, h);
-  Guider& g = guider_for(w, h, 16, 16, GuidingConfig::TrainMemory::Auto);
+  Guider& g = reference_guider(w, h);
   const sh::pg_guiding_params params = make_guiding_params(g.config());
   std::vector<float> out(in.n * 8);
   std::vector<std::uint8_t> trained(in.n);
@@ -543,17 +575,19 @@ void register_all(bool full) {
             ->Unit(benchmark::kMillisecond)
             ->MinTime(0.2);
       };
-      add("Reproject/" + res + local, Kernel::Reproject, M::Auto);
-      add("Sample/" + res + local, Kernel::Sample, M::Auto);
+      add("Reproject/" + res + local, Kernel::Reproject, M::Global);
+      add("Sample/" + res + local, Kernel::Sample, M::Global);
       add("Train/" + res + local + "/memory:global", Kernel::Train, M::Global);
       add("Train/" + res + local + "/memory:local", Kernel::Train, M::Local);
     }
   }
-  for (auto [w, h] : sizes)
+  for (auto [w, h] : sizes) {
+    if (w != 1280 && !full) continue;
     benchmark::RegisterBenchmark(("TrainTbb/" + std::to_string(w) + "x" + std::to_string(h)).c_str(), BM_TrainTbb, w, h)
         ->UseManualTime()
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2);
+  }
 }
 
 }  // namespace
