@@ -38,7 +38,9 @@ namespace rtpg::bench {
 
 // ---- scenes ------------------------------------------------------------------------------
 
-inline std::string cornell_path() { return std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json"; }
+inline std::string cornell_path() {
+  return std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json";
+}
 
 // $RTPG_ASSET_ROOT, else ../shared/scenes next to the source tree.
 inline std::string shared_scenes_dir() {
@@ -46,7 +48,9 @@ inline std::string shared_scenes_dir() {
   return std::string(RTPG_SOURCE_DIR) + "/../shared/scenes";
 }
 
-inline std::string sponza_obj_path() { return shared_scenes_dir() + "/crytek-sponza/sponza.obj"; }
+inline std::string sponza_obj_path() {
+  return shared_scenes_dir() + "/crytek-sponza/sponza.obj";
+}
 
 // The Cornell box, loaded once per process.
 inline const Scene& cornell_scene() {
@@ -64,17 +68,20 @@ inline const Scene* sponza_scene(std::string* why) {
     tried = true;
     const std::string obj = sponza_obj_path();
     if (!std::filesystem::exists(obj)) {
-      missing = "Crytek Sponza not found at " + obj +
-                ": set RTPG_ASSET_ROOT to the folder holding crytek-sponza/ (default: ../shared/scenes"
-                " next to the source tree)";
+      missing =
+          "Crytek Sponza not found at " + obj +
+          ": set RTPG_ASSET_ROOT to the folder holding crytek-sponza/ (default: ../shared/scenes"
+          " next to the source tree)";
     } else {
       const std::filesystem::path json =
-          std::filesystem::temp_directory_path() / ("rtpg_bench_sponza_" + std::to_string(::getpid()) + ".json");
+          std::filesystem::temp_directory_path() /
+          ("rtpg_bench_sponza_" + std::to_string(::getpid()) + ".json");
       {
         std::ofstream out(json);
         out << "{\n"
                "  \"description\": \"rtpg benchmarks: Crytek Sponza, sun and sky\",\n"
-               "  \"camera\": {\"position\": [-1100, 180, -40], \"look_at\": [1000, 420, 40], \"fov\": 60},\n"
+               "  \"camera\": {\"position\": [-1100, 180, -40], \"look_at\": [1000, 420, 40], "
+               "\"fov\": 60},\n"
                "  \"meshes\": [{\"file\": \""
             << obj
             << "\"}],\n"
@@ -144,7 +151,8 @@ inline RaySets make_ray_sets(const Scene& scene, const EmbreeScene& tracer, int 
       shared::pg_rng rng = shared::pg_rng_make(seed, static_cast<shared::uint>(i), 0u, 0u, 9u);
       const float u1 = shared::pg_rng_next(&rng), u2 = shared::pg_rng_next(&rng);
       const float r = std::sqrt(u1), phi = 2.0f * PG_PI * u2;
-      const glm::vec3 local(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - u1)));
+      const glm::vec3 local(r * std::cos(phi), r * std::sin(phi),
+                            std::sqrt(std::max(0.0f, 1.0f - u1)));
       const shared::pg_frame frame = shared::pg_frame_from_normal(sp.geometric_normal);
       Ray b;
       b.origin = origin;
@@ -152,14 +160,16 @@ inline RaySets make_ray_sets(const Scene& scene, const EmbreeScene& tracer, int 
       bounce[i] = b;
       has_bounce[i] = 1;
       LightSample ls;
-      const float us = shared::pg_rng_next(&rng), v1 = shared::pg_rng_next(&rng), v2 = shared::pg_rng_next(&rng);
+      const float us = shared::pg_rng_next(&rng), v1 = shared::pg_rng_next(&rng),
+                  v2 = shared::pg_rng_next(&rng);
       if (!lights.empty() && lights.sample(sp.position, us, v1, v2, ls) &&
           glm::dot(ls.direction, sp.geometric_normal) > 0.0f) {
         Ray sr;
         sr.origin = origin;
         sr.direction = ls.direction;
         sr.tmin = 0.0f;
-        sr.tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity() : ls.distance * (1.0f - 1e-4f);
+        sr.tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity()
+                                          : ls.distance * (1.0f - 1e-4f);
         shadow[i] = sr;
         has_shadow[i] = 1;
       }

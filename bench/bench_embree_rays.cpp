@@ -35,12 +35,13 @@ Setup* setup_for(const std::string& scene_name, int w, int h, std::string* why) 
   s->tracer = std::make_unique<EmbreeScene>(*scene);
   s->rays = make_ray_sets(*scene, *s->tracer, w, h);
   // Warm the BVH and the TBB arena once per kind, outside any timed loop.
-  for (RayKind k : {RayKind::Primary, RayKind::Secondary, RayKind::Shadow}) trace_set(*s->tracer, s->rays, k, RayMode::Single);
+  for (RayKind k : {RayKind::Primary, RayKind::Secondary, RayKind::Shadow})
+    trace_set(*s->tracer, s->rays, k, RayMode::Single);
   return (cache[key] = std::move(s)).get();
 }
 
-void BM_EmbreeRays(benchmark::State& state, const std::string& scene_name, int w, int h, RayKind kind,
-                   RayMode mode) {
+void BM_EmbreeRays(benchmark::State& state, const std::string& scene_name, int w, int h,
+                   RayKind kind, RayMode mode) {
   std::string why;
   Setup* s = setup_for(scene_name, w, h, &why);
   if (!s) {
@@ -58,11 +59,14 @@ void BM_EmbreeRays(benchmark::State& state, const std::string& scene_name, int w
     }
   }
   state.counters["rays"] = count;
-  state.counters["rays_per_s"] = benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
-  if (mode == RayMode::Packet8 && packet_s > 0.0) state.counters["packet_speedup"] = single_s / packet_s;
+  state.counters["rays_per_s"] =
+      benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
+  if (mode == RayMode::Packet8 && packet_s > 0.0)
+    state.counters["packet_speedup"] = single_s / packet_s;
   if (kind != RayKind::Shadow) {
     std::size_t hit = 0;
-    for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i) hit += s->rays.hits[i].valid();
+    for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i)
+      hit += s->rays.hits[i].valid();
     state.counters["hit_fraction"] = static_cast<double>(hit) / std::max(count, 1.0);
   } else {
     std::size_t blocked = 0;
@@ -78,10 +82,11 @@ void register_all(bool full) {
     for (auto [w, h] : sizes)
       for (RayKind kind : {RayKind::Primary, RayKind::Secondary, RayKind::Shadow})
         for (RayMode mode : {RayMode::Single, RayMode::Packet8}) {
-          const std::string name = std::string("EmbreeRays/") + scene + "/" + kind_name(kind) + "/" +
-                                   (mode == RayMode::Single ? "single" : "packet8") + "/" +
+          const std::string name = std::string("EmbreeRays/") + scene + "/" + kind_name(kind) +
+                                   "/" + (mode == RayMode::Single ? "single" : "packet8") + "/" +
                                    std::to_string(w) + "x" + std::to_string(h);
-          benchmark::RegisterBenchmark(name.c_str(), BM_EmbreeRays, std::string(scene), w, h, kind, mode)
+          benchmark::RegisterBenchmark(name.c_str(), BM_EmbreeRays, std::string(scene), w, h, kind,
+                                       mode)
               ->UseManualTime()
               ->Unit(benchmark::kMillisecond)
               ->MinTime(0.3);
@@ -91,4 +96,6 @@ void register_all(bool full) {
 }  // namespace
 }  // namespace rtpg::bench
 
-int main(int argc, char** argv) { return rtpg::bench::bench_main(argc, argv, rtpg::bench::register_all); }
+int main(int argc, char** argv) {
+  return rtpg::bench::bench_main(argc, argv, rtpg::bench::register_all);
+}

@@ -81,7 +81,8 @@ double embree_only_ms(FrameSetup& s, const FrameStats& stats) {
   const double p = per_ray(RayKind::Primary, RayMode::Packet8);
   const double b = per_ray(RayKind::Secondary, RayMode::Single);
   const double sh = per_ray(RayKind::Shadow, RayMode::Single);
-  return 1e3 * (static_cast<double>(stats.primary_rays) * p + static_cast<double>(stats.secondary_rays) * b +
+  return 1e3 * (static_cast<double>(stats.primary_rays) * p +
+                static_cast<double>(stats.secondary_rays) * b +
                 static_cast<double>(stats.shadow_rays) * sh);
 }
 
@@ -100,19 +101,23 @@ void BM_Frame(benchmark::State& state, const std::string& scene_name, int w, int
   std::map<std::string, double> sum;
   double rays_p = 0, rays_s = 0, rays_sh = 0;
   for (auto _ : state) {
-    const FrameStats st = guided ? s->pmm->render_frame(s->next_pmm++) : s->off->render_frame(s->next_off++);
+    const FrameStats st =
+        guided ? s->pmm->render_frame(s->next_pmm++) : s->off->render_frame(s->next_off++);
     const double total = stage(st, "total");
     state.SetIterationTime(total * 1e-3);
     sum["frame_ms"] += total;
-    for (const char* k : {"primary", "gbuffer", "first_bounce", "trace", "shade"}) sum[std::string(k) + "_ms"] += stage(st, k);
+    for (const char* k : {"primary", "gbuffer", "first_bounce", "trace", "shade"})
+      sum[std::string(k) + "_ms"] += stage(st, k);
     if (guided) {
-      sum["guiding_ms"] += stage(st, "guiding_begin") + stage(st, "first_bounce") + stage(st, "guiding_end");
+      sum["guiding_ms"] +=
+          stage(st, "guiding_begin") + stage(st, "first_bounce") + stage(st, "guiding_end");
       sum["reproject_kernel_ms"] += stage(st, "reproject");
       sum["sample_kernel_ms"] += stage(st, "sample");
       sum["train_kernel_ms"] += stage(st, "train");
       sum["upload_ms"] += stage(st, "upload");
       sum["readback_ms"] += stage(st, "readback");
-      sum["guided_fraction"] += st.extra.count("guided_fraction") ? st.extra.at("guided_fraction") : 0.0;
+      sum["guided_fraction"] +=
+          st.extra.count("guided_fraction") ? st.extra.at("guided_fraction") : 0.0;
       // The same frame without guiding, interleaved (drift cancels in the ratio).
       const FrameStats off = s->off->render_frame(s->next_off++);
       sum["off_frame_ms"] += stage(off, "total");
@@ -126,7 +131,9 @@ void BM_Frame(benchmark::State& state, const std::string& scene_name, int w, int
   if (it <= 0) return;
   for (const auto& [k, v] : sum) state.counters[k] = v / it;
   state.counters["ratio"] = sum["frame_ms"] / sum["embree_only_ms"];
-  if (guided) state.counters["guiding_overhead"] = (sum["frame_ms"] - sum["off_frame_ms"]) / sum["off_frame_ms"];
+  if (guided)
+    state.counters["guiding_overhead"] =
+        (sum["frame_ms"] - sum["off_frame_ms"]) / sum["off_frame_ms"];
   state.counters["primary_rays"] = rays_p / it;
   state.counters["secondary_rays"] = rays_s / it;
   state.counters["shadow_rays"] = rays_sh / it;
@@ -140,7 +147,8 @@ void register_all(bool full) {
     const char* scene;
     int w, h, iterations;
   };
-  std::vector<Config> configs = {{"cornell", 640, 360, 3}, {"cornell", 1920, 1080, 1}, {"sponza", 640, 360, 3}};
+  std::vector<Config> configs = {
+      {"cornell", 640, 360, 3}, {"cornell", 1920, 1080, 1}, {"sponza", 640, 360, 3}};
   if (full) configs.push_back({"sponza", 1920, 1080, 1});
   for (const Config& c : configs)
     for (bool guided : {false, true}) {
@@ -156,4 +164,6 @@ void register_all(bool full) {
 }  // namespace
 }  // namespace rtpg::bench
 
-int main(int argc, char** argv) { return rtpg::bench::bench_main(argc, argv, rtpg::bench::register_all); }
+int main(int argc, char** argv) {
+  return rtpg::bench::bench_main(argc, argv, rtpg::bench::register_all);
+}

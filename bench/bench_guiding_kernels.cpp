@@ -67,11 +67,13 @@ ClRuntime& runtime() {
 // ---- synthetic inputs ------------------------------------------------------------------------
 
 struct HostGBuffer {
-  std::vector<float4> position_depth, shading_normal, view_dir, base_color_roughness, metallic_specular;
+  std::vector<float4> position_depth, shading_normal, view_dir, base_color_roughness,
+      metallic_specular;
   std::vector<std::uint32_t> flags, material;
   std::vector<float2> motion;
   void resize(std::size_t n) {
-    for (auto* v : {&position_depth, &shading_normal, &view_dir, &base_color_roughness, &metallic_specular})
+    for (auto* v :
+         {&position_depth, &shading_normal, &view_dir, &base_color_roughness, &metallic_specular})
       v->assign(n, float4(0.0f));
     flags.assign(n, 0u);
     material.assign(n, 0u);
@@ -103,8 +105,8 @@ float3 tilt(std::mt19937& g, float3 n, float max_deg) {
 
 template <typename T>
 cl::Buffer upload(const std::vector<T>& v) {
-  return cl::Buffer(runtime().context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
-                    const_cast<T*>(v.data()));
+  return cl::Buffer(runtime().context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                    v.size() * sizeof(T), const_cast<T*>(v.data()));
 }
 
 GuiderGBuffer upload(const HostGBuffer& g) {
@@ -133,8 +135,8 @@ void make_gbuffer(Inputs& in, std::mt19937& g) {
   for (int m = 0; m < 12; ++m) {
     const float rough = m < 2 ? 0.02f : 0.1f + 0.9f * u(g);  // two near-specular (skipped)
     const bool metal = u(g) < 0.25f;
-    mats.push_back({float4(u(g), u(g), u(g), rough), float4(metal ? 1.0f : 0.0f, u(g) < 0.5f ? 0.04f : 0.0f, 0, 0),
-                    m == 11});
+    mats.push_back({float4(u(g), u(g), u(g), rough),
+                    float4(metal ? 1.0f : 0.0f, u(g) < 0.5f ? 0.04f : 0.0f, 0, 0), m == 11});
   }
   const float tan_half = std::tan(30.0f * PG_PI / 180.0f), aspect = static_cast<float>(w) / h;
   in.cur.resize(in.n);
@@ -163,7 +165,8 @@ void make_gbuffer(Inputs& in, std::mt19937& g) {
       const int id = static_cast<int>(patches.size());
       patches.push_back(p);
       for (int y = ys[py]; y < std::min(ys[py + 1], h); ++y)
-        for (int x = xs[px]; x < std::min(xs[px + 1], w); ++x) patch_of[static_cast<std::size_t>(y) * w + x] = id;
+        for (int x = xs[px]; x < std::min(xs[px + 1], w); ++x)
+          patch_of[static_cast<std::size_t>(y) * w + x] = id;
     }
   HostGBuffer& c = in.cur;
   for (int y = 0; y < h; ++y)
@@ -207,8 +210,11 @@ void make_gbuffer(Inputs& in, std::mt19937& g) {
       in.prev.shading_normal[j] = c.shading_normal[i];
       in.prev.material[j] = c.material[i];
       const float r = u(g);
-      if (r < 0.03f) in.prev.material[j] = c.material[i] + 1;
-      else if (r < 0.13f) in.prev.shading_normal[j] = float4(tilt(g, sh::pg_float4_xyz(c.shading_normal[i]), 3.0f), 0.0f);
+      if (r < 0.03f)
+        in.prev.material[j] = c.material[i] + 1;
+      else if (r < 0.13f)
+        in.prev.shading_normal[j] =
+            float4(tilt(g, sh::pg_float4_xyz(c.shading_normal[i]), 3.0f), 0.0f);
     }
 }
 
@@ -224,7 +230,8 @@ void make_vpls(Inputs& in, std::mt19937& g) {
     const float3 x = sh::pg_float4_xyz(in.cur.position_depth[i]);
     const sh::pg_frame fr = sh::pg_frame_from_normal(sh::pg_float4_xyz(in.cur.shading_normal[i]));
     const float u1 = u(g), u2 = u(g);
-    const float r = std::sqrt(u1), phi = 2.0f * PG_PI * u2, cz = std::sqrt(std::max(1e-4f, 1.0f - u1));
+    const float r = std::sqrt(u1), phi = 2.0f * PG_PI * u2,
+                cz = std::sqrt(std::max(1e-4f, 1.0f - u1));
     const float3 w = sh::pg_to_world(fr, float3(r * std::cos(phi), r * std::sin(phi), cz));
     const float pdf = cz * PG_INV_PI;
     const std::uint32_t strategy = u(g) < 0.8f ? PG_STRATEGY_BSDF : PG_STRATEGY_GUIDE;
@@ -240,7 +247,8 @@ void make_vpls(Inputs& in, std::mt19937& g) {
       in.vpl_position[i] = float4(x + w * d, pdf * cos_y / (d * d));
       in.vpl_normal[i] = float4(ny, 0.0f);
     }
-    in.vpl_radiance[i] = float4(bright * u(g), bright * u(g), bright * u(g), static_cast<float>(info));
+    in.vpl_radiance[i] =
+        float4(bright * u(g), bright * u(g), bright * u(g), static_cast<float>(info));
   }
 }
 
@@ -274,19 +282,24 @@ void count_bytes(Inputs& in, const sh::pg_guiding_params& p) {
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      const bool applies = sh::pg_guiding_applies(in.cur.flags[i], in.cur.base_color_roughness[i].w, p);
+      const bool applies =
+          sh::pg_guiding_applies(in.cur.flags[i], in.cur.base_color_roughness[i].w, p);
       const bool sky = (in.cur.flags[i] & PG_GBUF_SKY) != 0u;
       double r = 4 + 16 + 32;
       if (applies) {
         r += 8;
         const float2 mv = in.cur.motion[i];
-        const int px = static_cast<int>(std::floor(x + 0.5f + mv.x)), py = static_cast<int>(std::floor(y + 0.5f + mv.y));
+        const int px = static_cast<int>(std::floor(x + 0.5f + mv.x)),
+                  py = static_cast<int>(std::floor(y + 0.5f + mv.y));
         if (px >= 0 && py >= 0 && px < w && py < h) {
           r += 2 * 16 + 2 * 16 + 2 * 4;
           const std::size_t j = static_cast<std::size_t>(py) * w + px;
-          const float3 d = sh::pg_float4_xyz(in.cur.position_depth[i]) - sh::pg_float4_xyz(in.prev.position_depth[j]);
-          const float3 n = sh::pg_float4_xyz(in.cur.shading_normal[i]), m = sh::pg_float4_xyz(in.prev.shading_normal[j]);
-          if (std::sqrt(sh::dot(d, d)) <= p.reproject_depth * std::fmax(in.cur.position_depth[i].w, 1e-6f) &&
+          const float3 d = sh::pg_float4_xyz(in.cur.position_depth[i]) -
+                           sh::pg_float4_xyz(in.prev.position_depth[j]);
+          const float3 n = sh::pg_float4_xyz(in.cur.shading_normal[i]),
+                       m = sh::pg_float4_xyz(in.prev.shading_normal[j]);
+          if (std::sqrt(sh::dot(d, d)) <=
+                  p.reproject_depth * std::fmax(in.cur.position_depth[i].w, 1e-6f) &&
               sh::dot(n, m) >= p.reproject_normal && in.prev.material[j] == in.cur.material[i] &&
               in.prev.position_depth[j].w > 0.0f)
             r += 32;
@@ -342,7 +355,8 @@ struct Copy {
   static double bytes() { return 2.0 * kElements * 16; }
   double run() {  // ms
     cl::Event done;
-    runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(kElements), cl::NullRange, nullptr, &done);
+    runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(kElements),
+                                           cl::NullRange, nullptr, &done);
     done.wait();
     return ClRuntime::event_ms(done);
   }
@@ -363,7 +377,8 @@ void BM_CopyFloat4(benchmark::State& state) {
 
 enum class Kernel { Reproject, Sample, Train };
 
-std::unique_ptr<Guider> make_guider(int w, int h, int lx, int ly, GuidingConfig::TrainMemory memory) {
+std::unique_ptr<Guider> make_guider(int w, int h, int lx, int ly,
+                                    GuidingConfig::TrainMemory memory) {
   GuidingConfig config;
   config.local_x = lx;
   config.local_y = ly;
@@ -456,17 +471,19 @@ void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int 
   const double kernel_bw = bytes * it / (kernel_ms * 1e-3);
   const double copy_bw = Copy::bytes() * it / (copy_ms * 1e-3);
   state.counters["bytes_per_pixel"] = bytes / static_cast<double>(in.n);
-  state.counters["copy_bw"] = benchmark::Counter(copy_bw, benchmark::Counter::kDefaults, benchmark::Counter::kIs1024);
+  state.counters["copy_bw"] =
+      benchmark::Counter(copy_bw, benchmark::Counter::kDefaults, benchmark::Counter::kIs1024);
   state.counters["copy_fraction"] = kernel_bw / copy_bw;
   state.counters["vs_16x16_global"] = kernel_ms / ref_ms;
-  if (kernel == Kernel::Train) state.counters["local_tile"] = g->train_uses_local_memory() ? 1.0 : 0.0;
+  if (kernel == Kernel::Train)
+    state.counters["local_tile"] = g->train_uses_local_memory() ? 1.0 : 0.0;
 }
 
 // ---- train as plain C++ over TBB -------------------------------------------------------------
 
 // train.cl with PG_TRAIN_LOCAL_TILE=0, one pixel per loop iteration, rows spread over TBB.
-void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint32_t seed, std::uint32_t frame,
-               std::vector<float>& out, std::vector<std::uint8_t>& trained) {
+void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint32_t seed,
+               std::uint32_t frame, std::vector<float>& out, std::vector<std::uint8_t>& trained) {
   const int w = in.w, h = in.h;
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y != rows.end(); ++y)
@@ -485,9 +502,11 @@ void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint3
           px.x = sh::pg_float4_xyz(in.cur.position_depth[i]);
           px.frame = sh::pg_frame_from_normal(sh::pg_float4_xyz(in.cur.shading_normal[i]));
           px.wo = sh::pg_to_local(px.frame, sh::pg_float4_xyz(in.cur.view_dir[i]));
-          px.lobes = sh::pg_make_lobes(sh::pg_material_from_gbuffer(bcr, in.cur.metallic_specular[i]), px.wo);
+          px.lobes = sh::pg_make_lobes(
+              sh::pg_material_from_gbuffer(bcr, in.cur.metallic_specular[i]), px.wo);
           const int apron = params.apron, side = 2 * apron + 1;
-          const int n = std::min(std::min(sh::pg_pmm_neighbour_count(s1.w, params), side * side), PG_MAX_TRAIN_SAMPLES);
+          const int n = std::min(std::min(sh::pg_pmm_neighbour_count(s1.w, params), side * side),
+                                 PG_MAX_TRAIN_SAMPLES);
           sh::pg_rng rng = sh::pg_rng_make(seed, static_cast<sh::uint>(i), frame, 0u, 3u);
           const sh::uint start = sh::pg_rng_next_uint(&rng) % static_cast<sh::uint>(side * side);
           float4 samples[PG_MAX_TRAIN_SAMPLES];
@@ -497,11 +516,12 @@ void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint3
             const int sx = x + wi % side - apron, sy = y + wi / side - apron;
             if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
             const int j = sy * w + sx;
-            kept += sh::pg_train_sample_from_vpl(px, in.vpl_position[j], in.vpl_normal[j], in.vpl_radiance[j],
-                                                 &samples[kept]);
+            kept += sh::pg_train_sample_from_vpl(px, in.vpl_position[j], in.vpl_normal[j],
+                                                 in.vpl_radiance[j], &samples[kept]);
           }
           int updated = 0;
-          st = sh::pg_pmm_train(st, samples, kept, params, static_cast<float>(n), params.em_passes, &updated);
+          st = sh::pg_pmm_train(st, samples, kept, params, static_cast<float>(n), params.em_passes,
+                                &updated);
           s0 = st.s0;
           s1 = st.s1;
           changed = static_cast<std::uint8_t>(updated);
@@ -528,7 +548,8 @@ void BM_TrainTbb(benchmark::State& state, int w, int h) {
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
     tbb_train(in, params, 1u, frame, out, trained);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     state.SetIterationTime(ms * 1e-3);
     tbb_ms += ms;
     kernel_ms += launch(g, in, Kernel::Train, frame);
@@ -556,7 +577,9 @@ void BM_TrainTbb(benchmark::State& state, int w, int h) {
 
 void register_all(bool full) {
   benchmark::AddCustomContext("opencl_device", runtime().info().device_name);
-  benchmark::RegisterBenchmark("CopyFloat4/64MiB", BM_CopyFloat4)->UseManualTime()->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("CopyFloat4/64MiB", BM_CopyFloat4)
+      ->UseManualTime()
+      ->Unit(benchmark::kMillisecond);
   using M = GuidingConfig::TrainMemory;
   struct Local {
     int x, y;
@@ -583,7 +606,8 @@ void register_all(bool full) {
   }
   for (auto [w, h] : sizes) {
     if (w != 1280 && !full) continue;
-    benchmark::RegisterBenchmark(("TrainTbb/" + std::to_string(w) + "x" + std::to_string(h)).c_str(), BM_TrainTbb, w, h)
+    benchmark::RegisterBenchmark(
+        ("TrainTbb/" + std::to_string(w) + "x" + std::to_string(h)).c_str(), BM_TrainTbb, w, h)
         ->UseManualTime()
         ->Unit(benchmark::kMillisecond)
         ->MinTime(0.2);
@@ -593,4 +617,6 @@ void register_all(bool full) {
 }  // namespace
 }  // namespace rtpg::bench
 
-int main(int argc, char** argv) { return rtpg::bench::bench_main(argc, argv, rtpg::bench::register_all); }
+int main(int argc, char** argv) {
+  return rtpg::bench::bench_main(argc, argv, rtpg::bench::register_all);
+}

@@ -276,8 +276,14 @@ def main():
     ap.add_argument("--report", default=None, help="folder of the Markdown report")
     ap.add_argument("--only", nargs="*", choices=list(EXPERIMENTS), default=list(EXPERIMENTS))
     ap.add_argument("--scenes", nargs="*", default=None)
+    ap.add_argument("--res", help="override the mode's resolution (WxH); the report states it")
+    ap.add_argument("--ref-spp", type=int, help="override the references' samples per pixel")
     args = ap.parse_args()
     ctx = Context(args)
+    if args.res:
+        ctx.mode["res"] = args.res
+    if args.ref_spp:
+        ctx.mode["ref_spp"] = args.ref_spp
     scenes = args.scenes or ctx.mode["scenes"]
     results = {"machine": runner.machine_info(), "mode": "quick" if args.quick else "full", "settings": ctx.mode,
                "started": time.strftime("%Y-%m-%d %H:%M:%S"), "skipped_scenes": {}, "experiments": {}}

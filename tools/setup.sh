@@ -11,7 +11,7 @@ DEBIAN_PACKAGES=(
   pocl-opencl-icd ocl-icd-opencl-dev opencl-clhpp-headers opencl-c-headers clinfo
   libembree-dev libopenimageio-dev openimageio-tools libglm-dev libassimp-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
-  libgtest-dev libgmock-dev libbenchmark-dev oclgrind
+  libgtest-dev libgmock-dev libbenchmark-dev oclgrind clang-format
   python3 python3-pip python3-venv
 )
 

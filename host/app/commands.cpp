@@ -36,7 +36,8 @@ constexpr float kPngExposure = 1.0f;
 
 std::string extension_of(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 
@@ -83,7 +84,8 @@ void write_output(const std::string& path, const ImageRgb& image, ClRuntime& cl,
                   const std::map<std::string, std::string>& metadata) {
   if (extension_of(path) == ".png") {
     std::vector<glm::vec4> radiance(image.pixels.size());
-    for (std::size_t i = 0; i < radiance.size(); ++i) radiance[i] = glm::vec4(image.pixels[i], 1.0f);
+    for (std::size_t i = 0; i < radiance.size(); ++i)
+      radiance[i] = glm::vec4(image.pixels[i], 1.0f);
     std::vector<std::uint8_t> rgba8;
     tonemap_on_device(cl, radiance, image.width, image.height, kPngExposure, rgba8);
     write_png(path, image.width, image.height, rgba8);
@@ -110,16 +112,19 @@ int run_render(const RenderOptions& options) {
   check_output_path(options.output, "--output", true);
   if (!options.stats_json.empty()) check_output_folder(options.stats_json);
   if (options.frames <= 0) throw InputError("--frames", "must be at least 1");
-  if (options.max_bounces < 0) throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
+  if (options.max_bounces < 0)
+    throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
   ImageRgb reference;
   if (!options.reference.empty()) {
     reference = load_quietly([&] { return read_image(options.reference); });
     if (reference.width != options.settings.width || reference.height != options.settings.height)
-      throw InputError(options.reference,
-                       fmt::format("reference is {}x{}, the render is {}x{}", reference.width,
-                                   reference.height, options.settings.width, options.settings.height));
+      throw InputError(
+          options.reference,
+          fmt::format("reference is {}x{}, the render is {}x{}", reference.width, reference.height,
+                      options.settings.width, options.settings.height));
   }
-  const std::string scene_path = options.common.scene.empty() ? default_scene_path() : options.common.scene;
+  const std::string scene_path =
+      options.common.scene.empty() ? default_scene_path() : options.common.scene;
   const Scene scene = load(options.common);
   ClRuntime cl(options.common.device);
   RenderSettings settings = options.settings;
@@ -167,9 +172,10 @@ int run_render(const RenderOptions& options) {
     nlohmann::json frame = {{"index", f},
                             {"time_ms", stats.time_ms},
                             {"nonfinite_samples", stats.nonfinite_samples},
-                            {"rays", {{"primary", stats.primary_rays},
-                                      {"secondary", stats.secondary_rays},
-                                      {"shadow", stats.shadow_rays}}}};
+                            {"rays",
+                             {{"primary", stats.primary_rays},
+                              {"secondary", stats.secondary_rays},
+                              {"shadow", stats.shadow_rays}}}};
     for (const auto& [key, value] : stats.extra) frame[key] = value;
     if (flicker >= 0.0) frame["flicker_mse"] = flicker;
     if (!options.reference.empty()) {
@@ -204,20 +210,21 @@ int run_render(const RenderOptions& options) {
                   {"guiding", options.guiding}});
   }
   if (!options.stats_json.empty()) {
-    const nlohmann::json stats = {{"scene", scene_path},
-                                  {"width", options.settings.width},
-                                  {"height", options.settings.height},
-                                  {"spp", options.settings.spp},
-                                  {"seed", options.settings.seed},
-                                  {"jitter", options.settings.jitter},
-                                  {"accumulate", options.accumulate},
-                                  {"camera_path", options.settings.camera_path},
-                                  {"guiding", options.guiding},
-                                  {"max_bounces", settings.path_tracer.max_bounces},
-                                  {"device", cl.info().device_name},
-                                  {"threads", static_cast<int>(std::thread::hardware_concurrency())},
-                                  {"bvh_build_ms", renderer.tracer().build_seconds() * 1e3},
-                                  {"frames", frames}};
+    const nlohmann::json stats = {
+        {"scene", scene_path},
+        {"width", options.settings.width},
+        {"height", options.settings.height},
+        {"spp", options.settings.spp},
+        {"seed", options.settings.seed},
+        {"jitter", options.settings.jitter},
+        {"accumulate", options.accumulate},
+        {"camera_path", options.settings.camera_path},
+        {"guiding", options.guiding},
+        {"max_bounces", settings.path_tracer.max_bounces},
+        {"device", cl.info().device_name},
+        {"threads", static_cast<int>(std::thread::hardware_concurrency())},
+        {"bvh_build_ms", renderer.tracer().build_seconds() * 1e3},
+        {"frames", frames}};
     write_text_atomically(options.stats_json, stats.dump(2) + "\n");
   }
   if (!options.common.quiet) {
@@ -236,7 +243,8 @@ int run_render(const RenderOptions& options) {
 int run_reference(const ReferenceOptions& options) {
   check_output_path(options.output, "--output", false);
   if (options.spp <= 0) throw InputError("--spp", "must be at least 1");
-  if (options.max_bounces < 0) throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
+  if (options.max_bounces < 0)
+    throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
   const Scene scene = load(options.common);
   RenderSettings settings;
   settings.width = options.width;
@@ -270,7 +278,8 @@ int run_reference(const ReferenceOptions& options) {
   }
   if (progress) std::fprintf(stderr, "\n");
   for (auto& px : sum.pixels) px /= static_cast<float>(passes);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   write_exr(options.output, sum,
             {{"scene", options.common.scene},
              {"spp", std::to_string(options.spp)},
@@ -291,23 +300,30 @@ int run_info(const CommonOptions& options) {
     if (scene.materials[m.material].is_emissive()) emissive_triangles += m.triangles.size();
   const glm::vec3 lo = scene.bounds_min(), hi = scene.bounds_max();
   std::printf("scene: %s\n", scene.source_path.c_str());
-  std::printf("triangles: %zu\nmeshes: %zu\nmaterials: %zu\ntextures: %zu\n", scene.triangle_count(),
-              scene.meshes.size(), scene.materials.size(), scene.textures.size());
+  std::printf("triangles: %zu\nmeshes: %zu\nmaterials: %zu\ntextures: %zu\n",
+              scene.triangle_count(), scene.meshes.size(), scene.materials.size(),
+              scene.textures.size());
   std::printf("lights: %zu emissive triangles, sun: %s, environment: %s\n", emissive_triangles,
               scene.sun.enabled ? "yes" : "no",
               scene.environment.kind == Environment::Kind::None       ? "none"
               : scene.environment.kind == Environment::Kind::Constant ? "constant"
-                                                                       : "map");
+                                                                      : "map");
   std::printf("bounds: [%g %g %g] - [%g %g %g]\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
   std::printf("camera paths: %zu", scene.camera.paths.size());
   for (const auto& [name, path] : scene.camera.paths) std::printf(" %s", name.c_str());
   std::printf("\nfeatures:");
-  const std::pair<const char*, bool> list[] = {
-      {"textures", f.textures},       {"normal_maps", f.normal_maps}, {"bump_maps", f.bump_maps},
-      {"alpha_masks", f.alpha_masks}, {"area_lights", f.area_lights}, {"sun", f.sun},
-      {"environment", f.environment}, {"environment_map", f.environment_map},
-      {"glossy", f.glossy},           {"metallic", f.metallic},       {"transmission", f.transmission},
-      {"camera_paths", f.camera_paths}};
+  const std::pair<const char*, bool> list[] = {{"textures", f.textures},
+                                               {"normal_maps", f.normal_maps},
+                                               {"bump_maps", f.bump_maps},
+                                               {"alpha_masks", f.alpha_masks},
+                                               {"area_lights", f.area_lights},
+                                               {"sun", f.sun},
+                                               {"environment", f.environment},
+                                               {"environment_map", f.environment_map},
+                                               {"glossy", f.glossy},
+                                               {"metallic", f.metallic},
+                                               {"transmission", f.transmission},
+                                               {"camera_paths", f.camera_paths}};
   for (const auto& [name, on] : list)
     if (on) std::printf(" %s", name);
   std::printf("\n");

@@ -20,11 +20,11 @@ struct RenderOptions {
   CommonOptions common;
   RenderSettings settings;
   int frames = 1;
-  bool accumulate = false;  // output = running mean of all frames instead of the last one
-  int max_bounces = 0;     // 0 = the scene's integrator.max_bounces, else the default
-  std::string output;      // .exr or .png; "" = none
-  std::string reference;   // EXR to compute relMSE against
-  std::string stats_json;  // "" = none
+  bool accumulate = false;      // output = running mean of all frames instead of the last one
+  int max_bounces = 0;          // 0 = the scene's integrator.max_bounces, else the default
+  std::string output;           // .exr or .png; "" = none
+  std::string reference;        // EXR to compute relMSE against
+  std::string stats_json;       // "" = none
   std::string guiding = "pmm";  // "off" or "pmm"
   GuidingConfig guiding_config;
   std::string train_memory = "auto";
@@ -34,7 +34,7 @@ struct ReferenceOptions {
   CommonOptions common;
   int width = 640, height = 360, spp = 1024;
   std::uint32_t seed = 0;
-  int max_bounces = 0;  // 0 = the scene's, else the default
+  int max_bounces = 0;      // 0 = the scene's, else the default
   std::string camera_path;  // "" = static camera
   int frame = 0;            // the camera path's frame to render
   std::string output;

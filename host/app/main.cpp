@@ -13,12 +13,14 @@
 namespace {
 
 void add_common(CLI::App* cmd, rtpg::CommonOptions& common, bool scene_required) {
-  auto* scene = cmd->add_option("scene", common.scene, "Scene JSON file (default: scenes/cornell-box.json)");
+  auto* scene =
+      cmd->add_option("scene", common.scene, "Scene JSON file (default: scenes/cornell-box.json)");
   if (scene_required) scene->required();
   cmd->add_option("--asset-root", common.asset_root,
                   "Folder for scene assets (default: $RTPG_ASSET_ROOT, else ../shared/scenes)");
   cmd->add_option("--device", common.device,
-                  "OpenCL device: gpu, cpu, P:D or part of its name (default: $RTPG_DEVICE, else a GPU, else the CPU)");
+                  "OpenCL device: gpu, cpu, P:D or part of its name (default: $RTPG_DEVICE, else a "
+                  "GPU, else the CPU)");
   cmd->add_flag("-q,--quiet", common.quiet, "Print nothing but errors");
 }
 
@@ -27,26 +29,50 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderOptions& r) {
   cmd->add_option("--guiding", r.guiding, "First-bounce sampling: pmm (guided) or off (BSDF)")
       ->check(CLI::IsMember({"off", "pmm"}))
       ->capture_default_str();
-  auto* grp = cmd->add_option_group("Guiding", "Parameters of the PMM guider (include/rtpg/guider.h)");
-  grp->add_option("--pg-kmax", g.k_max, "Epochs after which the EM step size stops shrinking")->capture_default_str();
-  grp->add_option("--pg-n-min", g.n_min, "Neighbour VPLs per pixel at k = kMax")->capture_default_str();
-  grp->add_option("--pg-n-max", g.n_max, "Neighbour VPLs per pixel at k = 0 (n-min = n-max: fixed N)")->capture_default_str();
+  auto* grp =
+      cmd->add_option_group("Guiding", "Parameters of the PMM guider (include/rtpg/guider.h)");
+  grp->add_option("--pg-kmax", g.k_max, "Epochs after which the EM step size stops shrinking")
+      ->capture_default_str();
+  grp->add_option("--pg-n-min", g.n_min, "Neighbour VPLs per pixel at k = kMax")
+      ->capture_default_str();
+  grp->add_option("--pg-n-max", g.n_max,
+                  "Neighbour VPLs per pixel at k = 0 (n-min = n-max: fixed N)")
+      ->capture_default_str();
   grp->add_option("--pg-apron", g.apron, "Neighbourhood radius in pixels")->capture_default_str();
-  grp->add_option("--pg-local", g.local_x, "Work-group (tile) width and height")->capture_default_str()
+  grp->add_option("--pg-local", g.local_x, "Work-group (tile) width and height")
+      ->capture_default_str()
       ->each([&g](const std::string&) { g.local_y = g.local_x; });
-  grp->add_option("--pg-pi-min", g.pi_min, "Lower clamp of the mixing weight")->capture_default_str();
-  grp->add_option("--pg-pi-max", g.pi_max, "Upper clamp of the mixing weight")->capture_default_str();
+  grp->add_option("--pg-pi-min", g.pi_min, "Lower clamp of the mixing weight")
+      ->capture_default_str();
+  grp->add_option("--pg-pi-max", g.pi_max, "Upper clamp of the mixing weight")
+      ->capture_default_str();
   grp->add_option("--pg-pi-init", g.pi_init, "Mixing weight of a new model")->capture_default_str();
-  grp->add_option("--pg-alpha", g.step_alpha, "Step size exponent: eta_k = max((k+1)^-alpha, 1/(kMax+1))")->capture_default_str();
-  grp->add_option("--pg-sigma-eps", g.sigma_eps, "Regularisation of the covariance diagonal")->capture_default_str();
-  grp->add_option("--pg-sigma-prior", g.sigma_prior, "Prior variance, added as sigma-prior / (k + 1)")->capture_default_str();
-  grp->add_option("--pg-reseed-ratio", g.reseed_ratio, "Re-seed a lobe on a sample this many times brighter than its history")->capture_default_str();
-  grp->add_option("--pg-em-passes", g.em_passes, "E-step passes over each frame's training samples")->capture_default_str();
-  grp->add_option("--pg-weight-clamp", g.weight_clamp, "Clamp training weights to this multiple of the running mean (0 = off)")->capture_default_str();
-  grp->add_option("--pg-reproject-position", g.reproject_position, "Relative position change that rejects history")->capture_default_str();
-  grp->add_option("--pg-reproject-normal", g.reproject_normal, "Normal cosine below which history is rejected")->capture_default_str();
-  grp->add_option("--pg-roughness-skip", g.roughness_skip, "No guiding at or below this roughness")->capture_default_str();
-  grp->add_option("--pg-train-memory", r.train_memory, "VPL reads of the train kernel: auto, local or global")
+  grp->add_option("--pg-alpha", g.step_alpha,
+                  "Step size exponent: eta_k = max((k+1)^-alpha, 1/(kMax+1))")
+      ->capture_default_str();
+  grp->add_option("--pg-sigma-eps", g.sigma_eps, "Regularisation of the covariance diagonal")
+      ->capture_default_str();
+  grp->add_option("--pg-sigma-prior", g.sigma_prior,
+                  "Prior variance, added as sigma-prior / (k + 1)")
+      ->capture_default_str();
+  grp->add_option("--pg-reseed-ratio", g.reseed_ratio,
+                  "Re-seed a lobe on a sample this many times brighter than its history")
+      ->capture_default_str();
+  grp->add_option("--pg-em-passes", g.em_passes, "E-step passes over each frame's training samples")
+      ->capture_default_str();
+  grp->add_option("--pg-weight-clamp", g.weight_clamp,
+                  "Clamp training weights to this multiple of the running mean (0 = off)")
+      ->capture_default_str();
+  grp->add_option("--pg-reproject-position", g.reproject_position,
+                  "Relative position change that rejects history")
+      ->capture_default_str();
+  grp->add_option("--pg-reproject-normal", g.reproject_normal,
+                  "Normal cosine below which history is rejected")
+      ->capture_default_str();
+  grp->add_option("--pg-roughness-skip", g.roughness_skip, "No guiding at or below this roughness")
+      ->capture_default_str();
+  grp->add_option("--pg-train-memory", r.train_memory,
+                  "VPL reads of the train kernel: auto, local or global")
       ->check(CLI::IsMember({"auto", "local", "global"}))
       ->capture_default_str();
 }
@@ -54,7 +80,8 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderOptions& r) {
 bool parse_resolution(const std::string& text, int& w, int& h) {
   unsigned long long pw = 0, ph = 0;
   char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%llu%c%llu%c", &pw, &x, &ph, &extra) != 3 || (x != 'x' && x != 'X'))
+  if (std::sscanf(text.c_str(), "%llu%c%llu%c", &pw, &x, &ph, &extra) != 3 ||
+      (x != 'x' && x != 'X'))
     return false;
   if (pw > 1000000 || ph > 1000000) return false;
   w = static_cast<int>(pw);
@@ -73,23 +100,29 @@ int main(int argc, char** argv) {
   auto* render_cmd = app.add_subcommand("render", "Render frames of a scene");
   add_common(render_cmd, render.common, false);
   render_cmd->add_option("--res", render_res, "Resolution WxH")->capture_default_str();
-  render_cmd->add_option("--spp", render.settings.spp, "Samples per pixel per frame")->capture_default_str();
+  render_cmd->add_option("--spp", render.settings.spp, "Samples per pixel per frame")
+      ->capture_default_str();
   render_cmd->add_option("--frames", render.frames, "Number of frames")->capture_default_str();
   render_cmd->add_option("--seed", render.settings.seed, "Random seed")->capture_default_str();
-  render_cmd->add_flag("--no-jitter", [&](std::int64_t) { render.settings.jitter = false; },
-                       "Sample pixel centres (no sub-pixel jitter)");
-  render_cmd->add_option("--camera-path", render.settings.camera_path, "Named camera path of the scene");
-  render_cmd->add_option("--max-bounces", render.max_bounces,
-                         "Path vertices after the primary hit (default: the scene's integrator.max_bounces, else 8)");
-  render_cmd->add_flag("--no-nee", [&](std::int64_t) { render.settings.path_tracer.next_event = false; },
-                       "BSDF sampling only (no next-event estimation)");
-  render_cmd->add_option("-o,--output", render.output, "Last frame: .exr (linear) or .png (tonemapped)");
+  render_cmd->add_flag(
+      "--no-jitter", [&](std::int64_t) { render.settings.jitter = false; },
+      "Sample pixel centres (no sub-pixel jitter)");
+  render_cmd->add_option("--camera-path", render.settings.camera_path,
+                         "Named camera path of the scene");
+  render_cmd->add_option(
+      "--max-bounces", render.max_bounces,
+      "Path vertices after the primary hit (default: the scene's integrator.max_bounces, else 8)");
+  render_cmd->add_flag(
+      "--no-nee", [&](std::int64_t) { render.settings.path_tracer.next_event = false; },
+      "BSDF sampling only (no next-event estimation)");
+  render_cmd->add_option("-o,--output", render.output,
+                         "Last frame: .exr (linear) or .png (tonemapped)");
   render_cmd->add_option("--reference", render.reference, "Reference EXR: relMSE per frame");
-  render_cmd->add_flag("--accumulate", render.accumulate,
-                       "Output the running mean of all frames (static camera); adds relmse_accumulated");
+  render_cmd->add_flag(
+      "--accumulate", render.accumulate,
+      "Output the running mean of all frames (static camera); adds relmse_accumulated");
   render_cmd->add_option("--stats-json", render.stats_json, "Write per-frame statistics as JSON");
   add_guiding_options(render_cmd, render);
-
 
   rtpg::ReferenceOptions reference;
   std::string reference_res = "640x360";
@@ -99,8 +132,10 @@ int main(int argc, char** argv) {
   reference_cmd->add_option("--spp", reference.spp, "Samples per pixel")->capture_default_str();
   reference_cmd->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
   reference_cmd->add_option("-o,--output", reference.output, "Output EXR")->required();
-  reference_cmd->add_option("--camera-path", reference.camera_path, "Named camera path of the scene");
-  reference_cmd->add_option("--frame", reference.frame, "Frame of the camera path (its time is frame / fps)")
+  reference_cmd->add_option("--camera-path", reference.camera_path,
+                            "Named camera path of the scene");
+  reference_cmd
+      ->add_option("--frame", reference.frame, "Frame of the camera path (its time is frame / fps)")
       ->capture_default_str();
   reference_cmd->add_option("--max-bounces", reference.max_bounces,
                             "Path vertices after the primary hit (default: the scene's, else 8)");

@@ -10,7 +10,8 @@ namespace rtpg {
 namespace {
 
 using shared::pg_guiding_params;
-static_assert(sizeof(pg_guiding_params) == 19 * 4, "pg_guiding_params: 19 plain 4-byte fields, no padding");
+static_assert(sizeof(pg_guiding_params) == 19 * 4,
+              "pg_guiding_params: 19 plain 4-byte fields, no padding");
 static_assert(sizeof(shared::pg_pmm_state) == 32, "8 floats of state per pixel");
 
 // A step through the neighbourhood window that visits every cell once: coprime with its size.
@@ -24,14 +25,16 @@ int window_stride(int apron) {
 void validate(const GuidingConfig& c, int width, int height) {
   auto fail = [](const std::string& what) { throw GuiderError("guiding configuration: " + what); };
   if (width <= 0 || height <= 0) fail("resolution must be positive");
-  if (!(c.pi_min >= 0.0f && c.pi_min <= c.pi_max && c.pi_max < 1.0f)) fail("need 0 <= pi_min <= pi_max < 1");
+  if (!(c.pi_min >= 0.0f && c.pi_min <= c.pi_max && c.pi_max < 1.0f))
+    fail("need 0 <= pi_min <= pi_max < 1");
   if (!(c.pi_init > 0.0f && c.pi_init < 1.0f)) fail("pi_init must be in (0, 1)");
   if (c.k_max < 1) fail("k_max must be at least 1");
   if (!(c.step_alpha > 0.0f && c.step_alpha <= 1.0f)) fail("step_alpha must be in (0, 1]");
   if (!(c.sigma_eps > 0.0f)) fail("sigma_eps must be positive");
   if (!(c.sigma_prior >= 0.0f)) fail("sigma_prior must be non-negative");
   if (!(c.reseed_ratio > 0.0f)) fail("reseed_ratio must be positive");
-  if (!(c.max_correlation > 0.0f && c.max_correlation < 1.0f)) fail("max_correlation must be in (0, 1)");
+  if (!(c.max_correlation > 0.0f && c.max_correlation < 1.0f))
+    fail("max_correlation must be in (0, 1)");
   if (c.n_min < 1 || c.n_max < c.n_min) fail("need 1 <= n_min <= n_max");
   if (c.n_max > 32) fail("n_max must be at most 32 (PG_MAX_TRAIN_SAMPLES)");
   if (c.em_passes < 1 || c.em_passes > 8) fail("em_passes must be in [1, 8]");
@@ -71,11 +74,18 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingConfig& c
   validate(config, width, height);
   const DeviceInfo& info = runtime.info();
   switch (config.train_memory) {
-    case GuidingConfig::TrainMemory::Local: local_tile_ = true; break;
-    case GuidingConfig::TrainMemory::Global: local_tile_ = false; break;
-    case GuidingConfig::TrainMemory::Auto: local_tile_ = info.type != "cpu"; break;
+    case GuidingConfig::TrainMemory::Local:
+      local_tile_ = true;
+      break;
+    case GuidingConfig::TrainMemory::Global:
+      local_tile_ = false;
+      break;
+    case GuidingConfig::TrainMemory::Auto:
+      local_tile_ = info.type != "cpu";
+      break;
   }
-  const std::string train_options = std::string("-DPG_TRAIN_LOCAL_TILE=") + (local_tile_ ? "1" : "0");
+  const std::string train_options =
+      std::string("-DPG_TRAIN_LOCAL_TILE=") + (local_tile_ ? "1" : "0");
   reproject_ = runtime.kernel("reproject.cl", "reproject");
   sample_ = runtime.kernel("sample.cl", "sample");
   train_ = runtime.kernel("train.cl", "train", train_options);
@@ -86,9 +96,10 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingConfig& c
     const std::size_t limit = k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device());
     if (group > limit || static_cast<std::size_t>(config.local_x) > max_items.at(0) ||
         static_cast<std::size_t>(config.local_y) > max_items.at(1))
-      throw GuiderError("local size " + std::to_string(config.local_x) + "x" + std::to_string(config.local_y) +
-                        " is refused by " + info.device_name + " (at most " + std::to_string(limit) +
-                        " work-items for kernel " + k->getInfo<CL_KERNEL_FUNCTION_NAME>() + ")");
+      throw GuiderError("local size " + std::to_string(config.local_x) + "x" +
+                        std::to_string(config.local_y) + " is refused by " + info.device_name +
+                        " (at most " + std::to_string(limit) + " work-items for kernel " +
+                        k->getInfo<CL_KERNEL_FUNCTION_NAME>() + ")");
   }
   if (local_tile_) {
     const std::size_t tile = static_cast<std::size_t>(config.local_x + 2 * config.apron) *
@@ -97,8 +108,9 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingConfig& c
     if (tile + used > info.local_mem_size)
       throw GuiderError("the VPL tile (" + std::to_string(tile) + " bytes for " +
                         std::to_string(config.local_x) + "x" + std::to_string(config.local_y) +
-                        " pixels, apron " + std::to_string(config.apron) + ") does not fit in the " +
-                        std::to_string(info.local_mem_size) + " bytes of local memory of " + info.device_name);
+                        " pixels, apron " + std::to_string(config.apron) +
+                        ") does not fit in the " + std::to_string(info.local_mem_size) +
+                        " bytes of local memory of " + info.device_name);
   }
   const std::size_t n = static_cast<std::size_t>(width) * height;
   for (int b = 0; b < 2; ++b) {
@@ -126,13 +138,15 @@ void Guider::reset() {
   runtime_.queue().finish();  // the host vectors must outlive the writes
 }
 
-void Guider::check_buffer(const cl::Buffer& b, std::size_t element_size, const std::string& name) const {
+void Guider::check_buffer(const cl::Buffer& b, std::size_t element_size,
+                          const std::string& name) const {
   const std::size_t need = element_size * static_cast<std::size_t>(width_) * height_;
   if (b() == nullptr) throw GuiderError(name + ": buffer is not set");
   const std::size_t have = b.getInfo<CL_MEM_SIZE>();
   if (have < need)
-    throw GuiderError(name + ": buffer holds " + std::to_string(have) + " bytes, " + std::to_string(width_) +
-                      "x" + std::to_string(height_) + " pixels need " + std::to_string(need));
+    throw GuiderError(name + ": buffer holds " + std::to_string(have) + " bytes, " +
+                      std::to_string(width_) + "x" + std::to_string(height_) + " pixels need " +
+                      std::to_string(need));
 }
 
 void Guider::check_gbuffer(const GuiderGBuffer& g, const char* which) const {
@@ -177,7 +191,8 @@ void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previo
   k.setArg(a++, params);
   cl::Event done;
   runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, global_range(),
-                                        cl::NDRange(config_.local_x, config_.local_y), nullptr, &done);
+                                        cl::NDRange(config_.local_x, config_.local_y), nullptr,
+                                        &done);
   done.wait();
   times_.reproject_ms = ClRuntime::event_ms(done);
   current_ = to;
@@ -208,7 +223,8 @@ void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint3
   k.setArg(a++, params);
   cl::Event done;
   runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, global_range(),
-                                        cl::NDRange(config_.local_x, config_.local_y), nullptr, &done);
+                                        cl::NDRange(config_.local_x, config_.local_y), nullptr,
+                                        &done);
   done.wait();
   times_.sample_ms = ClRuntime::event_ms(done);
 }
@@ -221,9 +237,10 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
   check_buffer(vpls.radiance_info, 16, "vpls.radiance_info");
   const pg_guiding_params params = make_guiding_params(config_);
   const int from = current_, to = 1 - current_;
-  const std::size_t tile = local_tile_ ? static_cast<std::size_t>(config_.local_x + 2 * config_.apron) *
-                                             (config_.local_y + 2 * config_.apron) * 16
-                                       : 16;
+  const std::size_t tile = local_tile_
+                               ? static_cast<std::size_t>(config_.local_x + 2 * config_.apron) *
+                                     (config_.local_y + 2 * config_.apron) * 16
+                               : 16;
   int a = 0;
   cl::Kernel& k = train_;
   k.setArg(a++, state0_[from]);
@@ -250,7 +267,8 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
   k.setArg(a++, cl::Local(tile));
   cl::Event done;
   runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, global_range(),
-                                        cl::NDRange(config_.local_x, config_.local_y), nullptr, &done);
+                                        cl::NDRange(config_.local_x, config_.local_y), nullptr,
+                                        &done);
   done.wait();
   times_.train_ms = ClRuntime::event_ms(done);
   current_ = to;

@@ -17,7 +17,8 @@ Distribution1D::Distribution1D(std::vector<float> weights) : weights_(std::move(
 std::size_t Distribution1D::sample_discrete(float u, float* probability, float* remapped) const {
   const double target = static_cast<double>(u) * cdf_.back();
   auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), target);
-  std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - cdf_.begin()) - 1, weights_.size() - 1);
+  std::size_t i =
+      std::min<std::size_t>(static_cast<std::size_t>(it - cdf_.begin()) - 1, weights_.size() - 1);
   while (i > 0 && weights_[i] == 0.0f) --i;  // u at the very top of a run of empty cells
   if (probability) *probability = this->probability(i);
   if (remapped) {
@@ -42,7 +43,8 @@ float Distribution1D::sample_continuous(float u, float* pdf, std::size_t* cell) 
 float Distribution1D::pdf_continuous(float x) const {
   if (total_ <= 0.0f) return 0.0f;
   const float n = static_cast<float>(weights_.size());
-  const std::size_t i = std::min(static_cast<std::size_t>(std::max(x, 0.0f) * n), weights_.size() - 1);
+  const std::size_t i =
+      std::min(static_cast<std::size_t>(std::max(x, 0.0f) * n), weights_.size() - 1);
   return weights_[i] * n / total_;
 }
 
@@ -50,8 +52,9 @@ Distribution2D::Distribution2D(const std::vector<float>& weights, int width, int
   std::vector<float> row_totals(height);
   rows_.reserve(height);
   for (int y = 0; y < height; ++y) {
-    rows_.emplace_back(std::vector<float>(weights.begin() + static_cast<std::ptrdiff_t>(y) * width,
-                                          weights.begin() + static_cast<std::ptrdiff_t>(y + 1) * width));
+    rows_.emplace_back(
+        std::vector<float>(weights.begin() + static_cast<std::ptrdiff_t>(y) * width,
+                           weights.begin() + static_cast<std::ptrdiff_t>(y + 1) * width));
     row_totals[y] = rows_.back().total();
   }
   marginal_ = Distribution1D(std::move(row_totals));
@@ -67,7 +70,8 @@ void Distribution2D::sample(float u0, float u1, float& u, float& v, float& pdf) 
 
 float Distribution2D::pdf(float u, float v) const {
   const std::size_t h = rows_.size();
-  const std::size_t row = std::min(static_cast<std::size_t>(std::max(v, 0.0f) * static_cast<float>(h)), h - 1);
+  const std::size_t row =
+      std::min(static_cast<std::size_t>(std::max(v, 0.0f) * static_cast<float>(h)), h - 1);
   return marginal_.pdf_continuous(v) * rows_[row].pdf_continuous(u);
 }
 

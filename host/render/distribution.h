@@ -16,7 +16,8 @@ class Distribution1D {
   // Discrete: index with probability weight / total (u in [0,1)).
   // remapped (optional) receives u's relative position inside the chosen cell, a fresh
   // uniform number for the next decision.
-  std::size_t sample_discrete(float u, float* probability = nullptr, float* remapped = nullptr) const;
+  std::size_t sample_discrete(float u, float* probability = nullptr,
+                              float* remapped = nullptr) const;
   float probability(std::size_t i) const { return total_ > 0.0f ? weights_[i] / total_ : 0.0f; }
   // Continuous on [0,1): returns x, writes the density over [0,1) and the cell index.
   float sample_continuous(float u, float* pdf, std::size_t* cell) const;

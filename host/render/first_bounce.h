@@ -15,7 +15,11 @@
 namespace rtpg {
 
 // Which strategy produced a first-bounce direction (the paper trains only on kBsdf samples).
-enum FirstBounceStrategy : std::uint32_t { kStrategyNone = 0, kStrategyBsdf = 1, kStrategyGuide = 2 };
+enum FirstBounceStrategy : std::uint32_t {
+  kStrategyNone = 0,
+  kStrategyBsdf = 1,
+  kStrategyGuide = 2
+};
 
 struct FirstBounceSample {
   glm::vec3 direction{0.0f};  // world space, unit
@@ -36,10 +40,12 @@ class FirstBounceSampler {
   // reprojects its state here).
   virtual void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) {}
   // After the frame's first path-tracing pass, with its VPLs (guiding trains here).
-  virtual void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls, const SampleCoordinates& at) {}
+  virtual void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls,
+                         const SampleCoordinates& at) {}
   virtual bool wants_vpls() const { return false; }
   // Figures of the last frame: times (ms) by kernel name, and other figures by name.
-  virtual void report(std::map<std::string, double>& time_ms, std::map<std::string, double>& extra) {}
+  virtual void report(std::map<std::string, double>& time_ms,
+                      std::map<std::string, double>& extra) {}
   // One direction for every surface pixel of the G-buffer (others get pdf 0).
   virtual void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
                       std::vector<FirstBounceSample>& out) = 0;

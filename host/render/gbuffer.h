@@ -14,16 +14,16 @@ namespace rtpg {
 
 struct GBuffer {
   int width = 0, height = 0;
-  std::vector<glm::vec4> position_depth;  // xyz world position, w linear depth (0 on sky)
-  std::vector<glm::vec4> shading_normal;  // xyz, facing the camera; w unused
-  std::vector<glm::vec4> geometric_normal;// xyz, facing the camera; w unused
-  std::vector<glm::vec4> view_dir;        // xyz unit vector from the surface to the camera
-  std::vector<glm::vec2> motion;          // pixel offset to where the point was last frame
+  std::vector<glm::vec4> position_depth;        // xyz world position, w linear depth (0 on sky)
+  std::vector<glm::vec4> shading_normal;        // xyz, facing the camera; w unused
+  std::vector<glm::vec4> geometric_normal;      // xyz, facing the camera; w unused
+  std::vector<glm::vec4> view_dir;              // xyz unit vector from the surface to the camera
+  std::vector<glm::vec2> motion;                // pixel offset to where the point was last frame
   std::vector<glm::vec4> base_color_roughness;  // rgb base colour, a perceptual roughness
   std::vector<glm::vec4> metallic_specular;     // x metallic, y dielectric F0
-  std::vector<glm::vec4> emission;        // rgb emitted towards the camera (or sky radiance)
+  std::vector<glm::vec4> emission;              // rgb emitted towards the camera (or sky radiance)
   std::vector<std::uint32_t> material_id;
-  std::vector<std::uint32_t> flags;       // PG_GBUF_* bits
+  std::vector<std::uint32_t> flags;  // PG_GBUF_* bits
 
   void resize(int w, int h);
   std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }

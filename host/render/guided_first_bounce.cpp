@@ -127,7 +127,8 @@ void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
   direction_pdf_.resize(n);
   strategy_.resize(n);
   const auto t = Clock::now();
-  runtime_.queue().enqueueReadBuffer(samples_.direction_pdf, CL_FALSE, 0, n * 16, direction_pdf_.data());
+  runtime_.queue().enqueueReadBuffer(samples_.direction_pdf, CL_FALSE, 0, n * 16,
+                                     direction_pdf_.data());
   runtime_.queue().enqueueReadBuffer(samples_.strategy, CL_TRUE, 0, n * 4, strategy_.data());
   readback_ms_ += ms_since(t);
   out.resize(n);
@@ -149,12 +150,14 @@ float GuidedFirstBounce::pdf(const GBuffer& g, std::size_t i, const glm::vec3& w
   const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
   const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
   shared::pg_pmm_state st = shared::pg_pmm_initial_state();
-  if (shared::pg_guiding_applies(g.flags[i], g.base_color_roughness[i].w, p)) st = state_at(state_, i);
+  if (shared::pg_guiding_applies(g.flags[i], g.base_color_roughness[i].w, p))
+    st = state_at(state_, i);
   const shared::pg_pmm_model model = shared::pg_pmm_model_from_state(st, p);
   return shared::pg_pmm_pdf(model, lobes, wo, shared::pg_to_local(frame, wi));
 }
 
-void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls, const SampleCoordinates& at) {
+void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
+                                  const SampleCoordinates& at) {
   if (!training_) return;
   const auto t = Clock::now();
   cl::CommandQueue& q = runtime_.queue();
@@ -166,10 +169,13 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls, const
   guider_->train(gbuffers_[current_], vpls_, at.seed, at.frame);
   std::size_t surfaces = 0;
   for (std::size_t i = 0; i < g.pixel_count(); ++i) surfaces += g.has_surface(i);
-  trained_fraction_ = surfaces ? static_cast<double>(guider_->count_trained()) / static_cast<double>(surfaces) : 0.0;
+  trained_fraction_ =
+      surfaces ? static_cast<double>(guider_->count_trained()) / static_cast<double>(surfaces)
+               : 0.0;
 }
 
-void GuidedFirstBounce::report(std::map<std::string, double>& time_ms, std::map<std::string, double>& extra) {
+void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
+                               std::map<std::string, double>& extra) {
   const GuiderTimes& k = guider_->last_times();
   time_ms["reproject"] = have_previous_ ? k.reproject_ms : 0.0;
   time_ms["sample"] = sample_ms_;

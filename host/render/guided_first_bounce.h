@@ -22,9 +22,11 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
               std::vector<FirstBounceSample>& out) override;
   float pdf(const GBuffer& gbuffer, std::size_t i, const glm::vec3& wi) const override;
-  void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls, const SampleCoordinates& at) override;
+  void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls,
+                 const SampleCoordinates& at) override;
   bool wants_vpls() const override { return true; }
-  void report(std::map<std::string, double>& time_ms, std::map<std::string, double>& extra) override;
+  void report(std::map<std::string, double>& time_ms,
+              std::map<std::string, double>& extra) override;
 
   Guider& guider() { return *guider_; }
   // Freezes (false) or resumes (true) training: frozen, end_frame() leaves the state alone.

@@ -18,7 +18,8 @@ namespace {
 // picks the format from it).
 std::string temporary_path_for(const std::string& path) {
   const fs::path p(path);
-  const std::string name = "." + p.stem().string() + ".tmp-" + std::to_string(::getpid()) + p.extension().string();
+  const std::string name =
+      "." + p.stem().string() + ".tmp-" + std::to_string(::getpid()) + p.extension().string();
   return (p.parent_path() / name).string();
 }
 
@@ -57,7 +58,8 @@ void write_exr(const std::string& path, const ImageRgb& image,
                    metadata);
 }
 
-void write_png(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgba8) {
+void write_png(const std::string& path, int width, int height,
+               const std::vector<std::uint8_t>& rgba8) {
   write_atomically(path, width, height, 4, OIIO::TypeDesc::UINT8, rgba8.data(), {});
 }
 

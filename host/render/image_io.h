@@ -20,7 +20,8 @@ struct ImageRgb {
 void write_exr(const std::string& path, const ImageRgb& image,
                const std::map<std::string, std::string>& metadata);
 // 8-bit RGBA (row 0 = top) as PNG.
-void write_png(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgba8);
+void write_png(const std::string& path, int width, int height,
+               const std::vector<std::uint8_t>& rgba8);
 // Reads any image OpenImageIO can (EXR for references); throws InputError(path, problem).
 ImageRgb read_image(const std::string& path);
 

@@ -12,7 +12,9 @@ namespace {
 constexpr float kPi = 3.14159265358979323846f;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
-float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+float luminance(const glm::vec3& c) {
+  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
 
 }  // namespace
 
@@ -69,7 +71,8 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
     std::vector<float> texel_weights(static_cast<std::size_t>(w) * h);
     double sum = 0.0;
     for (int y = 0; y < h; ++y) {
-      const float sin_theta = std::sin(kPi * (static_cast<float>(y) + 0.5f) / static_cast<float>(h));
+      const float sin_theta =
+          std::sin(kPi * (static_cast<float>(y) + 0.5f) / static_cast<float>(h));
       for (int x = 0; x < w; ++x) {
         const float l = luminance(glm::vec3(env_map_->fetch(x, y)) * env.color);
         texel_weights[static_cast<std::size_t>(y) * w + x] = l * sin_theta;
@@ -77,7 +80,8 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
       }
     }
     env_distribution_ = Distribution2D(texel_weights, w, h);
-    const float mean_radiance = static_cast<float>(sum / (static_cast<double>(w) * h)) * (kPi / 2.0f);
+    const float mean_radiance =
+        static_cast<float>(sum / (static_cast<double>(w) * h)) * (kPi / 2.0f);
     kinds[kEnvironment] = kPi * mean_radiance * disc;
   }
   selection_ = Distribution1D(kinds);
@@ -120,7 +124,8 @@ float Lights::environment_pdf(const glm::vec3& d) const {
   return 0.0f;
 }
 
-bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2, LightSample& out) const {
+bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2,
+                    LightSample& out) const {
   if (empty()) return false;
   float p_kind = 0.0f, u_next = 0.0f;
   const std::size_t kind = selection_.sample_discrete(u_select, &p_kind, &u_next);

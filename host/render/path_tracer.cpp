@@ -29,7 +29,9 @@ float power_heuristic(float a, float b) {
   return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
 }
 
-bool is_black(const glm::vec3& c) { return c.x <= 0.0f && c.y <= 0.0f && c.z <= 0.0f; }
+bool is_black(const glm::vec3& c) {
+  return c.x <= 0.0f && c.y <= 0.0f && c.z <= 0.0f;
+}
 bool is_finite(const glm::vec3& c) {
   return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
 }
@@ -88,8 +90,8 @@ void PathTracer::apply_shadow_rays(std::size_t count, const std::vector<std::uin
 
 void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& first,
                        const FirstBounceSampler& sampler, const SampleCoordinates& at,
-                       std::vector<glm::vec3>& radiance, VplBuffer* vpls,
-                       std::uint64_t& nonfinite, RayCounts& rays, PassTimes& times) {
+                       std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite,
+                       RayCounts& rays, PassTimes& times) {
   const std::size_t n = g.pixel_count();
   paths_.resize(n);
   radiance.assign(n, glm::vec3(0.0f));
@@ -130,7 +132,8 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
         const glm::vec3 wi = shared::pg_to_local(frame, ls.direction);
         const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
         if (!is_black(f)) {
-          const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, sampler.pdf(g, i, ls.direction));
+          const float w =
+              ls.delta ? 1.0f : power_heuristic(ls.pdf, sampler.pdf(g, i, ls.direction));
           shadow_work_[i].contribution = f * ls.radiance * (w / ls.pdf);
           shadow_work_[i].vpl_contribution = glm::vec3(0.0f);
           shadow_rays_[i] = shadow_ray(origin, ls);
@@ -211,11 +214,11 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
         }
         const SurfacePoint sp = make_surface_point(scene_, ray, hit);
         if (!is_black(sp.emission)) {
-          const float w = nee ? power_heuristic(p.prev_pdf,
-                                                lights_.pdf_triangle(hit.mesh, hit.triangle,
-                                                                     p.prev_position, sp.position,
-                                                                     sp.geometric_normal))
-                              : 1.0f;
+          const float w =
+              nee ? power_heuristic(p.prev_pdf,
+                                    lights_.pdf_triangle(hit.mesh, hit.triangle, p.prev_position,
+                                                         sp.position, sp.geometric_normal))
+                  : 1.0f;
           p.radiance += p.throughput * sp.emission * w;
           if (depth > 1) {
             p.vpl_radiance += p.vpl_throughput * sp.emission * w;
@@ -250,7 +253,8 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
           const glm::vec3 wi = shared::pg_to_local(frame, ls.direction);
           const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
           if (!is_black(f)) {
-            const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, shared::pg_bsdf_pdf(lobes, wo, wi));
+            const float w =
+                ls.delta ? 1.0f : power_heuristic(ls.pdf, shared::pg_bsdf_pdf(lobes, wo, wi));
             const glm::vec3 c = f * ls.radiance * (w / ls.pdf);
             shadow_work_[j].contribution = p.throughput * c;
             shadow_work_[j].vpl_contribution = vpl_throughput * c;
@@ -269,7 +273,8 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
         p.throughput *= weight;
         p.vpl_throughput = vpl_throughput * weight;
         if (depth >= settings_.roulette_start) {
-          const float q = std::min(0.95f, std::max(p.throughput.x, std::max(p.throughput.y, p.throughput.z)));
+          const float q =
+              std::min(0.95f, std::max(p.throughput.x, std::max(p.throughput.y, p.throughput.z)));
           if (!(u_rr < q)) continue;
           p.throughput /= q;
           p.vpl_throughput /= q;
@@ -309,8 +314,8 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
       if (!is_finite(vpl_l) || !(vpls->position[i].w > 0.0f) || !std::isfinite(vpls->position[i].w))
         vpls->info[i] &= ~PG_VPL_VALID;
       // The kernels read the info bits from radiance.w (exact: small integers).
-      vpls->radiance[i] = glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f),
-                                    static_cast<float>(vpls->info[i]));
+      vpls->radiance[i] =
+          glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f), static_cast<float>(vpls->info[i]));
     }
   }
 }

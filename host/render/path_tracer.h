@@ -18,9 +18,9 @@
 namespace rtpg {
 
 struct PathTracerSettings {
-  int max_bounces = 8;          // path vertices after the primary hit
-  int roulette_start = 3;       // first bounce at which Russian roulette may end a path
-  bool next_event = true;       // false: BSDF sampling only (emitters found by chance)
+  int max_bounces = 8;     // path vertices after the primary hit
+  int roulette_start = 3;  // first bounce at which Russian roulette may end a path
+  bool next_event = true;  // false: BSDF sampling only (emitters found by chance)
 };
 
 // The VPL buffer the guiding trainer reads (layout: kernels/shared/vpl.h); radiance.w
@@ -56,13 +56,13 @@ class PathTracer {
 
  private:
   struct PathState {
-    glm::vec3 throughput;       // from the camera
-    glm::vec3 vpl_throughput;   // from the first-bounce hit y (for the VPL's radiance)
-    glm::vec3 radiance;         // accumulated pixel estimate
-    glm::vec3 vpl_radiance;     // accumulated radiance leaving y towards x0
-    float prev_pdf;             // density of the direction that led here (for MIS)
-    glm::vec3 prev_position;    // origin of the current ray
-    std::uint32_t rng;          // pg_rng state
+    glm::vec3 throughput;      // from the camera
+    glm::vec3 vpl_throughput;  // from the first-bounce hit y (for the VPL's radiance)
+    glm::vec3 radiance;        // accumulated pixel estimate
+    glm::vec3 vpl_radiance;    // accumulated radiance leaving y towards x0
+    float prev_pdf;            // density of the direction that led here (for MIS)
+    glm::vec3 prev_position;   // origin of the current ray
+    std::uint32_t rng;         // pg_rng state
   };
   struct ShadowWork {
     glm::vec3 contribution;      // to the pixel, if unoccluded

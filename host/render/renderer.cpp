@@ -28,11 +28,13 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
                                   "x" + std::to_string(settings.height));
   const std::uint64_t pixels = static_cast<std::uint64_t>(settings.width) * settings.height;
   if (pixels > kMaxPixels)
-    throw InputError("--res", std::to_string(settings.width) + "x" + std::to_string(settings.height) +
-                                  " is too large (at most " + std::to_string(kMaxPixels) + " pixels)");
+    throw InputError("--res", std::to_string(settings.width) + "x" +
+                                  std::to_string(settings.height) + " is too large (at most " +
+                                  std::to_string(kMaxPixels) + " pixels)");
   if (settings.spp <= 0) throw InputError("--spp", "must be at least 1");
   if (!settings.camera_path.empty() && !scene.camera.paths.count(settings.camera_path))
-    throw InputError("--camera-path", "scene has no camera path named '" + settings.camera_path + "'");
+    throw InputError("--camera-path",
+                     "scene has no camera path named '" + settings.camera_path + "'");
   try {
     gbuffer_.resize(settings.width, settings.height);
     image_.assign(pixels, glm::vec3(0.0f));
@@ -110,14 +112,14 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
       g.shading_normal[i] = glm::vec4(sp.shading_normal, 0.0f);
       g.geometric_normal[i] = glm::vec4(sp.geometric_normal, 0.0f);
       g.view_dir[i] = glm::vec4(-dir, 0.0f);
-      g.base_color_roughness[i] =
-          glm::vec4(sp.material.base_color.x, sp.material.base_color.y, sp.material.base_color.z,
-                    sp.material.roughness);
+      g.base_color_roughness[i] = glm::vec4(sp.material.base_color.x, sp.material.base_color.y,
+                                            sp.material.base_color.z, sp.material.roughness);
       g.metallic_specular[i] = glm::vec4(sp.material.metallic, sp.material.specular, 0.0f, 0.0f);
       g.emission[i] = glm::vec4(sp.emission, 0.0f);
       g.material_id[i] = sp.material_id;
       std::uint32_t flags = 0;
-      if (sp.emission.x > 0.0f || sp.emission.y > 0.0f || sp.emission.z > 0.0f) flags |= PG_GBUF_EMITTER;
+      if (sp.emission.x > 0.0f || sp.emission.y > 0.0f || sp.emission.z > 0.0f)
+        flags |= PG_GBUF_EMITTER;
       if (sp.material.roughness <= PG_MIN_ROUGHNESS) flags |= PG_GBUF_DELTA;
       if (sp.transmissive) flags |= PG_GBUF_TRANSMISSIVE;
       g.flags[i] = flags;
@@ -148,7 +150,8 @@ FrameStats Renderer::render_frame(int index) {
   sampler_->begin_frame(gbuffer_, frame_at);
   stats.time_ms["guiding_begin"] = ms_since(t);
   for (int s = 0; s < settings_.spp; ++s) {
-    SampleCoordinates at{settings_.seed, static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(s)};
+    SampleCoordinates at{settings_.seed, static_cast<std::uint32_t>(index),
+                         static_cast<std::uint32_t>(s)};
     t = Clock::now();
     sampler_->sample(gbuffer_, at, first_);
     stats.time_ms["first_bounce"] += ms_since(t);

@@ -22,17 +22,18 @@ namespace rtpg {
 
 struct RenderSettings {
   int width = 640, height = 360;
-  int spp = 1;                // paths per pixel per frame (sharing one G-buffer)
+  int spp = 1;  // paths per pixel per frame (sharing one G-buffer)
   std::uint32_t seed = 0;
-  bool jitter = true;         // sub-pixel jitter of the camera ray, new every frame
-  std::string camera_path;    // "" = static camera
-  int camera_frame = -1;      // >= 0: the camera stays at this frame of the path (references)
+  bool jitter = true;       // sub-pixel jitter of the camera ray, new every frame
+  std::string camera_path;  // "" = static camera
+  int camera_frame = -1;    // >= 0: the camera stays at this frame of the path (references)
   PathTracerSettings path_tracer;
 };
 
 struct FrameStats {
   int index = 0;
-  std::map<std::string, double> time_ms;  // "total", "primary", "gbuffer", "sample", "trace", "shade", kernels
+  std::map<std::string, double>
+      time_ms;  // "total", "primary", "gbuffer", "sample", "trace", "shade", kernels
   std::uint64_t nonfinite_samples = 0;
   std::uint64_t primary_rays = 0, secondary_rays = 0, shadow_rays = 0;
   std::map<std::string, double> extra;  // sampler-specific figures (e.g. guided fraction)

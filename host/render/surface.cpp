@@ -16,8 +16,8 @@ glm::vec3 interpolate(const std::vector<glm::vec3>& a, const glm::uvec3& t, floa
 void tangent_basis(const Mesh& mesh, const glm::uvec3& tri, float u, float v, const glm::vec3& n,
                    glm::vec3& tangent, glm::vec3& bitangent) {
   if (!mesh.tangents.empty()) {
-    const glm::vec4 t4 = (1.0f - u - v) * mesh.tangents[tri.x] + u * mesh.tangents[tri.y] +
-                         v * mesh.tangents[tri.z];
+    const glm::vec4 t4 =
+        (1.0f - u - v) * mesh.tangents[tri.x] + u * mesh.tangents[tri.y] + v * mesh.tangents[tri.z];
     glm::vec3 t(t4);
     t = t - n * glm::dot(n, t);
     if (glm::dot(t, t) > 1e-12f) {
@@ -75,7 +75,8 @@ SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& h
   SurfacePoint sp;
   sp.material_id = mesh.material;
   sp.position = ray.origin + ray.direction * hit.t;
-  const glm::vec3 p0 = mesh.positions[tri.x], p1 = mesh.positions[tri.y], p2 = mesh.positions[tri.z];
+  const glm::vec3 p0 = mesh.positions[tri.x], p1 = mesh.positions[tri.y],
+                  p2 = mesh.positions[tri.z];
   glm::vec3 ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
   const bool front = glm::dot(ng, ray.direction) < 0.0f;
   if (!front) ng = -ng;
@@ -91,11 +92,14 @@ SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& h
 
   glm::vec3 base = mat.base_color;
   float roughness = mat.roughness, metallic = mat.metallic;
-  if (mat.base_color_texture >= 0) base *= glm::vec3(scene.textures[mat.base_color_texture].sample(uv));
+  if (mat.base_color_texture >= 0)
+    base *= glm::vec3(scene.textures[mat.base_color_texture].sample(uv));
   if (mat.roughness_texture >= 0)
-    roughness *= texture_channel(scene.textures[mat.roughness_texture].sample(uv), mat.roughness_channel);
+    roughness *=
+        texture_channel(scene.textures[mat.roughness_texture].sample(uv), mat.roughness_channel);
   if (mat.metallic_texture >= 0)
-    metallic *= texture_channel(scene.textures[mat.metallic_texture].sample(uv), mat.metallic_channel);
+    metallic *=
+        texture_channel(scene.textures[mat.metallic_texture].sample(uv), mat.metallic_channel);
 
   if (mat.normal_texture >= 0 || mat.bump_texture >= 0) {
     glm::vec3 t, b;

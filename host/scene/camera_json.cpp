@@ -22,7 +22,8 @@ void check_view(const JsonNode& node, const CameraView& view) {
 }
 
 CameraPath read_path(const JsonNode& node, const CameraView& base) {
-  node.check_object({"fps", "keys"});
+  node.check_object({"description", "fps", "keys"});
+  if (node.has("description")) node.child("description").string();  // a comment
   CameraPath path;
   path.fps = node.number_or("fps", 30.0f);
   if (!(path.fps > 0.0f)) node.child("fps").fail("fps must be positive");
@@ -50,7 +51,8 @@ CameraPath read_path(const JsonNode& node, const CameraView& base) {
 }  // namespace
 
 CameraView read_camera(const JsonNode& node) {
-  node.check_object({"position", "look_at", "up", "fov"});
+  node.check_object({"description", "position", "look_at", "up", "fov"});
+  if (node.has("description")) node.child("description").string();  // a comment
   CameraView view;
   view.position = node.child("position").vec3();
   view.look_at = node.child("look_at").vec3();

@@ -30,9 +30,10 @@ int read_texture(const JsonNode& node, ImageDecode decode, const TextureResolver
 }  // namespace
 
 void apply_material_fields(const JsonNode& node, Material& m, const TextureResolver& texture) {
-  node.check_object({"base_color", "roughness", "metallic", "specular", "emission",
+  node.check_object({"description", "base_color", "roughness", "metallic", "specular", "emission",
                      "base_color_texture", "roughness_texture", "normal_texture", "bump_texture",
                      "bump_scale", "alpha_texture", "alpha_cutoff", "transmissive"});
+  if (node.has("description")) node.child("description").string();  // a comment
   if (node.has("base_color")) m.base_color = read_colour(node.child("base_color"), true);
   if (node.has("roughness")) m.roughness = read_unit(node.child("roughness"));
   if (node.has("metallic")) m.metallic = read_unit(node.child("metallic"));

@@ -27,14 +27,14 @@ struct Material {
   float metallic = 0.0f;
   int metallic_texture = -1;  // channel metallic_channel multiplies metallic
   int metallic_channel = 2;
-  float specular = 0.04f;       // dielectric F0 at normal incidence; 0 disables the GGX lobe
-  int normal_texture = -1;      // tangent-space normal map (RGB in [0,1])
-  int bump_texture = -1;        // height map (grey); perturbs the shading normal
+  float specular = 0.04f;   // dielectric F0 at normal incidence; 0 disables the GGX lobe
+  int normal_texture = -1;  // tangent-space normal map (RGB in [0,1])
+  int bump_texture = -1;    // height map (grey); perturbs the shading normal
   float bump_scale = 1.0f;
-  int alpha_texture = -1;       // alpha mask, alpha-tested at alpha_cutoff
+  int alpha_texture = -1;  // alpha mask, alpha-tested at alpha_cutoff
   float alpha_cutoff = 0.5f;
-  glm::vec3 emission{0.0f};     // emitted radiance (one-sided, along the geometric normal)
-  bool transmissive = false;    // guiding and NEE skip it; rendered as the BSDF allows
+  glm::vec3 emission{0.0f};   // emitted radiance (one-sided, along the geometric normal)
+  bool transmissive = false;  // guiding and NEE skip it; rendered as the BSDF allows
   bool is_emissive() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
 };
 

@@ -119,7 +119,7 @@ class SceneBuilder {
   void build(const JsonNode& root) {
     root.check_object({"description", "camera", "camera_paths", "meshes", "shapes", "materials",
                        "material_overrides", "sun", "environment", "integrator"});
-    if (root.has("description")) root.child("description").string();
+    read_description(root);
     scene_.camera.view = read_camera(root.child("camera"));
     if (root.has("camera_paths"))
       read_camera_paths(root.child("camera_paths"), scene_.camera.view, scene_.camera);
@@ -158,6 +158,11 @@ class SceneBuilder {
     if (assets_.asset_root().empty())
       hint = " (no asset root: set RTPG_ASSET_ROOT or SceneLoadOptions::asset_root)";
     value.fail("file '" + written + "' not found; looked in: " + where + hint);
+  }
+
+  // A free-text comment on an entry: must be a string, otherwise ignored.
+  static void read_description(const JsonNode& entry) {
+    if (entry.has("description")) entry.child("description").string();
   }
 
   // Render defaults the scene asks for (as pbrt's Integrator directive); flags override them.
@@ -203,7 +208,8 @@ class SceneBuilder {
   }
 
   void read_mesh(const JsonNode& entry) {
-    entry.check_object({"file", "transform", "material"});
+    entry.check_object({"description", "file", "transform", "material"});
+    read_description(entry);
     const JsonNode file = entry.child("file");
     const std::string mesh_path = asset(file);
     const bool replace = entry.has("material");
@@ -224,20 +230,21 @@ class SceneBuilder {
     const std::string type = type_node.string();
     Mesh mesh;
     if (type == "quad") {
-      entry.check_object({"type", "corner", "edge1", "edge2", "material", "transform"});
+      entry.check_object(
+          {"description", "type", "corner", "edge1", "edge2", "material", "transform"});
       const glm::vec3 e1 = entry.child("edge1").vec3(), e2 = entry.child("edge2").vec3();
       const glm::vec3 n = glm::cross(e1, e2);
       if (!(glm::dot(n, n) > 0.0f)) entry.fail("edge1 and edge2 must span a parallelogram");
       mesh = make_quad(entry.child("corner").vec3(), e1, e2);
     } else if (type == "box") {
-      entry.check_object({"type", "min", "max", "material", "transform"});
+      entry.check_object({"description", "type", "min", "max", "material", "transform"});
       const glm::vec3 lo = entry.child("min").vec3(), hi = entry.child("max").vec3();
       if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
         entry.child("max").fail("max must exceed min in every component");
       mesh = make_box(lo, hi);
     } else if (type == "sphere") {
-      entry.check_object(
-          {"type", "center", "radius", "subdivisions", "inward", "material", "transform"});
+      entry.check_object({"description", "type", "center", "radius", "subdivisions", "inward",
+                          "material", "transform"});
       const JsonNode radius = entry.child("radius");
       const float r = radius.number();
       if (!(r > 0.0f)) radius.fail("radius must be positive");
@@ -252,13 +259,15 @@ class SceneBuilder {
     } else {
       type_node.fail("unknown shape type '" + type + "' (expected quad, box or sphere)");
     }
+    read_description(entry);
     mesh.name = type + "#" + std::to_string(shape_count_++);
     mesh.material = named_material(entry.child("material"));
     add_mesh(std::move(mesh), entry);
   }
 
   void apply_override(const JsonNode& entry) {
-    entry.check_object({"match", "set"});
+    entry.check_object({"description", "match", "set"});
+    read_description(entry);
     const JsonNode match = entry.child("match");
     const std::string pattern = match.string();
     const TextureResolver resolve = [this](const JsonNode& v, ImageDecode d) {

@@ -23,8 +23,7 @@ bool alpha_passes(const AlphaMask& mask, std::uint32_t prim, float u, float v) {
   const Mesh& mesh = *mask.mesh;
   if (mesh.uvs.empty()) return true;
   const glm::uvec3 tri = mesh.triangles[prim];
-  const glm::vec2 uv =
-      (1.0f - u - v) * mesh.uvs[tri.x] + u * mesh.uvs[tri.y] + v * mesh.uvs[tri.z];
+  const glm::vec2 uv = (1.0f - u - v) * mesh.uvs[tri.x] + u * mesh.uvs[tri.y] + v * mesh.uvs[tri.z];
   return mask.texture->sample(uv).w >= mask.cutoff;
 }
 
@@ -42,13 +41,20 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
 
 const char* embree_error_name(RTCError code) {
   switch (code) {
-    case RTC_ERROR_NONE: return "RTC_ERROR_NONE";
-    case RTC_ERROR_UNKNOWN: return "RTC_ERROR_UNKNOWN";
-    case RTC_ERROR_INVALID_ARGUMENT: return "RTC_ERROR_INVALID_ARGUMENT";
-    case RTC_ERROR_INVALID_OPERATION: return "RTC_ERROR_INVALID_OPERATION";
-    case RTC_ERROR_OUT_OF_MEMORY: return "RTC_ERROR_OUT_OF_MEMORY";
-    case RTC_ERROR_UNSUPPORTED_CPU: return "RTC_ERROR_UNSUPPORTED_CPU";
-    case RTC_ERROR_CANCELLED: return "RTC_ERROR_CANCELLED";
+    case RTC_ERROR_NONE:
+      return "RTC_ERROR_NONE";
+    case RTC_ERROR_UNKNOWN:
+      return "RTC_ERROR_UNKNOWN";
+    case RTC_ERROR_INVALID_ARGUMENT:
+      return "RTC_ERROR_INVALID_ARGUMENT";
+    case RTC_ERROR_INVALID_OPERATION:
+      return "RTC_ERROR_INVALID_OPERATION";
+    case RTC_ERROR_OUT_OF_MEMORY:
+      return "RTC_ERROR_OUT_OF_MEMORY";
+    case RTC_ERROR_UNSUPPORTED_CPU:
+      return "RTC_ERROR_UNSUPPORTED_CPU";
+    case RTC_ERROR_CANCELLED:
+      return "RTC_ERROR_CANCELLED";
   }
   return "RTC_ERROR_?";
 }
@@ -71,7 +77,9 @@ struct EmbreeScene::Impl {
 EmbreeScene::EmbreeScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   const auto start = std::chrono::steady_clock::now();
   impl_->device = rtcNewDevice(nullptr);
-  if (!impl_->device) throw EmbreeError("rtcNewDevice: " + std::string(embree_error_name(rtcGetDeviceError(nullptr))));
+  if (!impl_->device)
+    throw EmbreeError("rtcNewDevice: " +
+                      std::string(embree_error_name(rtcGetDeviceError(nullptr))));
   impl_->scene = rtcNewScene(impl_->device);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
   impl_->masks.reserve(scene.meshes.size());
@@ -79,10 +87,12 @@ EmbreeScene::EmbreeScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
     const Mesh& mesh = scene.meshes[m];
     RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     // Embree reads vertices as 16-byte vectors: allocate through Embree, which pads.
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.positions.size()));
-    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.triangles.size()));
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), mesh.positions.size()));
+    auto* indices = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(unsigned), mesh.triangles.size()));
     check(impl_->device, "rtcSetNewGeometryBuffer");
     for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
       vertices[3 * i + 0] = mesh.positions[i].x;
@@ -96,7 +106,8 @@ EmbreeScene::EmbreeScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
     }
     const Material& material = scene.materials.at(mesh.material);
     if (material.alpha_texture >= 0 && !mesh.uvs.empty()) {
-      impl_->masks.push_back({&mesh, &scene.textures.at(material.alpha_texture), material.alpha_cutoff});
+      impl_->masks.push_back(
+          {&mesh, &scene.textures.at(material.alpha_texture), material.alpha_cutoff});
       rtcSetGeometryUserData(geom, &impl_->masks.back());
       rtcSetGeometryIntersectFilterFunction(geom, alpha_filter);
       rtcSetGeometryOccludedFilterFunction(geom, alpha_filter);
@@ -108,8 +119,7 @@ EmbreeScene::EmbreeScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   }
   rtcCommitScene(impl_->scene);
   check(impl_->device, "rtcCommitScene");
-  build_seconds_ =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 EmbreeScene::~EmbreeScene() {
@@ -174,33 +184,34 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
     return;
   }
   const std::size_t packets = (count + 7) / 8;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), [&](const auto& range) {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    for (std::size_t p = range.begin(); p != range.end(); ++p) {
-      alignas(32) RTCRayHit8 rh;
-      alignas(32) int valid[8];
-      for (int lane = 0; lane < 8; ++lane) {
-        const std::size_t i = p * 8 + lane;
-        valid[lane] = i < count ? -1 : 0;
-        set_ray8(rh.ray, lane, rays[i < count ? i : count - 1]);
-        rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
-      }
-      rtcIntersect8(valid, scene, &context, &rh);
-      for (int lane = 0; lane < 8; ++lane) {
-        const std::size_t i = p * 8 + lane;
-        if (i >= count) break;
-        Hit& h = hits[i];
-        h.mesh = rh.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID[lane];
-        h.triangle = rh.hit.primID[lane];
-        h.t = rh.ray.tfar[lane];
-        h.u = rh.hit.u[lane];
-        h.v = rh.hit.v[lane];
-      }
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), [&](const auto& range) {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        for (std::size_t p = range.begin(); p != range.end(); ++p) {
+          alignas(32) RTCRayHit8 rh;
+          alignas(32) int valid[8];
+          for (int lane = 0; lane < 8; ++lane) {
+            const std::size_t i = p * 8 + lane;
+            valid[lane] = i < count ? -1 : 0;
+            set_ray8(rh.ray, lane, rays[i < count ? i : count - 1]);
+            rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
+          }
+          rtcIntersect8(valid, scene, &context, &rh);
+          for (int lane = 0; lane < 8; ++lane) {
+            const std::size_t i = p * 8 + lane;
+            if (i >= count) break;
+            Hit& h = hits[i];
+            h.mesh = rh.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID[lane];
+            h.triangle = rh.hit.primID[lane];
+            h.t = rh.ray.tfar[lane];
+            h.u = rh.hit.u[lane];
+            h.v = rh.hit.v[lane];
+          }
+        }
+      });
 }
 
 void EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
@@ -220,26 +231,27 @@ void EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::size_t 
     return;
   }
   const std::size_t packets = (count + 7) / 8;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), [&](const auto& range) {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    for (std::size_t p = range.begin(); p != range.end(); ++p) {
-      alignas(32) RTCRay8 ray;
-      alignas(32) int valid[8];
-      for (int lane = 0; lane < 8; ++lane) {
-        const std::size_t i = p * 8 + lane;
-        valid[lane] = i < count ? -1 : 0;
-        set_ray8(ray, lane, rays[i < count ? i : count - 1]);
-      }
-      rtcOccluded8(valid, scene, &context, &ray);
-      for (int lane = 0; lane < 8; ++lane) {
-        const std::size_t i = p * 8 + lane;
-        if (i >= count) break;
-        occluded[i] = std::isinf(ray.tfar[lane]) && ray.tfar[lane] < 0.0f ? 1 : 0;
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets, kGrain / 8),
+                    [&](const auto& range) {
+                      RTCIntersectContext context;
+                      rtcInitIntersectContext(&context);
+                      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+                      for (std::size_t p = range.begin(); p != range.end(); ++p) {
+                        alignas(32) RTCRay8 ray;
+                        alignas(32) int valid[8];
+                        for (int lane = 0; lane < 8; ++lane) {
+                          const std::size_t i = p * 8 + lane;
+                          valid[lane] = i < count ? -1 : 0;
+                          set_ray8(ray, lane, rays[i < count ? i : count - 1]);
+                        }
+                        rtcOccluded8(valid, scene, &context, &ray);
+                        for (int lane = 0; lane < 8; ++lane) {
+                          const std::size_t i = p * 8 + lane;
+                          if (i >= count) break;
+                          occluded[i] = std::isinf(ray.tfar[lane]) && ray.tfar[lane] < 0.0f ? 1 : 0;
+                        }
+                      }
+                    });
 }
 
 }  // namespace rtpg

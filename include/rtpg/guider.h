@@ -33,22 +33,22 @@ class GuiderError : public std::invalid_argument {
 
 // Every parameter of guiding, with the defaults we measured or took from the paper.
 struct GuidingConfig {
-  float pi_min = 0.05f;   // clamp of the Gaussian's mixing weight (paper 3.2)
+  float pi_min = 0.05f;  // clamp of the Gaussian's mixing weight (paper 3.2)
   float pi_max = 0.95f;
-  float pi_init = 0.05f;  // weight of a new model (paper 3.1)
-  int k_max = 32;         // epochs; the step size stops shrinking after k_max updates
-  float step_alpha = 1.0f;  // eta_k = max((k+1)^-alpha, 1/(k_max+1)): 1 = plain mean until k_max
-  float sigma_eps = 1e-4f;  // regularisation of Sigma's diagonal (square units^2)
-  float sigma_prior = 5e-2f;  // prior variance, added as sigma_prior / (k + 1)
+  float pi_init = 0.05f;       // weight of a new model (paper 3.1)
+  int k_max = 32;              // epochs; the step size stops shrinking after k_max updates
+  float step_alpha = 1.0f;     // eta_k = max((k+1)^-alpha, 1/(k_max+1)): 1 = plain mean until k_max
+  float sigma_eps = 1e-4f;     // regularisation of Sigma's diagonal (square units^2)
+  float sigma_prior = 5e-2f;   // prior variance, added as sigma_prior / (k + 1)
   float reseed_ratio = 10.0f;  // a sample with weight > ratio * W outside the lobe re-seeds it
   float weight_clamp = 0.0f;   // training weights clamped to weight_clamp * W (0 = no clamp)
   int em_passes = 3;           // E-step passes over each frame's samples
   float max_correlation = 0.95f;
-  float roughness_skip = 0.05f;  // roughness at or below: BSDF only, no training
-  int n_min = 5, n_max = 20;     // N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2);
-                                 // n_min == n_max gives a fixed N
-  int apron = 2;                 // neighbourhood radius: a (2*apron+1)^2 window of VPLs
-  float max_weight = 1e8f;       // training weights above this are dropped as absurd
+  float roughness_skip = 0.05f;      // roughness at or below: BSDF only, no training
+  int n_min = 5, n_max = 20;         // N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2);
+                                     // n_min == n_max gives a fixed N
+  int apron = 2;                     // neighbourhood radius: a (2*apron+1)^2 window of VPLs
+  float max_weight = 1e8f;           // training weights above this are dropped as absurd
   float reproject_position = 0.05f;  // relative distance (to the depth) that rejects history
   float reproject_normal = 0.9f;     // normal cosine below which history is rejected
   int local_x = 16, local_y = 16;    // work-group size of the kernels (the VPL tile)

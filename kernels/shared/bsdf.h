@@ -24,10 +24,10 @@ typedef struct {
 #define PG_MIN_ROUGHNESS 0.02f
 
 typedef struct {
-  float3 diffuse;  /* Lambert albedo (already scaled by 1 - metallic and 1 - F0) */
-  float3 f0;       /* Fresnel reflectance at normal incidence */
-  float alpha;     /* GGX alpha */
-  float p_specular;/* probability of sampling the GGX lobe, for outgoing direction wo */
+  float3 diffuse;   /* Lambert albedo (already scaled by 1 - metallic and 1 - F0) */
+  float3 f0;        /* Fresnel reflectance at normal incidence */
+  float alpha;      /* GGX alpha */
+  float p_specular; /* probability of sampling the GGX lobe, for outgoing direction wo */
 } pg_lobes;
 
 PG_FN float3 pg_fresnel_schlick(float3 f0, float cos_theta) {
@@ -70,7 +70,9 @@ PG_FN float pg_ggx_lambda(float3 w, float alpha) {
   return 0.5f * (-1.0f + sqrt(1.0f + alpha * alpha * t2));
 }
 
-PG_FN float pg_ggx_g1(float3 w, float alpha) { return 1.0f / (1.0f + pg_ggx_lambda(w, alpha)); }
+PG_FN float pg_ggx_g1(float3 w, float alpha) {
+  return 1.0f / (1.0f + pg_ggx_lambda(w, alpha));
+}
 
 PG_FN float pg_ggx_g2(float3 wo, float3 wi, float alpha) {
   return 1.0f / (1.0f + pg_ggx_lambda(wo, alpha) + pg_ggx_lambda(wi, alpha));
@@ -128,7 +130,7 @@ PG_FN float3 pg_ggx_sample_visible_normal(float3 wo, float alpha, float u1, floa
 
 typedef struct {
   float3 wi;
-  float pdf;   /* pg_bsdf_pdf(wo, wi); 0 = no sample */
+  float pdf; /* pg_bsdf_pdf(wo, wi); 0 = no sample */
 } pg_bsdf_sample_t;
 
 /* One direction from the lobe mixture; u_lobe picks the lobe, (u1, u2) the direction. */

@@ -61,16 +61,36 @@ using std::log;
 using std::sin;
 using std::sqrt;
 
-PG_FN float2 pg_make_float2(float x, float y) { return float2(x, y); }
-PG_FN float3 pg_make_float3(float x, float y, float z) { return float3(x, y, z); }
-PG_FN float4 pg_make_float4(float x, float y, float z, float w) { return float4(x, y, z, w); }
-PG_FN float3 pg_float4_xyz(float4 v) { return float3(v.x, v.y, v.z); }
-PG_FN float clamp(float x, float lo, float hi) { return fmin(fmax(x, lo), hi); }
-PG_FN int isfinite(float x) { return std::isfinite(x) ? 1 : 0; }
-PG_FN float mix(float a, float b, float t) { return a + (b - a) * t; }
-PG_FN float3 mix(float3 a, float3 b, float t) { return a + (b - a) * t; }
-PG_FN float sign(float x) { return x > 0.0f ? 1.0f : (x < 0.0f ? -1.0f : 0.0f); }
-PG_FN float copysign(float x, float y) { return std::copysign(x, y); }
+PG_FN float2 pg_make_float2(float x, float y) {
+  return float2(x, y);
+}
+PG_FN float3 pg_make_float3(float x, float y, float z) {
+  return float3(x, y, z);
+}
+PG_FN float4 pg_make_float4(float x, float y, float z, float w) {
+  return float4(x, y, z, w);
+}
+PG_FN float3 pg_float4_xyz(float4 v) {
+  return float3(v.x, v.y, v.z);
+}
+PG_FN float clamp(float x, float lo, float hi) {
+  return fmin(fmax(x, lo), hi);
+}
+PG_FN int isfinite(float x) {
+  return std::isfinite(x) ? 1 : 0;
+}
+PG_FN float mix(float a, float b, float t) {
+  return a + (b - a) * t;
+}
+PG_FN float3 mix(float3 a, float3 b, float t) {
+  return a + (b - a) * t;
+}
+PG_FN float sign(float x) {
+  return x > 0.0f ? 1.0f : (x < 0.0f ? -1.0f : 0.0f);
+}
+PG_FN float copysign(float x, float y) {
+  return std::copysign(x, y);
+}
 PG_NAMESPACE_END
 
 #endif
@@ -83,11 +103,21 @@ PG_NAMESPACE_BEGIN
 #define PG_INV_TWO_PI 0.15915494309189533577f
 #define PG_FLOAT_MAX 3.402823466e+38f
 
-PG_FN float pg_sqr(float x) { return x * x; }
-PG_FN float pg_safe_sqrt(float x) { return sqrt(fmax(x, 0.0f)); }
-PG_FN float pg_luminance(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-PG_FN int pg_all_finite3(float3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
-PG_FN float pg_max3(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
+PG_FN float pg_sqr(float x) {
+  return x * x;
+}
+PG_FN float pg_safe_sqrt(float x) {
+  return sqrt(fmax(x, 0.0f));
+}
+PG_FN float pg_luminance(float3 c) {
+  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
+PG_FN int pg_all_finite3(float3 v) {
+  return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
+}
+PG_FN float pg_max3(float3 v) {
+  return fmax(v.x, fmax(v.y, v.z));
+}
 
 /* Orthonormal basis around n (Duff et al. 2017, "Building an Orthonormal Basis, Revisited").
  * The hemisphere frame of a pixel: the guiding distribution lives in this frame, so
@@ -113,7 +143,9 @@ PG_FN float3 pg_to_local(pg_frame f, float3 v) {
   return pg_make_float3(dot(v, f.t), dot(v, f.b), dot(v, f.n));
 }
 
-PG_FN float3 pg_to_world(pg_frame f, float3 v) { return f.t * v.x + f.b * v.y + f.n * v.z; }
+PG_FN float3 pg_to_world(pg_frame f, float3 v) {
+  return f.t * v.x + f.b * v.y + f.n * v.z;
+}
 
 PG_NAMESPACE_END
 

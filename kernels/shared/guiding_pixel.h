@@ -11,7 +11,8 @@
 PG_NAMESPACE_BEGIN
 
 PG_FN int pg_guiding_applies(uint flags, float roughness, pg_guiding_params p) {
-  if ((flags & (PG_GBUF_SKY | PG_GBUF_EMITTER | PG_GBUF_DELTA | PG_GBUF_TRANSMISSIVE)) != 0u) return 0;
+  if ((flags & (PG_GBUF_SKY | PG_GBUF_EMITTER | PG_GBUF_DELTA | PG_GBUF_TRANSMISSIVE)) != 0u)
+    return 0;
   return roughness > p.roughness_skip;
 }
 

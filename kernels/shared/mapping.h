@@ -29,7 +29,7 @@ PG_FN float2 pg_square_to_disk(float2 u) {
 PG_FN float2 pg_disk_to_square(float2 d) {
   float r = sqrt(d.x * d.x + d.y * d.y);
   if (r == 0.0f) return pg_make_float2(0.5f, 0.5f);
-  float phi = atan2(d.y, d.x); /* (-pi, pi] */
+  float phi = atan2(d.y, d.x);                  /* (-pi, pi] */
   if (phi < -PG_PI / 4.0f) phi += 2.0f * PG_PI; /* [-pi/4, 7pi/4) */
   float a, b;
   if (phi < PG_PI / 4.0f) { /* right wedge: ox = r */
@@ -71,7 +71,9 @@ PG_FN float3 pg_sample_cosine_hemisphere(float2 u) {
   return pg_make_float3(d.x, d.y, z);
 }
 
-PG_FN float pg_cosine_hemisphere_pdf(float cos_theta) { return fmax(cos_theta, 0.0f) * PG_INV_PI; }
+PG_FN float pg_cosine_hemisphere_pdf(float cos_theta) {
+  return fmax(cos_theta, 0.0f) * PG_INV_PI;
+}
 
 PG_NAMESPACE_END
 

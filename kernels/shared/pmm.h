@@ -22,25 +22,25 @@ PG_NAMESPACE_BEGIN
 /* Every tunable of the guiding step, passed to the kernels by value. Plain 4-byte fields
  * only, so host and device agree on the layout (checked by static_assert on the host). */
 typedef struct {
-  float pi_min;            /* clamp of the mixing weight (paper: 0.05) */
-  float pi_max;            /* (paper: 0.95) */
-  float pi_init;           /* weight of a new model (paper: 0.05) */
-  float k_max;             /* epochs after which the step size stops shrinking */
-  float step_alpha;        /* eta_k = max((k+1)^-alpha, 1/(k_max+1)) */
-  float sigma_eps;         /* added to Sigma's diagonal: keeps it positive definite */
-  float max_correlation;   /* |rho| bound: keeps the Cholesky factor well conditioned */
-  float roughness_skip;    /* no guiding where roughness is at or below this */
-  float n_min;             /* N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2) */
+  float pi_min;          /* clamp of the mixing weight (paper: 0.05) */
+  float pi_max;          /* (paper: 0.95) */
+  float pi_init;         /* weight of a new model (paper: 0.05) */
+  float k_max;           /* epochs after which the step size stops shrinking */
+  float step_alpha;      /* eta_k = max((k+1)^-alpha, 1/(k_max+1)) */
+  float sigma_eps;       /* added to Sigma's diagonal: keeps it positive definite */
+  float max_correlation; /* |rho| bound: keeps the Cholesky factor well conditioned */
+  float roughness_skip;  /* no guiding where roughness is at or below this */
+  float n_min;           /* N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2) */
   float n_max;
-  float max_weight;        /* training weights above this are treated as absurd input */
-  float reproject_depth;   /* relative position difference that rejects history */
-  float reproject_normal;  /* cosine below which normals reject history */
-  float sigma_prior;       /* prior variance added as sigma_prior / (k + 1) */
-  float reseed_ratio;      /* a sample with a > reseed_ratio * W outside the lobe re-seeds */
-  float weight_clamp;      /* training weights are clamped to weight_clamp * W (0 = off) */
-  int em_passes;           /* E-step passes over a frame's samples (pg_pmm_train) */
-  int apron;               /* neighbourhood radius in pixels (window 2*apron+1 squared) */
-  int stride;              /* step through the window, coprime with its size */
+  float max_weight;       /* training weights above this are treated as absurd input */
+  float reproject_depth;  /* relative position difference that rejects history */
+  float reproject_normal; /* cosine below which normals reject history */
+  float sigma_prior;      /* prior variance added as sigma_prior / (k + 1) */
+  float reseed_ratio;     /* a sample with a > reseed_ratio * W outside the lobe re-seeds */
+  float weight_clamp;     /* training weights are clamped to weight_clamp * W (0 = off) */
+  int em_passes;          /* E-step passes over a frame's samples (pg_pmm_train) */
+  int apron;              /* neighbourhood radius in pixels (window 2*apron+1 squared) */
+  int stride;             /* step through the window, coprime with its size */
 } pg_guiding_params;
 
 typedef struct {
@@ -49,9 +49,9 @@ typedef struct {
 } pg_pmm_state;
 
 typedef struct {
-  int valid;        /* k > 0 and the statistics are usable */
-  float pi;         /* mixing weight of the Gaussian */
-  float mx, my;     /* mean in the square */
+  int valid;           /* k > 0 and the statistics are usable */
+  float pi;            /* mixing weight of the Gaussian */
+  float mx, my;        /* mean in the square */
   float l11, l21, l22; /* Cholesky factor of Sigma */
 } pg_pmm_model;
 
@@ -140,8 +140,8 @@ typedef struct {
 /* One-sample MIS over the two components (paper 3.1): xi < pi picks the Gaussian (Box-Muller
  * then the Cholesky factor, then M), else the BSDF. Either way the sample's weight is
  * f cos / D(w) with the full mixture density. */
-PG_FN pg_pmm_sample_t pg_pmm_sample(pg_pmm_model m, pg_lobes lobes, float3 wo, float xi,
-                                    float u1, float u2) {
+PG_FN pg_pmm_sample_t pg_pmm_sample(pg_pmm_model m, pg_lobes lobes, float3 wo, float xi, float u1,
+                                    float u2) {
   pg_pmm_sample_t s;
   s.wi = pg_make_float3(0.0f, 0.0f, 1.0f);
   s.pdf = 0.0f;

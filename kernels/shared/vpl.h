@@ -17,7 +17,9 @@ PG_NAMESPACE_BEGIN
 #define PG_VPL_DISTANT 2u /* escaped ray: position holds a direction */
 #define PG_VPL_STRATEGY_SHIFT 8u
 
-PG_FN uint pg_vpl_strategy(uint info) { return (info >> PG_VPL_STRATEGY_SHIFT) & 0xffu; }
+PG_FN uint pg_vpl_strategy(uint info) {
+  return (info >> PG_VPL_STRATEGY_SHIFT) & 0xffu;
+}
 
 PG_NAMESPACE_END
 

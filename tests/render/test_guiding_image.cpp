@@ -17,7 +17,9 @@
 namespace rtpg {
 namespace {
 
-std::string scene_file(const char* name) { return std::string(RTPG_SOURCE_DIR) + "/scenes/" + name; }
+std::string scene_file(const char* name) {
+  return std::string(RTPG_SOURCE_DIR) + "/scenes/" + name;
+}
 
 // Per-frame means of tiles (and of the whole image) over many frames, for a z-test of two
 // independent estimators: the frame-to-frame spread gives the standard error honestly, even
@@ -36,7 +38,8 @@ TileSeries run(const Scene& scene, bool guided, int size, int frames, ClRuntime&
   settings.path_tracer.max_bounces = scene.max_bounces > 0 ? scene.max_bounces : 8;
   Renderer renderer(scene, settings);
   if (guided)
-    renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(cl, size, size, GuidingConfig{}));
+    renderer.set_first_bounce_sampler(
+        std::make_unique<GuidedFirstBounce>(cl, size, size, GuidingConfig{}));
   TileSeries s;
   s.tiles_x = s.tiles_y = size / s.tile;
   s.per_tile.assign(s.tiles_x * s.tiles_y, {});
@@ -52,7 +55,8 @@ TileSeries run(const Scene& scene, bool guided, int size, int frames, ClRuntime&
         sums[(y / s.tile) * s.tiles_x + x / s.tile] += l;
         total += l;
       }
-    for (std::size_t t = 0; t < sums.size(); ++t) s.per_tile[t].push_back(sums[t] / (s.tile * s.tile));
+    for (std::size_t t = 0; t < sums.size(); ++t)
+      s.per_tile[t].push_back(sums[t] / (s.tile * s.tile));
     s.whole.push_back(total / (static_cast<double>(size) * size));
   }
   return s;
@@ -88,7 +92,8 @@ void expect_same_means(const char* name, int frames) {
   const TileSeries pg = run(scene, true, size, frames, cl);
   const int comparisons = static_cast<int>(pt.per_tile.size()) + 1;
   const double z = z_bound(comparisons);
-  auto check = [&](const std::vector<double>& a, const std::vector<double>& b, const std::string& what) {
+  auto check = [&](const std::vector<double>& a, const std::vector<double>& b,
+                   const std::string& what) {
     double ma, va, mb, vb;
     mean_and_variance(a, ma, va);
     mean_and_variance(b, mb, vb);
@@ -102,9 +107,13 @@ void expect_same_means(const char* name, int frames) {
     check(pt.per_tile[t], pg.per_tile[t], "tile " + std::to_string(t));
 }
 
-TEST(GuidingImage, UnbiasedOnCornellBox) { expect_same_means("cornell-box.json", 160); }
+TEST(GuidingImage, UnbiasedOnCornellBox) {
+  expect_same_means("cornell-box.json", 160);
+}
 
-TEST(GuidingImage, UnbiasedOnCornellIndirect) { expect_same_means("cornell-indirect.json", 160); }
+TEST(GuidingImage, UnbiasedOnCornellIndirect) {
+  expect_same_means("cornell-indirect.json", 160);
+}
 
 // The acceptance figure of the guiding issue: cornell-indirect, 128x128, fixed seed, 32 frames at
 // 1 spp; the mean relMSE of the last 8 frames with guiding is at most 0.7 times that without,
@@ -126,24 +135,28 @@ TEST(GuidingImage, HalvesErrorOnCornellIndirect) {
     const int passes = 256;  // 1024 spp
     for (int p = 0; p < passes; ++p) {
       renderer.render_frame(p);
-      for (std::size_t i = 0; i < reference.pixels.size(); ++i) reference.pixels[i] += renderer.image()[i] / float(passes);
+      for (std::size_t i = 0; i < reference.pixels.size(); ++i)
+        reference.pixels[i] += renderer.image()[i] / float(passes);
     }
   }
   double error[2] = {0.0, 0.0};
   for (int guided = 0; guided < 2; ++guided) {
     Renderer renderer(scene, settings);
     if (guided)
-      renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(cl, size, size, GuidingConfig{}));
+      renderer.set_first_bounce_sampler(
+          std::make_unique<GuidedFirstBounce>(cl, size, size, GuidingConfig{}));
     for (int f = 0; f < 32; ++f) {
       renderer.render_frame(f);
-      if (f >= 24) error[guided] += relative_mse(ImageRgb{size, size, renderer.image()}, reference) / 8.0;
+      if (f >= 24)
+        error[guided] += relative_mse(ImageRgb{size, size, renderer.image()}, reference) / 8.0;
     }
   }
   RecordProperty("relmse_pt", std::to_string(error[0]));
   RecordProperty("relmse_pg", std::to_string(error[1]));
   EXPECT_LE(error[1], 0.7 * error[0]) << "PT " << error[0] << ", guided " << error[1];
-  std::printf("cornell-indirect 128x128, last 8 of 32 frames: relMSE PT %.4f, guided %.4f (ratio %.3f)\n",
-              error[0], error[1], error[1] / error[0]);
+  std::printf(
+      "cornell-indirect 128x128, last 8 of 32 frames: relMSE PT %.4f, guided %.4f (ratio %.3f)\n",
+      error[0], error[1], error[1] / error[0]);
 }
 
 }  // namespace

@@ -558,6 +558,35 @@ TEST(SceneLoader, SharedCornellBox) {
   EXPECT_FALSE(scene.features().glossy);
 }
 
+// Scene files comment their parts through "description" keys (scenes/*.json); only strings.
+TEST(SceneLoader, DescriptionsAreCommentsOnEveryEntry) {
+  TempDir dir;
+  write_ply(dir / "floor.ply");
+  write_file(dir / "described.json", R"({
+    "description": "top",
+    "camera": {"description": "c", "position": [0, 0, 5], "look_at": [0, 0, 0], "fov": 40},
+    "camera_paths": {"p": {"description": "p", "keys": [
+        {"time": 0, "position": [0, 0, 5], "look_at": [0, 0, 0]},
+        {"time": 1, "position": [1, 0, 5], "look_at": [0, 0, 0]}]}},
+    "materials": {"lamp": {"description": "m", "emission": [1, 1, 1]}},
+    "meshes": [{"description": "mesh", "file": "floor.ply", "material": "lamp"}],
+    "shapes": [
+      {"description": "q", "type": "quad", "corner": [0,0,0], "edge1": [1,0,0], "edge2": [0,1,0],
+       "material": "lamp"},
+      {"description": "b", "type": "box", "min": [0,0,0], "max": [1,1,1], "material": "lamp"},
+      {"description": "s", "type": "sphere", "center": [0,0,0], "radius": 1, "material": "lamp"}],
+    "material_overrides": [{"description": "o", "match": "*", "set": {"roughness": 0.5}}]
+  })");
+  const Scene scene = load_scene(dir / "described.json");
+  EXPECT_EQ(scene.materials.size(), 1u);
+  EXPECT_FLOAT_EQ(scene.materials[0].roughness, 0.5f);
+  write_file(
+      dir / "number.json",
+      simple_scene(R"("material_overrides": [{"description": 3, "match": "*", "set": {}}],)"));
+  expect_input_error([&] { load_scene(dir / "number.json"); },
+                     {"number.json", "material_overrides[0].description"});
+}
+
 // ---- bad input: every error names the offending file ---------------------------------------
 
 TEST(SceneLoaderErrors, MissingSceneFile) {

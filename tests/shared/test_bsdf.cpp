@@ -59,7 +59,8 @@ TEST(Bsdf, SamplerMatchesPdfChiSquare) {
     EXPECT_GT(result.p_value, alpha) << c.name << ": " << result.describe();
     EXPECT_LE(result.pdf_integral, 1.0 + 2e-3) << c.name << ": " << result.describe();
     // The pdf integrates to the fraction of attempts that produce a direction.
-    EXPECT_NEAR(result.pdf_integral, result.sample_fraction, 5e-3) << c.name << ": " << result.describe();
+    EXPECT_NEAR(result.pdf_integral, result.sample_fraction, 5e-3)
+        << c.name << ": " << result.describe();
   }
 }
 
@@ -92,7 +93,8 @@ TEST(Bsdf, AlbedoNeverExceedsOneAndIsReciprocal) {
 }
 
 TEST(Rng, DeterministicAndUniform) {
-  pg_rng a = pg_rng_make(1, 2, 3, 4, 0), b = pg_rng_make(1, 2, 3, 4, 0), c = pg_rng_make(1, 2, 3, 5, 0);
+  pg_rng a = pg_rng_make(1, 2, 3, 4, 0), b = pg_rng_make(1, 2, 3, 4, 0),
+         c = pg_rng_make(1, 2, 3, 5, 0);
   EXPECT_EQ(pg_rng_next_uint(&a), pg_rng_next_uint(&b));
   EXPECT_NE(pg_rng_next_uint(&a), pg_rng_next_uint(&c));
   // Mean and variance of many draws across pixels.

@@ -39,11 +39,16 @@ TEST(Mapping, HemisphereToSquareRoundTrips) {
 TEST(Mapping, JacobianIsTwoPiEverywhere) {
   const float h = 1e-3f;
   auto jacobian = [&](float x, float y) {
-    const float3 dx = (pg_square_to_hemisphere(float2(x + h, y)) - pg_square_to_hemisphere(float2(x - h, y))) / (2.0f * h);
-    const float3 dy = (pg_square_to_hemisphere(float2(x, y + h)) - pg_square_to_hemisphere(float2(x, y - h))) / (2.0f * h);
+    const float3 dx =
+        (pg_square_to_hemisphere(float2(x + h, y)) - pg_square_to_hemisphere(float2(x - h, y))) /
+        (2.0f * h);
+    const float3 dy =
+        (pg_square_to_hemisphere(float2(x, y + h)) - pg_square_to_hemisphere(float2(x, y - h))) /
+        (2.0f * h);
     return length(cross(dx, dy));
   };
-  const float points[] = {0.0015f, 0.01f, 0.1f, 0.25f, 0.37f, 0.5f + 0.0015f, 0.63f, 0.9f, 0.99f, 0.9985f};
+  const float points[] = {0.0015f,        0.01f, 0.1f, 0.25f, 0.37f,
+                          0.5f + 0.0015f, 0.63f, 0.9f, 0.99f, 0.9985f};
   for (float x : points)
     for (float y : points) {
       // The map has creases on the diagonals (wedge boundaries): stay off them by 2h.

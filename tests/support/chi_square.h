@@ -48,8 +48,8 @@ struct ChiSquareResult {
   double statistic = 0.0;
   int degrees_of_freedom = 0;
   double p_value = 1.0;
-  double pdf_integral = 0.0;    // integral of the pdf over the sphere (numerical)
-  double sample_fraction = 0.0; // fraction of attempts that produced a direction
+  double pdf_integral = 0.0;     // integral of the pdf over the sphere (numerical)
+  double sample_fraction = 0.0;  // fraction of attempts that produced a direction
   std::string describe() const {
     return "chi2=" + std::to_string(statistic) + " dof=" + std::to_string(degrees_of_freedom) +
            " p=" + std::to_string(p_value) + " integral=" + std::to_string(pdf_integral) +
