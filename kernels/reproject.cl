@@ -34,8 +34,8 @@ __kernel void reproject(__global const float4* prev_state0, __global const float
         pg_pmm_state s;
         s.s0 = prev_state0[j];
         s.s1 = prev_state1[j];
-        if (dot(n, m) < 0.99999f)
-          s = pg_pmm_reframe(s, pg_frame_from_normal(m), pg_frame_from_normal(n));
+        pg_frame from = pg_frame_from_normal(m), to = pg_frame_from_normal(n);
+        if (pg_pmm_needs_reframe(from, to)) s = pg_pmm_reframe(s, from, to);
         if (pg_pmm_state_finite(s)) out = s;
       }
     }

@@ -302,6 +302,18 @@ PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples
   return out;
 }
 
+/* Hemisphere frames this close (normals and tangents within about 1.8 degrees: jitter across a
+ * bump map, say) keep a reprojected lobe as is: the error is below a lobe's width, and a change
+ * of frame costs three mappings. */
+#define PG_REFRAME_MIN_COS 0.9995f
+
+/* Whether a state reprojected from frame `from` to frame `to` must be carried over by
+ * pg_pmm_reframe. Whole frames are compared, not only normals: the tangent of
+ * pg_frame_from_normal turns abruptly where the normal crosses the z = 0 plane. */
+PG_FN int pg_pmm_needs_reframe(pg_frame from, pg_frame to) {
+  return dot(from.n, to.n) < PG_REFRAME_MIN_COS || dot(from.t, to.t) < PG_REFRAME_MIN_COS;
+}
+
 /* Carries a state from the hemisphere frame `from` to the frame `to` (reprojection onto a
  * pixel whose normal differs): the mean moves with its direction, the covariance with the
  * Jacobian of the change of frame at the mean (by central differences). A mean that ends up
