@@ -895,7 +895,7 @@ TEST(GuidingKernels, ReprojectionFollowsAMovingCamera) {
     }
   // Every case occurred: a moving camera over a sphere must show all of them.
   EXPECT_GT(kept * 3, g1.n() - sky);
-  EXPECT_GE(kept_reframed, 50);
+  EXPECT_GE(kept_reframed, 20);  // enough reframed pixels to exercise the change of frame
   EXPECT_GT(outside, 0u);
   EXPECT_GT(disoccluded, 0u);
   EXPECT_GT(sky, 0u);
