@@ -43,9 +43,13 @@ const Expected kScenes[] = {
 };
 
 // gtest prints a parameter in test listings: the file name, not its bytes.
-void PrintTo(const Expected& e, std::ostream* os) { *os << e.file; }
+void PrintTo(const Expected& e, std::ostream* os) {
+  *os << e.file;
+}
 
-std::string scene_path(const char* file) { return std::string(RTPG_SOURCE_DIR) + "/scenes/" + file; }
+std::string scene_path(const char* file) {
+  return std::string(RTPG_SOURCE_DIR) + "/scenes/" + file;
+}
 
 // Every scene here draws on ../shared/scenes (the Cornell boxes built from shapes do not, but
 // the suite is one unit: it runs whole or not at all).
@@ -97,12 +101,15 @@ double radiance_bound(const Scene& scene) {
   double bound = 0.0;
   auto max3 = [](const glm::vec3& v) { return std::max({v.x, v.y, v.z}); };
   if (scene.sun.enabled) bound += max3(scene.sun.irradiance) / M_PI;
-  if (scene.environment.kind == Environment::Kind::Constant) bound += 4.0 * max3(scene.environment.color);
+  if (scene.environment.kind == Environment::Kind::Constant)
+    bound += 4.0 * max3(scene.environment.color);
   if (scene.environment.kind == Environment::Kind::Map)
-    bound += 4.0 * max3(scene.environment.color * map_mean(scene.textures.at(scene.environment.map_texture)));
+    bound += 4.0 * max3(scene.environment.color *
+                        map_mean(scene.textures.at(scene.environment.map_texture)));
   float emission = 0.0f;
   for (const Mesh& m : scene.meshes)
-    if (!m.triangles.empty()) emission = std::max(emission, max3(scene.materials[m.material].emission));
+    if (!m.triangles.empty())
+      emission = std::max(emission, max3(scene.materials[m.material].emission));
   return bound + emission;
 }
 
@@ -164,8 +171,8 @@ TEST_P(SceneSuite, LoadsAndRenders) {
     }
     EXPECT_GT(mean, 0.0) << e.file << (guided ? " guided" : " PT");
     EXPECT_LT(mean, bound) << e.file << (guided ? " guided" : " PT");
-    std::printf("%-20s %-6s mean luminance %.4f (bound %.1f)\n", e.file, guided ? "guided" : "PT", mean,
-                bound);
+    std::printf("%-20s %-6s mean luminance %.4f (bound %.1f)\n", e.file, guided ? "guided" : "PT",
+                mean, bound);
   }
 }
 
