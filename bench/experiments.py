@@ -280,13 +280,15 @@ def main():
     ap.add_argument("--ref-spp", type=int, help="override the references' samples per pixel")
     args = ap.parse_args()
     ctx = Context(args)
+    overrides = {}
     if args.res:
-        ctx.mode["res"] = args.res
+        ctx.mode["res"] = ctx.mode["trade_res"] = overrides["res"] = args.res
     if args.ref_spp:
-        ctx.mode["ref_spp"] = args.ref_spp
+        ctx.mode["ref_spp"] = overrides["ref_spp"] = args.ref_spp
     scenes = args.scenes or ctx.mode["scenes"]
     results = {"machine": runner.machine_info(), "mode": "quick" if args.quick else "full", "settings": ctx.mode,
-               "started": time.strftime("%Y-%m-%d %H:%M:%S"), "skipped_scenes": {}, "experiments": {}}
+               "overrides": overrides, "started": time.strftime("%Y-%m-%d %H:%M:%S"), "skipped_scenes": {},
+               "experiments": {}}
     usable = []
     for s in scenes:
         ok, why = available(s)
