@@ -161,6 +161,15 @@ void Guider::check_gbuffer(const GuiderGBuffer& g, const char* which) const {
   check_buffer(g.motion, 8, w + ".motion");
 }
 
+double Guider::run(cl::Kernel& kernel) {
+  cl::Event done;
+  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, global_range(),
+                                        cl::NDRange(config_.local_x, config_.local_y), nullptr,
+                                        &done);
+  done.wait();
+  return ClRuntime::event_ms(done);
+}
+
 cl::NDRange Guider::global_range() const {
   auto round_up = [](int v, int m) { return static_cast<std::size_t>((v + m - 1) / m * m); };
   return cl::NDRange(round_up(width_, config_.local_x), round_up(height_, config_.local_y));
@@ -189,12 +198,7 @@ void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previo
   k.setArg(a++, static_cast<cl_uint>(width_));
   k.setArg(a++, static_cast<cl_uint>(height_));
   k.setArg(a++, params);
-  cl::Event done;
-  runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, global_range(),
-                                        cl::NDRange(config_.local_x, config_.local_y), nullptr,
-                                        &done);
-  done.wait();
-  times_.reproject_ms = ClRuntime::event_ms(done);
+  times_.reproject_ms = run(k);
   current_ = to;
 }
 
@@ -221,12 +225,7 @@ void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint3
   k.setArg(a++, static_cast<cl_uint>(frame));
   k.setArg(a++, static_cast<cl_uint>(sample_index));
   k.setArg(a++, params);
-  cl::Event done;
-  runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, global_range(),
-                                        cl::NDRange(config_.local_x, config_.local_y), nullptr,
-                                        &done);
-  done.wait();
-  times_.sample_ms = ClRuntime::event_ms(done);
+  times_.sample_ms = run(k);
 }
 
 void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::uint32_t seed,
@@ -265,12 +264,7 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
   k.setArg(a++, cl::Local(tile));
   k.setArg(a++, cl::Local(tile));
   k.setArg(a++, cl::Local(tile));
-  cl::Event done;
-  runtime_.queue().enqueueNDRangeKernel(k, cl::NullRange, global_range(),
-                                        cl::NDRange(config_.local_x, config_.local_y), nullptr,
-                                        &done);
-  done.wait();
-  times_.train_ms = ClRuntime::event_ms(done);
+  times_.train_ms = run(k);
   current_ = to;
 }
 

@@ -117,6 +117,7 @@ class Guider {
   void check_gbuffer(const GuiderGBuffer& g, const char* which) const;
   void check_buffer(const cl::Buffer& b, std::size_t element_size, const std::string& name) const;
   cl::NDRange global_range() const;
+  double run(cl::Kernel& kernel);  // launches over the image, waits, returns profiled ms
 
   ClRuntime& runtime_;
   int width_, height_;
