@@ -164,13 +164,7 @@ inline RaySets make_ray_sets(const Scene& scene, const EmbreeScene& tracer, int 
                   v2 = shared::pg_rng_next(&rng);
       if (!lights.empty() && lights.sample(sp.position, us, v1, v2, ls) &&
           glm::dot(ls.direction, sp.geometric_normal) > 0.0f) {
-        Ray sr;
-        sr.origin = origin;
-        sr.direction = ls.direction;
-        sr.tmin = 0.0f;
-        sr.tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity()
-                                          : ls.distance * (1.0f - 1e-4f);
-        shadow[i] = sr;
+        shadow[i] = shadow_ray(origin, ls);
         has_shadow[i] = 1;
       }
     }

@@ -18,6 +18,15 @@ float luminance(const glm::vec3& c) {
 
 }  // namespace
 
+Ray shadow_ray(const glm::vec3& origin, const LightSample& sample) {
+  Ray r;
+  r.origin = origin;
+  r.direction = sample.direction;
+  r.tmin = 0.0f;
+  r.tmax = std::isinf(sample.distance) ? kInfinity : sample.distance * (1.0f - 1e-4f);
+  return r;
+}
+
 Lights::Lights(const Scene& scene) : scene_(scene) {
   // Emissive triangles, weighted by their emitted power (area * luminance of Le).
   std::vector<float> weights;

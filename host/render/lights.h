@@ -11,6 +11,7 @@
 
 #include "render/distribution.h"
 #include "scene/scene.h"
+#include "trace/ray.h"
 
 namespace rtpg {
 
@@ -21,6 +22,10 @@ struct LightSample {
   float pdf = 0.0f;           // solid-angle density of this sample (selection included)
   bool delta = false;         // a delta light: BSDF sampling can never hit it (no MIS)
 };
+
+// Shadow ray from origin towards a light sample, stopping just short of the light (infinite
+// for the sun and the environment).
+Ray shadow_ray(const glm::vec3& origin, const LightSample& sample);
 
 class Lights {
  public:

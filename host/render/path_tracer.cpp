@@ -45,17 +45,6 @@ Ray inactive_ray() {
   return r;
 }
 
-// Shadow ray towards a light sample; infinite distance for the sun and the environment.
-Ray shadow_ray(const glm::vec3& origin, const LightSample& ls) {
-  Ray r;
-  r.origin = origin;
-  r.direction = ls.direction;
-  r.tmin = 0.0f;
-  r.tmax = std::isinf(ls.distance) ? std::numeric_limits<float>::infinity()
-                                   : ls.distance * (1.0f - 1e-4f);
-  return r;
-}
-
 }  // namespace
 
 void VplBuffer::resize(std::size_t n) {
