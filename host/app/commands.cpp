@@ -103,6 +103,13 @@ int bounces_for(const Scene& scene, int flag) {
 
 }  // namespace
 
+std::string frame_output_path(const std::string& output, int frame) {
+  const fs::path path(output);
+  return (path.parent_path() /
+          fmt::format("{}-f{:04d}{}", path.stem().string(), frame, path.extension().string()))
+      .string();
+}
+
 std::string default_scene_path() {
   if (fs::exists("scenes/cornell-box.json")) return "scenes/cornell-box.json";
   return std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json";
@@ -112,6 +119,12 @@ int run_render(const RenderOptions& options) {
   check_output_path(options.output, "--output", true);
   if (!options.stats_json.empty()) check_output_folder(options.stats_json);
   if (options.frames <= 0) throw InputError("--frames", "must be at least 1");
+  if (!options.save_frames.empty() && options.output.empty())
+    throw InputError("--save-frames", "needs --output (the frames are written beside it)");
+  for (int f : options.save_frames)
+    if (f < 0 || f >= options.frames)
+      throw InputError("--save-frames", fmt::format("frame {} is outside 0..{} (--frames {})", f,
+                                                    options.frames - 1, options.frames));
   if (options.max_bounces < 0)
     throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
   ImageRgb reference;
@@ -145,6 +158,23 @@ int run_render(const RenderOptions& options) {
   std::vector<glm::vec3> previous;  // last frame, for the temporal flicker metric
   std::vector<glm::vec4> frame_rgba;
   ImageRgb accumulated{settings.width, settings.height, {}};
+  // The current frame's image (the running mean with --accumulate) to --output or a
+  // --save-frames file, with the metadata that says which frame it is.
+  auto write_frame = [&](const std::string& path, int f) {
+    ImageRgb out = to_image(renderer);
+    if (accumulator) {
+      const std::vector<glm::vec4> mean = accumulator->read();
+      for (std::size_t i = 0; i < mean.size(); ++i) out.pixels[i] = glm::vec3(mean[i]);
+    }
+    write_output(path, out, cl,
+                 {{"scene", scene_path},
+                  {"spp", std::to_string(options.settings.spp)},
+                  {"seed", std::to_string(options.settings.seed)},
+                  {"frame", std::to_string(f)},
+                  {"accumulated_frames", std::to_string(accumulator ? f + 1 : 1)},
+                  {"render_time_ms", fmt::format("{:.3f}", totals.back())},
+                  {"guiding", options.guiding}});
+  };
   for (int f = 0; f < options.frames; ++f) {
     FrameStats stats = renderer.render_frame(f);
     totals.push_back(stats.time_ms["total"]);
@@ -189,26 +219,15 @@ int run_render(const RenderOptions& options) {
       }
     }
     frames.push_back(frame);
+    if (std::find(options.save_frames.begin(), options.save_frames.end(), f) !=
+        options.save_frames.end())
+      write_frame(frame_output_path(options.output, f), f);
     if (!options.common.quiet && options.frames > 1)
       std::printf("frame %d: %.1f ms%s\n", f, stats.time_ms["total"],
                   last_relmse >= 0.0 ? fmt::format(", relMSE {:.4g}", last_relmse).c_str() : "");
   }
 
-  if (!options.output.empty()) {
-    ImageRgb out = to_image(renderer);
-    if (accumulator) {
-      const std::vector<glm::vec4> mean = accumulator->read();
-      for (std::size_t i = 0; i < mean.size(); ++i) out.pixels[i] = glm::vec3(mean[i]);
-    }
-    write_output(options.output, out, cl,
-                 {{"scene", scene_path},
-                  {"spp", std::to_string(options.settings.spp)},
-                  {"seed", std::to_string(options.settings.seed)},
-                  {"frame", std::to_string(options.frames - 1)},
-                  {"accumulated_frames", std::to_string(accumulator ? options.frames : 1)},
-                  {"render_time_ms", fmt::format("{:.3f}", totals.back())},
-                  {"guiding", options.guiding}});
-  }
+  if (!options.output.empty()) write_frame(options.output, options.frames - 1);
   if (!options.stats_json.empty()) {
     const nlohmann::json stats = {
         {"scene", scene_path},

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "render/renderer.h"
 #include "rtpg/guider.h"
@@ -20,12 +21,13 @@ struct RenderOptions {
   CommonOptions common;
   RenderSettings settings;
   int frames = 1;
-  bool accumulate = false;      // output = running mean of all frames instead of the last one
-  int max_bounces = 0;          // 0 = the scene's integrator.max_bounces, else the default
-  std::string output;           // .exr or .png; "" = none
-  std::string reference;        // EXR to compute relMSE against
-  std::string stats_json;       // "" = none
-  std::string guiding = "pmm";  // "off" or "pmm"
+  bool accumulate = false;       // output = running mean of all frames instead of the last one
+  int max_bounces = 0;           // 0 = the scene's integrator.max_bounces, else the default
+  std::string output;            // .exr or .png; "" = none
+  std::vector<int> save_frames;  // also written beside `output` (frame_output_path)
+  std::string reference;         // EXR to compute relMSE against
+  std::string stats_json;        // "" = none
+  std::string guiding = "pmm";   // "off" or "pmm"
   GuidingConfig guiding_config;
   std::string train_memory = "auto";
 };
@@ -39,6 +41,10 @@ struct ReferenceOptions {
   int frame = 0;            // the camera path's frame to render
   std::string output;
 };
+
+// Where --save-frames writes frame `frame` of a render whose --output is `output`:
+// "dir/name.exr" -> "dir/name-f0007.exr".
+std::string frame_output_path(const std::string& output, int frame);
 
 int run_render(const RenderOptions& options);
 int run_reference(const ReferenceOptions& options);

@@ -117,6 +117,11 @@ int main(int argc, char** argv) {
       "BSDF sampling only (no next-event estimation)");
   render_cmd->add_option("-o,--output", render.output,
                          "Last frame: .exr (linear) or .png (tonemapped)");
+  render_cmd
+      ->add_option("--save-frames", render.save_frames,
+                   "Also write these frames (0-based, comma-separated) beside --output as "
+                   "NAME-fNNNN.EXT")
+      ->delimiter(',');
   render_cmd->add_option("--reference", render.reference, "Reference EXR: relMSE per frame");
   render_cmd->add_flag(
       "--accumulate", render.accumulate,

@@ -259,6 +259,16 @@ TEST_F(Cli, RejectsZeroFrames) {
   expect_rejected(render("--res 16x16 --frames 0"), "--frames");
 }
 
+TEST_F(Cli, RejectsSavedFrameOutsideTheRender) {
+  expect_rejected(render("--res 16x16 --frames 3 --save-frames 0,3"), "--save-frames",
+                  {"out.exr", "out-f0000.exr", "out-f0003.exr", "stats.json"});
+}
+
+TEST_F(Cli, RejectsSavedFramesWithoutOutput) {
+  expect_rejected("render --res 16x16 --spp 1 --guiding off --frames 2 --save-frames 1",
+                  "--save-frames", {"out-f0001.exr"});
+}
+
 TEST_F(Cli, RejectsNegativeMaxBounces) {
   expect_rejected(render("--res 16x16 --max-bounces -1"), "--max-bounces");
 }
@@ -429,6 +439,27 @@ TEST_F(Cli, StatisticsCarryRelMseAgainstReference) {
     const double relmse = frame["relmse"].get<double>();
     EXPECT_TRUE(std::isfinite(relmse) && relmse > 0.0) << relmse;
   }
+}
+
+TEST_F(Cli, SavesTheRequestedFramesBesideTheOutput) {
+  const RunResult r =
+      run_rtpg(dir(), "render --res 16x16 --frames 3 --seed 5 -q --save-frames 2,0 -o out.exr");
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  const auto files = snapshot(dir());
+  EXPECT_EQ(files.size(), 3u) << "out.exr, out-f0000.exr and out-f0002.exr only";
+  const ExrImage last = read_exr(dir() / "out.exr");
+  const ExrImage first = read_exr(dir() / "out-f0000.exr");
+  const ExrImage saved_last = read_exr(dir() / "out-f0002.exr");
+  ASSERT_EQ(first.pixels.size(), 16u * 16u * first.channels);
+  EXPECT_EQ(saved_last.pixels, last.pixels) << "frame 2 is the last frame";
+  EXPECT_NE(first.pixels, last.pixels) << "frame 0 has its own noise";
+  EXPECT_EQ(first.metadata.at("rtpg:frame"), "0");
+  EXPECT_EQ(saved_last.metadata.at("rtpg:frame"), "2");
+
+  // Frame 0 of a longer run is the image of a one-frame run with the same seed.
+  const RunResult one = run_rtpg(dir(), "render --res 16x16 --frames 1 --seed 5 -q -o one.exr");
+  ASSERT_EQ(one.exit_code, 0) << describe(one);
+  EXPECT_EQ(read_exr(dir() / "one.exr").pixels, first.pixels);
 }
 
 TEST_F(Cli, InfoCountsMatchTheSceneFile) {
