@@ -3,12 +3,14 @@
 guiding (PG), with official FLIP, plots and a Markdown report.
 
     python3 bench/experiments.py --quick            # CI-sized check of the pipeline (< 5 min)
-    python3 bench/experiments.py                    # full run (540p, 1024-spp references): hours
+    python3 bench/experiments.py                    # full run (960x540, 1024-spp references): ~1.5 h
     python3 bench/experiments.py --only equal_frame convergence --scenes cornell-indirect
+    python3 bench/experiments.py --scenes all       # also the scenes outside the default set
 
 Every experiment writes JSON (machine, commit, settings, every figure) and PNG plots into
 --out (default: build/bench-results); the report goes to --report (default docs/results/ for a
-full run, <out>/report for --quick).
+full run, <out>/report for --quick). References are cached in <out>/references, so a rerun of
+the same command renders only the experiments (bench/compare.py compares two runs).
 """
 import argparse
 import json
@@ -29,15 +31,25 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 ALL_SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza", "sponza-glossy",
               "sponza-sky"]
+METHODS = ("off", "pmm")
+LABEL = {"off": "PT", "pmm": "PG"}
 
+# res: equal frame, equal time, static convergence and flicker, against references of ref_spp.
+# T: training frames of the equal-frame comparison; sweep: other T (all from one static run of
+# max(sweep) frames per method, saved with --save-frames). path_*: convergence along the scene's
+# camera path, per-frame references of path_ref_spp. trade_res: trade-offs, against the main
+# reference box-filtered down (metrics.downsample_box).
 MODES = {
-    "quick": dict(res="48x32", ref_spp=64, frames=8, sweep=[2, 8], time_frames=6, repeats=2, conv_frames=8,
-                  path_frames=[0, 4], path_ref_spp=32, trade_res="48x32", trade_frames=8,
-                  scenes=["cornell-box", "cornell-indirect"]),
-    "full": dict(res="960x540", ref_spp=1024, frames=32, sweep=[1, 4, 8, 16, 32, 64], time_frames=48, repeats=3,
-                 conv_frames=64, path_frames=[0, 15, 30, 45, 59], path_ref_spp=256, trade_res="480x270",
-                 trade_frames=32, scenes=ALL_SCENES),
+    "quick": dict(res="48x32", ref_spp=64, T=8, sweep=[2, 8], time_frames=6, repeats=2, flicker_frames=4,
+                  path_res="24x16", path_frames=[1, 4], path_ref_spp=64, trade_res="24x16", trade_frames=8,
+                  scenes=["cornell-box", "cornell-indirect"], tradeoff_scenes=["cornell-indirect"]),
+    "full": dict(res="960x540", ref_spp=1024, T=32, sweep=[1, 4, 8, 16, 32, 64], time_frames=32, repeats=3,
+                 flicker_frames=24, path_res="480x270", path_frames=[7, 15, 31, 59], path_ref_spp=256,
+                 trade_res="480x270", trade_frames=32,
+                 scenes=["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza"],
+                 tradeoff_scenes=["cornell-indirect", "sponza"]),
 }
+LAST = 8  # equal-frame and trade-off errors: mean over the last 8 frames of a run
 
 
 def available(scene):
@@ -51,13 +63,17 @@ def available(scene):
         return False, str(e).splitlines()[-1]
 
 
-def last_frames_error(stats, key="relmse", count=8):
-    values = [f[key] for f in stats["frames"] if key in f]
-    return statistics.mean(values[-count:]) if values else float("nan")
+def mean_sem(values):
+    """Mean and its standard error (frames of one run have independent noise)."""
+    values = list(values)
+    sem = statistics.stdev(values) / len(values) ** 0.5 if len(values) > 1 else float("nan")
+    return statistics.mean(values), sem
 
 
-def median_time(stats, key="total"):
-    return statistics.median(f["time_ms"].get(key, 0.0) for f in stats["frames"][1:] or stats["frames"])
+def median_frame_ms(stats, key="total"):
+    """Median over frames; frame 0 is left out (it builds programs and warms caches)."""
+    frames = stats["frames"][1:] or stats["frames"]
+    return statistics.median(f["time_ms"].get(key, 0.0) for f in frames)
 
 
 def crop_box(err_map, size):
@@ -77,37 +93,62 @@ def crop_box(err_map, size):
     return y0, x0, s
 
 
+def saved_frame(image_path, frame):
+    return Path(image_path).with_name(f"{Path(image_path).stem}-f{frame:04d}{Path(image_path).suffix}")
+
+
+def static_run(ctx, scene, method):
+    """The static-camera run shared by equal_frame and convergence: max(sweep, T) frames at 1 spp
+    with relMSE per frame, and the frames of the sweep saved as EXR. Rendered once per scene."""
+    key = (scene, method)
+    if key not in ctx.static_runs:
+        m = ctx.mode
+        frames = max(m["sweep"] + [m["T"]])
+        saved = sorted({t - 1 for t in m["sweep"] + [m["T"]]})
+        out = ctx.out / "static" / scene
+        stats, image = runner.render(scene, m["res"], frames, method, out, method,
+                                     reference=ctx.reference(scene, m["res"]),
+                                     extra=["--save-frames", ",".join(map(str, saved))])
+        ctx.static_runs[key] = (stats, {t: saved_frame(image, t - 1) for t in m["sweep"] + [m["T"]]})
+    return ctx.static_runs[key]
+
+
 def equal_frame(ctx, scene):
-    """PT vs PG at 1 spp after T training frames, FLIP and relMSE, images with zoomed crops."""
+    """PT vs PG at 1 spp after T training frames, FLIP and relMSE, images with zoomed crops; the
+    sweep over T comes from the same runs."""
     m = ctx.mode
-    ref_path = ctx.refs.get(scene, m["res"], m["ref_spp"])
-    ref = metrics.load_exr(ref_path)
+    T = m["T"]
+    ref = ctx.reference_image(scene, m["res"])
     out = ctx.out / "equal_frame" / scene
-    result = {"scene": scene, "reference": str(ref_path), "T": m["frames"], "methods": {}, "sweep": {}}
+    out.mkdir(parents=True, exist_ok=True)
+    result = {"scene": scene, "reference": str(ctx.reference(scene, m["res"])), "T": T, "methods": {}, "sweep": {}}
     images = {}
-    for method in ("off", "pmm"):
-        stats, img_path = runner.render(scene, m["res"], m["frames"], method, out, f"{method}-T{m['frames']}",
-                                        reference=ref_path)
-        img = metrics.load_exr(img_path)
+    for method in METHODS:
+        stats, frames = static_run(ctx, scene, method)
+        img = metrics.load_exr(frames[T])
         images[method] = img
+        window = [f["relmse"] for f in stats["frames"][T - LAST:T]]
+        mean, sem = mean_sem(window)
         result["methods"][method] = {
-            "relmse": metrics.relmse(img, ref), "relmse_last8": last_frames_error(stats),
+            "relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
             "flip_ldr": metrics.flip_ldr(img, ref), "flip_hdr": metrics.flip_hdr(img, ref),
-            "frame_ms": median_time(stats), "nonfinite": sum(f["nonfinite_samples"] for f in stats["frames"]),
-            "time_ms": {k: statistics.median(f["time_ms"].get(k, 0.0) for f in stats["frames"][1:])
+            "frame_ms": median_frame_ms(stats), "nonfinite": sum(f["nonfinite_samples"] for f in stats["frames"]),
+            "time_ms": {k: statistics.median(f["time_ms"].get(k, 0.0) for f in stats["frames"][1:] or stats["frames"])
                         for k in stats["frames"][-1]["time_ms"]},
         }
+        for key in ("guided_fraction", "trained_fraction", "mean_pi"):
+            if key in stats["frames"][T - 1]:
+                result["methods"][method][key] = stats["frames"][T - 1][key]
     for t in m["sweep"]:
         row = {}
-        for method in ("off", "pmm"):
-            stats, img_path = runner.render(scene, m["res"], t, method, out, f"{method}-T{t}", reference=ref_path)
-            img = metrics.load_exr(img_path)
+        for method in METHODS:
+            img = metrics.load_exr(static_run(ctx, scene, method)[1][t])
             row[method] = {"relmse": metrics.relmse(img, ref), "flip_ldr": metrics.flip_ldr(img, ref)}
         result["sweep"][str(t)] = row
     # Figure: reference, PT, PG, each with a zoomed crop where PT's error is largest.
     err = np.mean((images["off"] - ref) ** 2 / (ref ** 2 + 0.01), axis=2)
     y0, x0, s = crop_box(err, max(16, min(ref.shape[:2]) // 3))
-    fig, axes = plt.subplots(2, 3, figsize=(9, 6))
+    fig, axes = plt.subplots(2, 3, figsize=(12, 8) if ref.shape[1] > 400 else (9, 6))
     for col, (name, img) in enumerate((("Reference", ref), ("PT 1 spp", images["off"]), ("PG 1 spp", images["pmm"]))):
         tm = metrics.tonemap_srgb(img)
         axes[0, col].imshow(tm)
@@ -117,7 +158,7 @@ def equal_frame(ctx, scene):
         axes[1, col].imshow(tm[y0:y0 + s, x0:x0 + s], interpolation="nearest")
         for a in axes[:, col]:
             a.axis("off")
-    fig.suptitle(f"{scene}: 1 spp after {m['frames']} frames")
+    fig.suptitle(f"{scene}: 1 spp after {T} frames ({m['res']})")
     fig.tight_layout()
     fig.savefig(out / "comparison.png", dpi=100)
     plt.close(fig)
@@ -126,68 +167,93 @@ def equal_frame(ctx, scene):
 
 
 def equal_time(ctx, scene):
-    """Error of the accumulated image against cumulative wall time, both methods, same run."""
+    """Error of the accumulated image against cumulative wall time, both methods, same run,
+    medians over repeats with different seeds."""
     m = ctx.mode
-    ref_path = ctx.refs.get(scene, m["res"], m["ref_spp"])
+    ref_path = ctx.reference(scene, m["res"])
     out = ctx.out / "equal_time" / scene
     curves = {}
-    for method in ("off", "pmm"):
+    for method in METHODS:
         runs = []
         for r in range(m["repeats"]):
             stats, _ = runner.render(scene, m["res"], m["time_frames"], method, out, f"{method}-r{r}",
                                      reference=ref_path, extra=["--accumulate", "--seed", 100 + r])
-            t = np.cumsum([f["time_ms"]["total"] for f in stats["frames"]])
-            e = [f["relmse_accumulated"] for f in stats["frames"]]
-            runs.append((t, e))
-        t_med = np.median([r[0] for r in runs], axis=0)
-        e_med = np.median([r[1] for r in runs], axis=0)
-        curves[method] = {"time_ms": t_med.tolist(), "relmse": e_med.tolist()}
+            ms = [f["time_ms"]["total"] for f in stats["frames"]]
+            # Frame 0 also builds the OpenCL programs (from the disk cache) and compiles
+            # work-group functions: a one-time start-up cost, replaced by a typical frame.
+            ms[0] = statistics.median(ms[1:]) if len(ms) > 1 else ms[0]
+            runs.append((np.cumsum(ms), [f["relmse_accumulated"] for f in stats["frames"]]))
+        curves[method] = {"time_ms": np.median([r[0] for r in runs], axis=0).tolist(),
+                          "relmse": np.median([r[1] for r in runs], axis=0).tolist(),
+                          "final_relmse_runs": [r[1][-1] for r in runs]}
     fig, ax = plt.subplots(figsize=(5, 4))
     for method, c in curves.items():
-        ax.loglog(c["time_ms"], c["relmse"], label="PT" if method == "off" else "PG")
+        ax.loglog(c["time_ms"], c["relmse"], label=LABEL[method])
     ax.set_xlabel("wall time (ms, cumulative)")
     ax.set_ylabel("relMSE of the accumulated image")
-    ax.set_title(f"{scene}: equal time")
+    ax.set_title(f"{scene}: equal time ({m['res']})")
     ax.legend()
     fig.tight_layout()
     fig.savefig(out / "equal_time.png", dpi=100)
     plt.close(fig)
-    # Error each method reaches at the time budget PT needs for all its frames.
+    # The error each method reaches within PT's time for all its frames, and the time each
+    # needs to reach the error PT ends with (ratio PG/PT: below 1, guiding pays for itself).
     budget = curves["off"]["time_ms"][-1]
     at_budget = {k: float(np.interp(budget, c["time_ms"], c["relmse"])) for k, c in curves.items()}
-    return {"scene": scene, "curves": curves, "relmse_at_pt_budget": at_budget, "figure": str(out / "equal_time.png")}
+    target = curves["off"]["relmse"][-1]
+    pg_time = metrics.time_to_reach(curves["pmm"]["time_ms"], curves["pmm"]["relmse"], target)
+    return {"scene": scene, "curves": curves, "relmse_at_pt_budget": at_budget,
+            "pt_time_ms": budget, "pg_time_to_pt_error_ms": pg_time,
+            "time_ratio_pg_pt": (pg_time / budget) if pg_time else None, "figure": str(out / "equal_time.png")}
+
+
+def flicker(ctx, scene):
+    """Temporal flicker (DESIGN.md 5): mean MSE between consecutive frames of a static camera
+    with jitter off, over the last 8 frame pairs of a run (PG has trained by then)."""
+    m = ctx.mode
+    out = ctx.out / "flicker" / scene
+    result = {"scene": scene, "frames": m["flicker_frames"], "methods": {}}
+    for method in METHODS:
+        stats, _ = runner.render(scene, m["res"], m["flicker_frames"], method, out, method, extra=["--no-jitter"])
+        values = [f["flicker_mse"] for f in stats["frames"] if "flicker_mse" in f][-LAST:]
+        mean, sem = mean_sem(values)
+        result["methods"][method] = {"flicker_mse": mean, "sem": sem}
+    return result
 
 
 def convergence(ctx, scene):
-    """relMSE of the 1-spp frame against frame index: static camera, and along the camera path."""
+    """relMSE of the 1-spp frame against frame index: static camera (every frame), and at
+    checkpoints along the scene's first camera path (per-frame references)."""
     m = ctx.mode
-    ref_path = ctx.refs.get(scene, m["res"], m["ref_spp"])
     out = ctx.out / "convergence" / scene
-    result = {"scene": scene, "static": {}, "path": {}}
-    for method in ("off", "pmm"):
-        stats, _ = runner.render(scene, m["res"], m["conv_frames"], method, out, f"static-{method}", reference=ref_path)
-        result["static"][method] = [f["relmse"] for f in stats["frames"]]
+    result = {"scene": scene, "static": {}, "path": {}, "res": m["res"], "path_res": m["path_res"]}
+    for method in METHODS:
+        result["static"][method] = [f["relmse"] for f in static_run(ctx, scene, method)[0]["frames"]]
     paths = json.loads(Path(runner.scene_path(scene)).read_text()).get("camera_paths", {})
     if paths:
         name = sorted(paths)[0]
         result["path_name"] = name
-        for method in ("off", "pmm"):
-            errors = []
-            for frame in m["path_frames"]:
-                ref = ctx.refs.get(scene, m["res"], m["path_ref_spp"], camera_path=name, frame=frame)
-                stats, _ = runner.render(scene, m["res"], frame + 1, method, out, f"path-{method}-{frame}",
-                                         reference=ref, extra=["--camera-path", name])
-                errors.append(stats["frames"][-1]["relmse"])
-            result["path"][method] = {"frames": m["path_frames"], "relmse": errors}
-    fig, ax = plt.subplots(figsize=(5, 4))
+        refs = {f: metrics.load_exr(ctx.refs.get(scene, m["path_res"], m["path_ref_spp"], camera_path=name, frame=f))
+                for f in m["path_frames"]}
+        for method in METHODS:
+            _, image = runner.render(scene, m["path_res"], max(m["path_frames"]) + 1, method, out, f"path-{method}",
+                                     extra=["--camera-path", name, "--save-frames", ",".join(map(str, m["path_frames"]))])
+            imgs = {f: metrics.load_exr(saved_frame(image, f)) for f in m["path_frames"]}
+            result["path"][method] = {"frames": m["path_frames"],
+                                      "relmse": [metrics.relmse(imgs[f], refs[f]) for f in m["path_frames"]],
+                                      "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f]) for f in m["path_frames"]]}
+    fig, axes = plt.subplots(1, 2 if paths else 1, figsize=(10 if paths else 5, 4), squeeze=False)
     for method, e in result["static"].items():
-        ax.semilogy(e, label=("PT" if method == "off" else "PG") + " static")
+        axes[0, 0].semilogy(e, label=LABEL[method])
+    axes[0, 0].set_title(f"{scene}: static camera ({m['res']})", fontsize=9)
     for method, p in result["path"].items():
-        ax.semilogy(p["frames"], p["relmse"], "o--", label=("PT" if method == "off" else "PG") + " camera path")
-    ax.set_xlabel("frame")
-    ax.set_ylabel("relMSE of the 1-spp frame")
-    ax.set_title(f"{scene}: convergence")
-    ax.legend(fontsize=8)
+        axes[0, 1].semilogy(p["frames"], p["relmse"], "o--", label=LABEL[method])
+    if paths:
+        axes[0, 1].set_title(f"camera path '{result['path_name']}' ({m['path_res']})", fontsize=9)
+    for ax in axes[0]:
+        ax.set_xlabel("frame")
+        ax.set_ylabel("relMSE of the 1-spp frame")
+        ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out / "convergence.png", dpi=100)
     plt.close(fig)
@@ -210,27 +276,30 @@ TRADEOFFS = {
 def tradeoffs(ctx, scene):
     """Time against error for the N schedule, kMax and the tile/apron size."""
     m = ctx.mode
-    ref_path = ctx.refs.get(scene, m["trade_res"], m["ref_spp"])
+    ref = ctx.reference_image(scene, m["trade_res"])
     out = ctx.out / "tradeoffs" / scene
+    last = ",".join(str(f) for f in range(m["trade_frames"] - LAST, m["trade_frames"]))
     rows = {}
-    stats, _ = runner.render(scene, m["trade_res"], m["trade_frames"], "off", out, "pt", reference=ref_path)
-    rows["PT (no guiding)"] = {"train_ms": 0.0, "frame_ms": median_time(stats), "relmse_last8": last_frames_error(stats)}
-    for i, (name, flags) in enumerate(TRADEOFFS.items()):
-        stats, _ = runner.render(scene, m["trade_res"], m["trade_frames"], "pmm", out, f"v{i}", reference=ref_path,
-                                 extra=flags)
-        rows[name] = {"train_ms": median_time(stats, "train"), "frame_ms": median_time(stats),
-                      "relmse_last8": last_frames_error(stats)}
+    for name, method, flags in [("PT (no guiding)", "off", [])] + [(n, "pmm", f) for n, f in TRADEOFFS.items()]:
+        tag = f"v{len(rows)}"
+        stats, image = runner.render(scene, m["trade_res"], m["trade_frames"], method, out, tag,
+                                     extra=flags + ["--save-frames", last])
+        errors = [metrics.relmse(metrics.load_exr(saved_frame(image, f)), ref)
+                  for f in range(m["trade_frames"] - LAST, m["trade_frames"])]
+        mean, sem = mean_sem(errors)
+        rows[name] = {"train_ms": median_frame_ms(stats, "train"), "frame_ms": median_frame_ms(stats),
+                      "relmse_last8": mean, "relmse_last8_sem": sem, "flags": [str(f) for f in flags]}
     fig, ax = plt.subplots(figsize=(6, 4))
     for name, r in rows.items():
-        ax.scatter(r["train_ms"], r["relmse_last8"])
+        ax.errorbar(r["train_ms"], r["relmse_last8"], yerr=r["relmse_last8_sem"], fmt="o")
         ax.annotate(name, (r["train_ms"], r["relmse_last8"]), fontsize=7)
     ax.set_xlabel("train kernel time (ms, median)")
     ax.set_ylabel("relMSE, mean of the last 8 frames")
-    ax.set_title(f"{scene}: trade-offs")
+    ax.set_title(f"{scene}: trade-offs ({m['trade_res']})")
     fig.tight_layout()
     fig.savefig(out / "tradeoffs.png", dpi=100)
     plt.close(fig)
-    return {"scene": scene, "rows": rows, "figure": str(out / "tradeoffs.png")}
+    return {"scene": scene, "res": m["trade_res"], "rows": rows, "figure": str(out / "tradeoffs.png")}
 
 
 def kernels(ctx, _scene=None):
@@ -256,8 +325,13 @@ def kernels(ctx, _scene=None):
     return {"benchmarks": rows}
 
 
-EXPERIMENTS = {"equal_frame": equal_frame, "equal_time": equal_time, "convergence": convergence,
+EXPERIMENTS = {"equal_frame": equal_frame, "equal_time": equal_time, "flicker": flicker, "convergence": convergence,
                "tradeoffs": tradeoffs, "kernels": kernels}
+
+
+def parse_res(res):
+    w, h = res.split("x")
+    return int(w), int(h)
 
 
 class Context:
@@ -267,6 +341,28 @@ class Context:
         self.out = Path(args.out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.refs = runner.ReferenceCache(self.out / "references")
+        self.static_runs = {}
+        self._images = {}
+
+    def reference(self, scene, res):
+        """The cached reference of the mode's main resolution (rendered on first use)."""
+        assert res == self.mode["res"], res
+        return self.refs.get(scene, res, self.mode["ref_spp"])
+
+    def reference_image(self, scene, res):
+        """The reference at `res`: the main one, or the main one box-filtered down by an integer
+        factor (an unbiased reference for the smaller image, metrics.downsample_box)."""
+        key = (scene, res)
+        if key not in self._images:
+            (w, h), (mw, mh) = parse_res(res), parse_res(self.mode["res"])
+            main = metrics.load_exr(self.reference(scene, self.mode["res"]))
+            if (w, h) == (mw, mh):
+                self._images[key] = main
+            elif mw % w == 0 and mw // w == mh // h and mh % h == 0:
+                self._images[key] = metrics.downsample_box(main, mw // w)
+            else:
+                raise ValueError(f"{res} is not the main resolution {self.mode['res']} divided by an integer")
+        return self._images[key]
 
 
 def main():
@@ -275,20 +371,16 @@ def main():
     ap.add_argument("--out", default=str(runner.ROOT / "build" / "bench-results"))
     ap.add_argument("--report", default=None, help="folder of the Markdown report")
     ap.add_argument("--only", nargs="*", choices=list(EXPERIMENTS), default=list(EXPERIMENTS))
-    ap.add_argument("--scenes", nargs="*", default=None)
-    ap.add_argument("--res", help="override the mode's resolution (WxH); the report states it")
-    ap.add_argument("--ref-spp", type=int, help="override the references' samples per pixel")
+    ap.add_argument("--scenes", nargs="*", default=None, help="scene names, or 'all' (%s)" % ", ".join(ALL_SCENES))
     args = ap.parse_args()
     ctx = Context(args)
-    overrides = {}
-    if args.res:
-        ctx.mode["res"] = ctx.mode["trade_res"] = overrides["res"] = args.res
-    if args.ref_spp:
-        ctx.mode["ref_spp"] = overrides["ref_spp"] = args.ref_spp
-    scenes = args.scenes or ctx.mode["scenes"]
+    scenes = ALL_SCENES if args.scenes == ["all"] else (args.scenes or ctx.mode["scenes"])
+    command = "python3 bench/experiments.py" + (" --quick" if args.quick else "") + \
+        (f" --only {' '.join(args.only)}" if args.only != list(EXPERIMENTS) else "") + \
+        (f" --scenes {' '.join(args.scenes)}" if args.scenes else "")
     results = {"machine": runner.machine_info(), "mode": "quick" if args.quick else "full", "settings": ctx.mode,
-               "overrides": overrides, "started": time.strftime("%Y-%m-%d %H:%M:%S"), "skipped_scenes": {},
-               "experiments": {}}
+               "command": command, "started": time.strftime("%Y-%m-%d %H:%M:%S"), "skipped_scenes": {},
+               "experiments": {}, "seconds": {}}
     usable = []
     for s in scenes:
         ok, why = available(s)
@@ -303,9 +395,12 @@ def main():
         if name == "kernels":
             results["experiments"][name] = fn(ctx)
         else:
-            scene_list = usable if name != "tradeoffs" else [s for s in usable if s in ("cornell-indirect", "sponza")] or usable[:1]
-            results["experiments"][name] = {s: fn(ctx, s) for s in scene_list}
-        print(f"{name}: {time.time() - t0:.1f} s", file=sys.stderr)
+            scene_list = usable if name != "tradeoffs" else [s for s in usable if s in ctx.mode["tradeoff_scenes"]]
+            results["experiments"][name] = {}
+            for s in scene_list:
+                results["experiments"][name][s] = fn(ctx, s)
+                print(f"{name} {s}: {time.time() - t0:.0f} s", file=sys.stderr, flush=True)
+        results["seconds"][name] = round(time.time() - t0, 1)
         (ctx.out / "results.json").write_text(json.dumps(results, indent=2))
     results["finished"] = time.strftime("%Y-%m-%d %H:%M:%S")
     (ctx.out / "results.json").write_text(json.dumps(results, indent=2))

@@ -54,3 +54,29 @@ def flicker(frames):
     if len(frames) < 2:
         return 0.0
     return float(np.mean([np.mean((a.astype(np.float64) - b) ** 2) for a, b in zip(frames[1:], frames[:-1])]))
+
+
+def downsample_box(image, factor):
+    """Mean of each factor x factor block. rtpg's pixel filter is a box (uniform sub-pixel jitter
+    through a pinhole camera, linear in raster position), so the block mean of a reference at
+    (f W) x (f H) is an unbiased reference at W x H with f^2 times its samples per pixel."""
+    image = np.asarray(image, dtype=np.float64)
+    h, w = image.shape[0] // factor, image.shape[1] // factor
+    if h * factor != image.shape[0] or w * factor != image.shape[1]:
+        raise ValueError(f"{image.shape[1]}x{image.shape[0]} is not a multiple of {factor}")
+    return image.reshape(h, factor, w, factor, -1).mean(axis=(1, 3)).astype(np.float32)
+
+
+def time_to_reach(times, errors, target):
+    """First time at which a decreasing error curve reaches `target`, interpolated linearly in
+    log-log between samples; None when the curve never gets there."""
+    times = np.asarray(times, dtype=np.float64)
+    errors = np.asarray(errors, dtype=np.float64)
+    if errors[0] <= target:
+        return float(times[0])
+    for i in range(1, len(errors)):
+        if errors[i] <= target:
+            lt0, lt1 = np.log(times[i - 1]), np.log(times[i])
+            le0, le1, lt = np.log(errors[i - 1]), np.log(errors[i]), np.log(target)
+            return float(np.exp(lt0 + (lt - le0) * (lt1 - lt0) / (le1 - le0)))
+    return None

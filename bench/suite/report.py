@@ -13,95 +13,178 @@ def _copy_figure(src, report_dir, name):
     return f"figures/{name}"
 
 
+def _ms(value):
+    return f"{value / 1e3:.1f} s" if value >= 1e4 else f"{value:.3g} ms"
+
+
+def verdict(pt_mean, pt_sem, pg_mean, pg_sem):
+    """Better / worse when the difference of the means exceeds 3 combined standard errors."""
+    gap = 3.0 * (pt_sem ** 2 + pg_sem ** 2) ** 0.5
+    if pg_mean < pt_mean - gap:
+        return "PG better"
+    if pg_mean > pt_mean + gap:
+        return "PT better"
+    return "no significant difference"
+
+
+def _equal_frame(ex, report_dir):
+    lines = ["## Equal frame: 1 spp after T frames (paper, figure 3)", "",
+             "| scene | PT FLIP | PG FLIP | ratio | relMSE ratio | frame time PT | frame time PG | guiding overhead |",
+             "|---|---|---|---|---|---|---|---|"]
+    for scene, r in ex.items():
+        pt, pg = r["methods"]["off"], r["methods"]["pmm"]
+        lines.append(
+            f"| {scene} | {pt['flip_ldr']:.3f} | {pg['flip_ldr']:.3f} | {pt['flip_ldr'] / max(pg['flip_ldr'], 1e-9):.2f}x "
+            f"| {pg['relmse_last8'] / max(pt['relmse_last8'], 1e-12):.2f} | {_ms(pt['frame_ms'])} | {_ms(pg['frame_ms'])} "
+            f"| {100.0 * (pg['frame_ms'] - pt['frame_ms']) / max(pt['frame_ms'], 1e-9):+.0f}% |")
+    lines += ["", "FLIP: mean LDR-FLIP of frame T (tonemapped as rtpg's PNG output); ratio = PT/PG (above 1: "
+              "guiding is better). relMSE ratio = PG/PT of the mean relMSE of frames T-7..T (below 1: guiding is "
+              "better). Frame times: medians over the frames of the run (frame 0 left out); overhead = (PG - PT) / PT.",
+              "", "| scene | HDR-FLIP PT | HDR-FLIP PG | relMSE PT (± s.e.) | relMSE PG (± s.e.) | verdict | guided pixels | mean pi |",
+              "|---|---|---|---|---|---|---|---|"]
+    for scene, r in ex.items():
+        pt, pg = r["methods"]["off"], r["methods"]["pmm"]
+        lines.append(f"| {scene} | {pt['flip_hdr']:.3f} | {pg['flip_hdr']:.3f} "
+                     f"| {pt['relmse_last8']:.4g} ± {pt['relmse_last8_sem']:.2g} "
+                     f"| {pg['relmse_last8']:.4g} ± {pg['relmse_last8_sem']:.2g} "
+                     f"| {verdict(pt['relmse_last8'], pt['relmse_last8_sem'], pg['relmse_last8'], pg['relmse_last8_sem'])} "
+                     f"| {pg.get('guided_fraction', float('nan')):.2f} | {pg.get('mean_pi', float('nan')):.2f} |")
+    lines += ["", "Verdict: the difference of the relMSE means against three combined standard errors (the 8 "
+              "frames have independent noise). Guided pixels: share of surface pixels that sampled a trained "
+              "mixture at frame T; mean pi: their mean Gaussian weight.", ""]
+    for scene, r in ex.items():
+        fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-comparison.png")
+        if fig:
+            lines += [f"![{scene}]({fig})", ""]
+    lines += ["Training sweep (relMSE and LDR-FLIP of the frame after T frames; one run per method, frames saved "
+              "with `--save-frames`):", "", "| scene | T | relMSE PT | relMSE PG | FLIP PT | FLIP PG |",
+              "|---|---|---|---|---|---|"]
+    for scene, r in ex.items():
+        for t, row in r["sweep"].items():
+            lines.append(f"| {scene} | {t} | {row['off']['relmse']:.4g} | {row['pmm']['relmse']:.4g} "
+                         f"| {row['off']['flip_ldr']:.3f} | {row['pmm']['flip_ldr']:.3f} |")
+    return lines + [""]
+
+
+def _equal_time(ex, report_dir, settings):
+    lines = ["## Equal time: error of the accumulated image against wall time", "",
+             f"{settings['time_frames']} accumulated frames per method, medians over {settings['repeats']} runs "
+             "(seeds 100, 101, ...) in the same process tree; frame 0's one-time program build is replaced by the "
+             "median frame time.", "",
+             "| scene | PT time | relMSE PT at PT's time | relMSE PG at the same time | PG time to PT's final error |",
+             "|---|---|---|---|---|"]
+    for scene, r in ex.items():
+        b = r["relmse_at_pt_budget"]
+        ratio = r.get("time_ratio_pg_pt")
+        lines.append(f"| {scene} | {_ms(r.get('pt_time_ms', float('nan')))} | {b['off']:.4g} | {b['pmm']:.4g} "
+                     f"| {f'{ratio:.2f}x PT time' if ratio else 'not reached'} |")
+    lines += ["", "Last column below 1x: guiding reaches PT's error sooner (it pays for its cost); above 1x or "
+              "'not reached' (within the frames rendered): PT is the better use of the time on this machine.", ""]
+    for scene, r in ex.items():
+        fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-equal-time.png")
+        if fig:
+            lines += [f"![{scene} equal time]({fig})", ""]
+    return lines
+
+
+def _flicker(ex, settings):
+    lines = ["## Temporal flicker (static camera, jitter off)", "",
+             f"Mean MSE between consecutive 1-spp frames, over the last {min(8, settings['flicker_frames'] - 1)} "
+             f"frame pairs of {settings['flicker_frames']} frames "
+             "(DESIGN.md section 5; the paper's flicker claim is for SVGF output, which comes later).", "",
+             "| scene | flicker PT | flicker PG | PG/PT |", "|---|---|---|---|"]
+    for scene, r in ex.items():
+        pt, pg = r["methods"]["off"], r["methods"]["pmm"]
+        lines.append(f"| {scene} | {pt['flicker_mse']:.4g} ± {pt['sem']:.2g} | {pg['flicker_mse']:.4g} ± {pg['sem']:.2g} "
+                     f"| {pg['flicker_mse'] / max(pt['flicker_mse'], 1e-30):.2f} |")
+    return lines + [""]
+
+
+def _convergence(ex, report_dir, settings):
+    lines = ["## Convergence: relMSE of the 1-spp frame against frame index", "",
+             f"Static camera at {settings['res']} (every frame, against the main reference) and along the scene's "
+             f"camera path at {settings['path_res']} (frames {settings['path_frames']}, against per-frame references "
+             f"of {settings['path_ref_spp']} spp: their own variance adds about 1/{settings['path_ref_spp']} of a "
+             "1-spp frame's).", "",
+             "| scene | static PT frame 0 -> last | static PG frame 0 -> last | path | path relMSE PG/PT per checkpoint |",
+             "|---|---|---|---|---|"]
+    for scene, r in ex.items():
+        s, p = r["static"], r.get("path", {})
+        ratios = ""
+        if p:
+            ratios = ", ".join(f"f{f}: {g / max(o, 1e-12):.2f}"
+                               for f, o, g in zip(p["off"]["frames"], p["off"]["relmse"], p["pmm"]["relmse"]))
+        lines.append(f"| {scene} | {s['off'][0]:.4g} -> {s['off'][-1]:.4g} | {s['pmm'][0]:.4g} -> {s['pmm'][-1]:.4g} "
+                     f"| {r.get('path_name', '-')} | {ratios} |")
+    lines.append("")
+    for scene, r in ex.items():
+        fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-convergence.png")
+        if fig:
+            lines += [f"![{scene} convergence]({fig})", ""]
+    return lines
+
+
+def _tradeoffs(ex, report_dir):
+    lines = ["## Trade-offs: train time against error", ""]
+    for scene, r in ex.items():
+        lines += [f"{scene} ({r.get('res', '?')}, reference: the main one box-filtered down):", "",
+                  "| variant | train ms | frame ms | relMSE (last 8, ± s.e.) |", "|---|---|---|---|"]
+        for name, row in r["rows"].items():
+            lines.append(f"| {name} | {row['train_ms']:.2f} | {row['frame_ms']:.1f} "
+                         f"| {row['relmse_last8']:.4g} ± {row.get('relmse_last8_sem', float('nan')):.2g} |")
+        fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-tradeoffs.png")
+        lines += ["", f"![{scene} trade-offs]({fig})" if fig else "", ""]
+    return lines
+
+
+def _kernels(k):
+    lines = ["## Kernel microbenchmarks (bench/bench_guiding_kernels)", ""]
+    if "skipped" in k:
+        return lines + [f"Skipped: {k['skipped']}", ""]
+    lines += ["| benchmark | time | counters |", "|---|---|---|"]
+    for b in k["benchmarks"]:
+        counters = ", ".join(f"{n}={v:.3g}" for n, v in b.items()
+                             if n not in ("name", "real_time", "time_unit", "cpu_time", "iterations"))
+        lines.append(f"| {b['name']} | {b.get('real_time', 0):.3g} {b.get('time_unit', '')} | {counters} |")
+    return lines + [""]
+
+
 def write(results, report_dir):
     report_dir = Path(report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
     m = results["machine"]
+    st = results["settings"]
     ex = results["experiments"]
     lines = [
         "# rtpg benchmark report",
         "",
-        f"Mode: **{results['mode']}** ({results['settings']['res']}, references of "
-        f"{results['settings']['ref_spp']} spp, T = {results['settings']['frames']} training frames). "
-        f"Generated by `python3 bench/experiments.py{' --quick' if results['mode'] == 'quick' else ''}"
-        f"{''.join(f' --{k.replace(chr(95), chr(45))} {v}' for k, v in results.get('overrides', {}).items())}` "
-        f"from {results.get('started', '?')} to {results.get('finished', '?')}.",
-        "",
-        ("**Not the full configuration**: settings overridden on the command line: "
-         + ", ".join(f"{k} = {v}" for k, v in results["overrides"].items()) + ".") if results.get("overrides") else "",
+        f"Mode: **{results['mode']}** ({st['res']}, references of {st['ref_spp']} spp, T = {st['T']} training "
+        f"frames). Generated by `{results.get('command', 'python3 bench/experiments.py')}` from "
+        f"{results.get('started', '?')} to {results.get('finished', '?')}"
+        + (" (seconds per experiment: " + ", ".join(f"{k} {v:.0f}" for k, v in results["seconds"].items()) + ")"
+           if results.get("seconds") else "") + ".",
         "",
         f"Machine: {m.get('cpu', '?')}, {m.get('cores', '?')} cores; OpenCL: {'; '.join(m.get('devices', []))}. "
         f"Commit `{m.get('git_commit', '?')}`{' (with uncommitted renderer changes)' if m.get('git_dirty') else ''}.",
+        "",
+        "PT = plain path tracing (BSDF sampling at the first bounce), PG = PMM path guiding (`--guiding pmm`), both "
+        "with next-event estimation and MIS, 1 sample per pixel per frame. relMSE = mean of (I - R)^2 / (R^2 + 0.01) "
+        "on linear radiance; FLIP = NVIDIA's flip-evaluator.",
         "",
     ]
     if results.get("skipped_scenes"):
         lines += ["Skipped scenes: " + ", ".join(f"{k} ({v})" for k, v in results["skipped_scenes"].items()), ""]
     if "equal_frame" in ex:
-        lines += ["## Equal frame: 1 spp after T frames (paper, figure 3)", "",
-                  "| scene | PT FLIP | PG FLIP | ratio | relMSE ratio | frame time PT | frame time PG | guiding overhead |",
-                  "|---|---|---|---|---|---|---|---|"]
-        for scene, r in ex["equal_frame"].items():
-            pt, pg = r["methods"]["off"], r["methods"]["pmm"]
-            lines.append(
-                f"| {scene} | {pt['flip_ldr']:.3f} | {pg['flip_ldr']:.3f} | {pt['flip_ldr'] / max(pg['flip_ldr'], 1e-9):.2f}x "
-                f"| {pg['relmse_last8'] / max(pt['relmse_last8'], 1e-12):.2f} | {pt['frame_ms']:.1f} ms | {pg['frame_ms']:.1f} ms "
-                f"| {100.0 * (pg['frame_ms'] - pt['frame_ms']) / max(pt['frame_ms'], 1e-9):+.0f}% |")
-        lines += ["", "FLIP: mean LDR-FLIP of the last frame (tonemapped as rtpg's PNG output); ratio = PT/PG "
-                  "(above 1: guiding is better). relMSE ratio = PG/PT over the last 8 frames (below 1: guiding "
-                  "is better). Overhead = (PG - PT) / PT frame time, medians.", ""]
-        lines += ["| scene | HDR-FLIP PT | HDR-FLIP PG | relMSE PT | relMSE PG |", "|---|---|---|---|---|"]
-        for scene, r in ex["equal_frame"].items():
-            pt, pg = r["methods"]["off"], r["methods"]["pmm"]
-            lines.append(f"| {scene} | {pt['flip_hdr']:.3f} | {pg['flip_hdr']:.3f} | {pt['relmse_last8']:.4g} | {pg['relmse_last8']:.4g} |")
-        lines.append("")
-        for scene, r in ex["equal_frame"].items():
-            fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-comparison.png")
-            if fig:
-                lines += [f"![{scene}]({fig})", ""]
-        lines += ["Training sweep (relMSE of the frame after T frames):", "", "| scene | T | PT | PG |", "|---|---|---|---|"]
-        for scene, r in ex["equal_frame"].items():
-            for t, row in r["sweep"].items():
-                lines.append(f"| {scene} | {t} | {row['off']['relmse']:.4g} | {row['pmm']['relmse']:.4g} |")
-        lines.append("")
+        lines += _equal_frame(ex["equal_frame"], report_dir)
     if "equal_time" in ex:
-        lines += ["## Equal time: error of the accumulated image against wall time", "",
-                  "| scene | relMSE PT at PT's time budget | relMSE PG at the same time |", "|---|---|---|"]
-        for scene, r in ex["equal_time"].items():
-            b = r["relmse_at_pt_budget"]
-            lines.append(f"| {scene} | {b['off']:.4g} | {b['pmm']:.4g} |")
-        lines.append("")
-        for scene, r in ex["equal_time"].items():
-            fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-equal-time.png")
-            if fig:
-                lines += [f"![{scene} equal time]({fig})", ""]
+        lines += _equal_time(ex["equal_time"], report_dir, st)
+    if "flicker" in ex:
+        lines += _flicker(ex["flicker"], st)
     if "convergence" in ex:
-        lines += ["## Convergence: relMSE of the 1-spp frame against frame index", ""]
-        for scene, r in ex["convergence"].items():
-            s = r["static"]
-            lines.append(f"- {scene}: static camera, frame 0 -> last: PT {s['off'][0]:.4g} -> {s['off'][-1]:.4g}, "
-                         f"PG {s['pmm'][0]:.4g} -> {s['pmm'][-1]:.4g}")
-            fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-convergence.png")
-            if fig:
-                lines += ["", f"![{scene} convergence]({fig})", ""]
-        lines.append("")
+        lines += _convergence(ex["convergence"], report_dir, st)
     if "tradeoffs" in ex:
-        lines += ["## Trade-offs: train time against error", ""]
-        for scene, r in ex["tradeoffs"].items():
-            lines += [f"{scene}:", "", "| variant | train ms | frame ms | relMSE (last 8) |", "|---|---|---|---|"]
-            for name, row in r["rows"].items():
-                lines.append(f"| {name} | {row['train_ms']:.2f} | {row['frame_ms']:.1f} | {row['relmse_last8']:.4g} |")
-            fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-tradeoffs.png")
-            lines += ["", f"![{scene} trade-offs]({fig})" if fig else "", ""]
+        lines += _tradeoffs(ex["tradeoffs"], report_dir)
     if "kernels" in ex:
-        k = ex["kernels"]
-        lines += ["## Kernel microbenchmarks (bench/bench_guiding_kernels)", ""]
-        if "skipped" in k:
-            lines += [f"Skipped: {k['skipped']}", ""]
-        else:
-            lines += ["| benchmark | time | counters |", "|---|---|---|"]
-            for b in k["benchmarks"]:
-                counters = ", ".join(f"{n}={v:.3g}" for n, v in b.items() if n not in ("name", "real_time", "time_unit", "cpu_time", "iterations"))
-                lines.append(f"| {b['name']} | {b.get('real_time', 0):.3g} {b.get('time_unit', '')} | {counters} |")
-            lines.append("")
+        lines += _kernels(ex["kernels"])
     (report_dir / "README.md").write_text("\n".join(lines) + "\n")
     (report_dir / "results.json").write_text(json.dumps(results, indent=2))

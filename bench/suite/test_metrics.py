@@ -46,6 +46,22 @@ class MetricTests(unittest.TestCase):
         b = np.full((4, 4, 3), 0.5, np.float32)
         self.assertAlmostEqual(metrics.flicker([a, b, a]), 0.25)
 
+    def test_box_downsample_averages_blocks(self):
+        img = np.arange(4 * 6 * 3, dtype=np.float32).reshape(4, 6, 3)
+        small = metrics.downsample_box(img, 2)
+        self.assertEqual(small.shape, (2, 3, 3))
+        self.assertAlmostEqual(float(small[1, 2, 0]), float(np.mean(img[2:4, 4:6, 0])), places=5)
+        self.assertAlmostEqual(float(small.mean()), float(img.mean()), places=4)
+        with self.assertRaises(ValueError):
+            metrics.downsample_box(img, 4)
+
+    def test_time_to_reach_interpolates_in_log_log(self):
+        # error = 1 / t: reaching 0.25 takes t = 4 exactly, between the samples 2 and 8.
+        t = [1.0, 2.0, 8.0]
+        self.assertAlmostEqual(metrics.time_to_reach(t, [1 / x for x in t], 0.25), 4.0, places=9)
+        self.assertEqual(metrics.time_to_reach(t, [1.0, 0.5, 0.2], 2.0), 1.0)
+        self.assertIsNone(metrics.time_to_reach(t, [1.0, 0.5, 0.2], 0.1))
+
     def test_tonemap_matches_documented_curve(self):
         # 0 -> 0, large -> 1, and the ACES fit at x = 1 (0.8038...) through the sRGB curve.
         t = metrics.tonemap_srgb(np.array([[[0.0, 1.0, 1e6]]], np.float32))[0, 0]
