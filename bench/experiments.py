@@ -372,7 +372,15 @@ def main():
     ap.add_argument("--report", default=None, help="folder of the Markdown report")
     ap.add_argument("--only", nargs="*", choices=list(EXPERIMENTS), default=list(EXPERIMENTS))
     ap.add_argument("--scenes", nargs="*", default=None, help="scene names, or 'all' (%s)" % ", ".join(ALL_SCENES))
+    ap.add_argument("--report-from", help="only rewrite the report from this results.json")
     args = ap.parse_args()
+    from suite import report
+    if args.report_from:
+        results = json.loads(Path(args.report_from).read_text())
+        report_dir = Path(args.report or Path(args.report_from).parent)
+        report.write(results, report_dir)
+        print(f"report: {report_dir / 'README.md'}")
+        return
     ctx = Context(args)
     scenes = ALL_SCENES if args.scenes == ["all"] else (args.scenes or ctx.mode["scenes"])
     command = "python3 bench/experiments.py" + (" --quick" if args.quick else "") + \
@@ -401,10 +409,13 @@ def main():
                 results["experiments"][name][s] = fn(ctx, s)
                 print(f"{name} {s}: {time.time() - t0:.0f} s", file=sys.stderr, flush=True)
         results["seconds"][name] = round(time.time() - t0, 1)
+        # Each experiment also on its own: machine, commit, settings and its figures.
+        own = {k: v for k, v in results.items() if k not in ("experiments", "seconds")}
+        own.update(experiment=name, seconds=results["seconds"][name], figures=results["experiments"][name])
+        (ctx.out / f"{name}.json").write_text(json.dumps(own, indent=2))
         (ctx.out / "results.json").write_text(json.dumps(results, indent=2))
     results["finished"] = time.strftime("%Y-%m-%d %H:%M:%S")
     (ctx.out / "results.json").write_text(json.dumps(results, indent=2))
-    from suite import report
     report_dir = Path(args.report) if args.report else (ctx.out / "report" if args.quick else runner.ROOT / "docs" / "results")
     report.write(results, report_dir)
     print(f"report: {report_dir / 'README.md'}")

@@ -13,8 +13,20 @@ def _copy_figure(src, report_dir, name):
     return f"figures/{name}"
 
 
+def _figures(ex, report_dir, suffix):
+    """The experiment's plot of every scene, copied beside the report, as Markdown images."""
+    lines = []
+    for scene, r in ex.items():
+        fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-{suffix}.png")
+        if fig:
+            lines += [f"![{scene} {suffix}]({fig})", ""]
+    return lines
+
+
 def _ms(value):
-    return f"{value / 1e3:.1f} s" if value >= 1e4 else f"{value:.3g} ms"
+    if value >= 1e4:
+        return f"{value / 1e3:.1f} s"
+    return f"{value:.0f} ms" if value >= 100 else f"{value:.3g} ms"
 
 
 def verdict(pt_mean, pt_sem, pg_mean, pg_sem):
@@ -52,10 +64,7 @@ def _equal_frame(ex, report_dir):
     lines += ["", "Verdict: the difference of the relMSE means against three combined standard errors (the 8 "
               "frames have independent noise). Guided pixels: share of surface pixels that sampled a trained "
               "mixture at frame T; mean pi: their mean Gaussian weight.", ""]
-    for scene, r in ex.items():
-        fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-comparison.png")
-        if fig:
-            lines += [f"![{scene}]({fig})", ""]
+    lines += _figures(ex, report_dir, "comparison")
     lines += ["Training sweep (relMSE and LDR-FLIP of the frame after T frames; one run per method, frames saved "
               "with `--save-frames`):", "", "| scene | T | relMSE PT | relMSE PG | FLIP PT | FLIP PG |",
               "|---|---|---|---|---|---|"]
@@ -80,11 +89,7 @@ def _equal_time(ex, report_dir, settings):
                      f"| {f'{ratio:.2f}x PT time' if ratio else 'not reached'} |")
     lines += ["", "Last column below 1x: guiding reaches PT's error sooner (it pays for its cost); above 1x or "
               "'not reached' (within the frames rendered): PT is the better use of the time on this machine.", ""]
-    for scene, r in ex.items():
-        fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-equal-time.png")
-        if fig:
-            lines += [f"![{scene} equal time]({fig})", ""]
-    return lines
+    return lines + _figures(ex, report_dir, "equal-time")
 
 
 def _flicker(ex, settings):
@@ -116,12 +121,7 @@ def _convergence(ex, report_dir, settings):
                                for f, o, g in zip(p["off"]["frames"], p["off"]["relmse"], p["pmm"]["relmse"]))
         lines.append(f"| {scene} | {s['off'][0]:.4g} -> {s['off'][-1]:.4g} | {s['pmm'][0]:.4g} -> {s['pmm'][-1]:.4g} "
                      f"| {r.get('path_name', '-')} | {ratios} |")
-    lines.append("")
-    for scene, r in ex.items():
-        fig = _copy_figure(r.get("figure"), report_dir, f"{scene}-convergence.png")
-        if fig:
-            lines += [f"![{scene} convergence]({fig})", ""]
-    return lines
+    return lines + [""] + _figures(ex, report_dir, "convergence")
 
 
 def _tradeoffs(ex, report_dir):

@@ -58,6 +58,13 @@ class QuickRun(unittest.TestCase):
         self.assertEqual(rows["PT (no guiding)"]["train_ms"], 0.0)
         self.assertGreater(rows["fixed N=20"]["train_ms"], 0.0)
 
+    def test_each_experiment_has_its_own_json(self):
+        for name in self.results["experiments"]:
+            own = json.loads((OUT / f"{name}.json").read_text())
+            self.assertEqual(own["experiment"], name)
+            self.assertEqual(own["figures"], self.results["experiments"][name])
+            self.assertIn("git_commit", own["machine"])
+
     def test_report(self):
         text = (OUT / "report" / "README.md").read_text()
         self.assertIn("| scene | PT FLIP | PG FLIP | ratio | relMSE ratio | frame time PT | frame time PG | guiding overhead |",
