@@ -96,7 +96,8 @@ def markdown(a, b, summary, path_a, path_b):
     for k in ("error", "time", "other"):
         if k in summary:
             s = summary[k]
-            lines.append(f"| {k} | {s['count']} | {s['median']:.2%} | {s['p90']:.2%} | {s['max']:.2%} | `{s['worst']}` |")
+            worst = f"`{s['worst']}`" if s["max"] > 0 else "-"
+            lines.append(f"| {k} | {s['count']} | {s['median']:.2%} | {s['p90']:.2%} | {s['max']:.2%} | {worst} |")
     lines += ["", "Error figures come from seeded renders (the same seed gives the same image), so they should agree "
               "to rounding; times are wall-clock on a shared 2-core machine.", "",
               "| scene | figure | first | rerun |", "|---|---|---|---|"]

@@ -172,6 +172,9 @@ def write(results, report_dir):
         "on linear radiance; FLIP = NVIDIA's flip-evaluator.",
         "",
     ]
+    if (report_dir / "reproducibility.md").exists():
+        lines += ["A rerun of the same command against this report: [reproducibility.md](reproducibility.md) "
+                  "(`bench/compare.py`).", ""]
     if results.get("skipped_scenes"):
         lines += ["Skipped scenes: " + ", ".join(f"{k} ({v})" for k, v in results["skipped_scenes"].items()), ""]
     if "equal_frame" in ex:
