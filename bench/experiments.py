@@ -3,7 +3,7 @@
 guiding (PG), with official FLIP, plots and a Markdown report.
 
     python3 bench/experiments.py --quick            # CI-sized check of the pipeline (< 5 min)
-    python3 bench/experiments.py                    # full run (960x540, 1024-spp references): ~1.5 h
+    python3 bench/experiments.py                    # full run (960x540, 1024-spp references): 75 min on 2 cores, 30 min with cached references
     python3 bench/experiments.py --only equal_frame convergence --scenes cornell-indirect
     python3 bench/experiments.py --scenes all       # also the scenes outside the default set
 
