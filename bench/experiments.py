@@ -94,6 +94,7 @@ def crop_box(err_map, size):
 
 
 def saved_frame(image_path, frame):
+    """Where `rtpg render --save-frames` put `frame` (host/app frame_output_path: NAME-fNNNN.EXT)."""
     return Path(image_path).with_name(f"{Path(image_path).stem}-f{frame:04d}{Path(image_path).suffix}")
 
 
@@ -103,13 +104,12 @@ def static_run(ctx, scene, method):
     key = (scene, method)
     if key not in ctx.static_runs:
         m = ctx.mode
-        frames = max(m["sweep"] + [m["T"]])
-        saved = sorted({t - 1 for t in m["sweep"] + [m["T"]]})
+        counts = sorted(set(m["sweep"]) | {m["T"]})  # frames rendered before each saved image
         out = ctx.out / "static" / scene
-        stats, image = runner.render(scene, m["res"], frames, method, out, method,
+        stats, image = runner.render(scene, m["res"], counts[-1], method, out, method,
                                      reference=ctx.reference(scene, m["res"]),
-                                     extra=["--save-frames", ",".join(map(str, saved))])
-        ctx.static_runs[key] = (stats, {t: saved_frame(image, t - 1) for t in m["sweep"] + [m["T"]]})
+                                     extra=["--save-frames", ",".join(str(t - 1) for t in counts)])
+        ctx.static_runs[key] = (stats, {t: saved_frame(image, t - 1) for t in counts})
     return ctx.static_runs[key]
 
 
@@ -133,8 +133,7 @@ def equal_frame(ctx, scene):
             "relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
             "flip_ldr": metrics.flip_ldr(img, ref), "flip_hdr": metrics.flip_hdr(img, ref),
             "frame_ms": median_frame_ms(stats), "nonfinite": sum(f["nonfinite_samples"] for f in stats["frames"]),
-            "time_ms": {k: statistics.median(f["time_ms"].get(k, 0.0) for f in stats["frames"][1:] or stats["frames"])
-                        for k in stats["frames"][-1]["time_ms"]},
+            "time_ms": {k: median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]},
         }
         for key in ("guided_fraction", "trained_fraction", "mean_pi"):
             if key in stats["frames"][T - 1]:
