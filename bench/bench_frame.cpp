@@ -26,7 +26,7 @@
 #include <map>
 #include <tuple>
 
-#include "cl/cl_runtime.h"
+#include "rtpg/cl_runtime.h"
 #include "render/guided_first_bounce.h"
 #include "render/renderer.h"
 
@@ -60,7 +60,7 @@ FrameSetup* setup_for(const std::string& scene_name, int w, int h, std::string* 
   settings.path_tracer.max_bounces = scene->max_bounces > 0 ? scene->max_bounces : 8;
   s->off = std::make_unique<Renderer>(*scene, settings);
   s->pmm = std::make_unique<Renderer>(*scene, settings);
-  auto guided = std::make_unique<GuidedFirstBounce>(runtime(), w, h, GuidingConfig{});
+  auto guided = std::make_unique<GuidedFirstBounce>(runtime(), w, h, GuidingSettings{});
   s->guided = guided.get();
   s->pmm->set_first_bounce_sampler(std::move(guided));
   s->rays = make_ray_sets(*scene, s->off->tracer(), w, h);

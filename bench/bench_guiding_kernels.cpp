@@ -42,14 +42,15 @@
 
 #include <tbb/task_arena.h>
 
-#include "cl/cl_runtime.h"
-#include "guiding/guiding_params.h"
+#include "rtpg/cl_runtime.h"
+#include "rtpg/guiding_settings.h"
 #include "rtpg/guider.h"
-#include "shared/gbuffer.h"
+#include "support/guiding_buffers.h"
+#include "rtpg/guiding_layout.h"
 #include "shared/guiding_pixel.h"
 #include "shared/pmm.h"
 #include "shared/pmm_train.h"
-#include "shared/vpl.h"
+#include "rtpg/guiding_layout.h"
 
 namespace rtpg::bench {
 namespace {
@@ -66,26 +67,14 @@ ClRuntime& runtime() {
 
 // ---- synthetic inputs ------------------------------------------------------------------------
 
-struct HostGBuffer {
-  std::vector<float4> position_depth, shading_normal, view_dir, base_color_roughness,
-      metallic_specular;
-  std::vector<std::uint32_t> flags, material;
-  std::vector<float2> motion;
-  void resize(std::size_t n) {
-    for (auto* v :
-         {&position_depth, &shading_normal, &view_dir, &base_color_roughness, &metallic_specular})
-      v->assign(n, float4(0.0f));
-    flags.assign(n, 0u);
-    material.assign(n, 0u);
-    motion.assign(n, float2(0.0f));
-  }
-};
+using testing::HostGBuffer;
+using testing::HostVpls;
 
 struct Inputs {
   int w = 0, h = 0;
   std::size_t n = 0;
   HostGBuffer cur, prev;
-  std::vector<float4> vpl_position, vpl_normal, vpl_radiance;
+  HostVpls vpls;
   std::vector<float> state;  // 8 floats per pixel
   GuiderGBuffer d_cur, d_prev;
   GuiderVpls d_vpls;
@@ -101,25 +90,6 @@ float3 tilt(std::mt19937& g, float3 n, float max_deg) {
   t = sh::normalize(t);
   const float a = u(g) * max_deg * PG_PI / 180.0f;
   return sh::normalize(n * std::cos(a) + t * std::sin(a));
-}
-
-template <typename T>
-cl::Buffer upload(const std::vector<T>& v) {
-  return cl::Buffer(runtime().context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
-                    v.size() * sizeof(T), const_cast<T*>(v.data()));
-}
-
-GuiderGBuffer upload(const HostGBuffer& g) {
-  GuiderGBuffer d;
-  d.position_depth = upload(g.position_depth);
-  d.shading_normal = upload(g.shading_normal);
-  d.view_dir = upload(g.view_dir);
-  d.base_color_roughness = upload(g.base_color_roughness);
-  d.metallic_specular = upload(g.metallic_specular);
-  d.flags = upload(g.flags);
-  d.material = upload(g.material);
-  d.motion = upload(g.motion);
-  return d;
 }
 
 // The image is split into patches of 32..160 pixels a side, each one plane with its own
@@ -139,7 +109,7 @@ void make_gbuffer(Inputs& in, std::mt19937& g) {
                     float4(metal ? 1.0f : 0.0f, u(g) < 0.5f ? 0.04f : 0.0f, 0, 0), m == 11});
   }
   const float tan_half = std::tan(30.0f * PG_PI / 180.0f), aspect = static_cast<float>(w) / h;
-  in.cur.resize(in.n);
+  in.cur = HostGBuffer(in.w, in.h);
   std::vector<int> patch_of(in.n);
   struct Patch {
     float3 n, p0;
@@ -222,9 +192,7 @@ void make_gbuffer(Inputs& in, std::mt19937& g) {
 // 0.3..6 units away (normal facing back within 60 degrees), or escapes (10%).
 void make_vpls(Inputs& in, std::mt19937& g) {
   std::uniform_real_distribution<float> u;
-  in.vpl_position.assign(in.n, float4(0.0f));
-  in.vpl_normal.assign(in.n, float4(0.0f));
-  in.vpl_radiance.assign(in.n, float4(0.0f));
+  in.vpls.resize(in.n);
   for (std::size_t i = 0; i < in.n; ++i) {
     if (in.cur.flags[i] & PG_GBUF_SKY) continue;
     const float3 x = sh::pg_float4_xyz(in.cur.position_depth[i]);
@@ -239,15 +207,15 @@ void make_vpls(Inputs& in, std::mt19937& g) {
     const float bright = u(g) < 0.03f ? 50.0f : 1.0f;
     if (u(g) < 0.1f) {
       info |= PG_VPL_DISTANT;
-      in.vpl_position[i] = float4(w, pdf);
+      in.vpls.position[i] = float4(w, pdf);
     } else {
       const float d = 0.3f + 5.7f * u(g);
       const float3 ny = tilt(g, -w, 60.0f);
       const float cos_y = std::max(1e-3f, -sh::dot(ny, w));
-      in.vpl_position[i] = float4(x + w * d, pdf * cos_y / (d * d));
-      in.vpl_normal[i] = float4(ny, 0.0f);
+      in.vpls.position[i] = float4(x + w * d, pdf * cos_y / (d * d));
+      in.vpls.normal[i] = float4(ny, 0.0f);
     }
-    in.vpl_radiance[i] =
+    in.vpls.radiance_info[i] =
         float4(bright * u(g), bright * u(g), bright * u(g), static_cast<float>(info));
   }
 }
@@ -276,7 +244,7 @@ void make_states(Inputs& in, std::mt19937& g, float k_max) {
   }
 }
 
-void count_bytes(Inputs& in, const sh::pg_guiding_params& p) {
+void count_bytes(Inputs& in, const pg_kernel_settings& p) {
   const int w = in.w, h = in.h;
   in.reproject_bytes = in.sample_bytes = in.train_bytes = 0;
   for (int y = 0; y < h; ++y)
@@ -294,14 +262,11 @@ void count_bytes(Inputs& in, const sh::pg_guiding_params& p) {
         if (px >= 0 && py >= 0 && px < w && py < h) {
           r += 2 * 16 + 2 * 16 + 2 * 4;
           const std::size_t j = static_cast<std::size_t>(py) * w + px;
-          const float3 d = sh::pg_float4_xyz(in.cur.position_depth[i]) -
-                           sh::pg_float4_xyz(in.prev.position_depth[j]);
           const float3 n = sh::pg_float4_xyz(in.cur.shading_normal[i]),
                        m = sh::pg_float4_xyz(in.prev.shading_normal[j]);
-          if (std::sqrt(sh::dot(d, d)) <=
-                  p.reproject_depth * std::fmax(in.cur.position_depth[i].w, 1e-6f) &&
-              sh::dot(n, m) >= p.reproject_normal && in.prev.material[j] == in.cur.material[i] &&
-              in.prev.position_depth[j].w > 0.0f)
+          if (sh::pg_same_surface(in.cur.position_depth[i], n, in.cur.material[i],
+                                  in.prev.position_depth[j], m, in.prev.material[j],
+                                  p.reproject_depth, p.reproject_normal))
             r += 32;
         }
       }
@@ -321,16 +286,15 @@ Inputs& inputs_for(int w, int h) {
   in.h = h;
   in.n = static_cast<std::size_t>(w) * h;
   std::mt19937 g(1234u + static_cast<unsigned>(w));
-  const GuidingConfig config;
+  const GuidingSettings settings;
   make_gbuffer(in, g);
   make_vpls(in, g);
-  make_states(in, g, static_cast<float>(config.k_max));
-  count_bytes(in, make_guiding_params(config));
-  in.d_cur = upload(in.cur);
-  in.d_prev = upload(in.prev);
-  in.d_vpls = {upload(in.vpl_position), upload(in.vpl_normal), upload(in.vpl_radiance)};
-  in.d_samples.direction_pdf = cl::Buffer(runtime().context(), CL_MEM_READ_WRITE, in.n * 16);
-  in.d_samples.strategy = cl::Buffer(runtime().context(), CL_MEM_READ_WRITE, in.n * 4);
+  make_states(in, g, static_cast<float>(settings.k_max));
+  count_bytes(in, to_kernel_settings(settings));
+  in.d_cur = testing::upload(runtime(), in.cur);
+  in.d_prev = testing::upload(runtime(), in.prev);
+  in.d_vpls = testing::upload(runtime(), in.vpls, w, h);
+  in.d_samples = make_guider_samples(runtime().context(), w, h);
   return in;
 }
 
@@ -378,12 +342,12 @@ void BM_CopyFloat4(benchmark::State& state) {
 enum class Kernel { Reproject, Sample, Train };
 
 std::unique_ptr<Guider> make_guider(int w, int h, int lx, int ly,
-                                    GuidingConfig::TrainMemory memory) {
-  GuidingConfig config;
-  config.local_x = lx;
-  config.local_y = ly;
-  config.train_memory = memory;
-  auto guider = std::make_unique<Guider>(runtime(), w, h, config);
+                                    GuidingSettings::TrainMemory memory) {
+  GuidingSettings settings;
+  settings.local_x = lx;
+  settings.local_y = ly;
+  settings.train_memory = memory;
+  auto guider = std::make_unique<Guider>(runtime(), w, h, settings);
   Inputs& in = inputs_for(w, h);
   guider->write_state(in.state);  // first launches of all three kernels, untimed
   guider->reproject(in.d_cur, in.d_prev);
@@ -393,9 +357,9 @@ std::unique_ptr<Guider> make_guider(int w, int h, int lx, int ly,
 }
 
 // The configuration every other one is compared with, in the same iterations: 16x16 work-groups,
-// VPLs read from global memory (what GuidingConfig's Auto picks on CPU devices).
+// VPLs read from global memory (what GuidingSettings's Auto picks on CPU devices).
 constexpr int kRefX = 16, kRefY = 16;
-constexpr GuidingConfig::TrainMemory kRefMemory = GuidingConfig::TrainMemory::Global;
+constexpr GuidingSettings::TrainMemory kRefMemory = GuidingSettings::TrainMemory::Global;
 
 Guider& reference_guider(int w, int h) {
   static std::unique_ptr<Guider> guider;
@@ -410,10 +374,10 @@ Guider& reference_guider(int w, int h) {
 
 // One other guider alive at a time (a 1080p guider's buffers take 130 MB): the repetitions of
 // one benchmark run back to back and reuse it.
-Guider& guider_for(int w, int h, int lx, int ly, GuidingConfig::TrainMemory memory) {
+Guider& guider_for(int w, int h, int lx, int ly, GuidingSettings::TrainMemory memory) {
   if (lx == kRefX && ly == kRefY && memory == kRefMemory) return reference_guider(w, h);
   static std::unique_ptr<Guider> guider;
-  static std::tuple<int, int, int, int, GuidingConfig::TrainMemory> key;
+  static std::tuple<int, int, int, int, GuidingSettings::TrainMemory> key;
   const auto want = std::make_tuple(w, h, lx, ly, memory);
   if (!guider || key != want) {
     guider.reset();
@@ -440,7 +404,7 @@ double launch(Guider& g, Inputs& in, Kernel k, std::uint32_t frame) {
 }
 
 void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int lx, int ly,
-                      GuidingConfig::TrainMemory memory) {
+                      GuidingSettings::TrainMemory memory) {
   Inputs& in = inputs_for(w, h);
   Guider* g = nullptr;
   Guider* ref = nullptr;
@@ -482,7 +446,7 @@ void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int 
 // ---- train as plain C++ over TBB -------------------------------------------------------------
 
 // train.cl with PG_TRAIN_LOCAL_TILE=0, one pixel per loop iteration, rows spread over TBB.
-void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint32_t seed,
+void tbb_train(const Inputs& in, const pg_kernel_settings& params, std::uint32_t seed,
                std::uint32_t frame, std::vector<float>& out, std::vector<std::uint8_t>& trained) {
   const int w = in.w, h = in.h;
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
@@ -507,7 +471,8 @@ void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint3
           const int apron = params.apron, side = 2 * apron + 1;
           const int n = std::min(std::min(sh::pg_pmm_neighbour_count(s1.w, params), side * side),
                                  PG_MAX_TRAIN_SAMPLES);
-          sh::pg_rng rng = sh::pg_rng_make(seed, static_cast<sh::uint>(i), frame, 0u, 3u);
+          sh::pg_rng rng =
+              sh::pg_rng_make(seed, static_cast<sh::uint>(i), frame, 0u, PG_RNG_STREAM_TRAIN);
           const sh::uint start = sh::pg_rng_next_uint(&rng) % static_cast<sh::uint>(side * side);
           float4 samples[PG_MAX_TRAIN_SAMPLES];
           int kept = 0;
@@ -516,8 +481,8 @@ void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint3
             const int sx = x + wi % side - apron, sy = y + wi / side - apron;
             if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
             const int j = sy * w + sx;
-            kept += sh::pg_train_sample_from_vpl(px, in.vpl_position[j], in.vpl_normal[j],
-                                                 in.vpl_radiance[j], &samples[kept]);
+            kept += sh::pg_train_sample_from_vpl(px, in.vpls.position[j], in.vpls.normal[j],
+                                                 in.vpls.radiance_info[j], &samples[kept]);
           }
           int updated = 0;
           st = sh::pg_pmm_train(st, samples, kept, params, static_cast<float>(n), params.em_passes,
@@ -539,7 +504,7 @@ void tbb_train(const Inputs& in, const sh::pg_guiding_params& params, std::uint3
 void BM_TrainTbb(benchmark::State& state, int w, int h) {
   Inputs& in = inputs_for(w, h);
   Guider& g = reference_guider(w, h);
-  const sh::pg_guiding_params params = make_guiding_params(g.config());
+  const pg_kernel_settings params = to_kernel_settings(g.settings());
   std::vector<float> out(in.n * 8);
   std::vector<std::uint8_t> trained(in.n);
   tbb_train(in, params, 1u, 0u, out, trained);  // warm: pages touched, TBB arena up
@@ -580,7 +545,7 @@ void register_all(bool full) {
   benchmark::RegisterBenchmark("CopyFloat4/64MiB", BM_CopyFloat4)
       ->UseManualTime()
       ->Unit(benchmark::kMillisecond);
-  using M = GuidingConfig::TrainMemory;
+  using M = GuidingSettings::TrainMemory;
   struct Local {
     int x, y;
   };

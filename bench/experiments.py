@@ -265,9 +265,9 @@ TRADEOFFS = {
     "fixed N=5": ["--pg-n-min", 5, "--pg-n-max", 5],
     "fixed N=10": ["--pg-n-min", 10, "--pg-n-max", 10],
     "fixed N=20": ["--pg-n-min", 20, "--pg-n-max", 20],
-    "kMax=8": ["--pg-kmax", 8],
-    "kMax=128": ["--pg-kmax", 128],
-    "tile 8, apron 1": ["--pg-local", 8, "--pg-apron", 1],
+    "kMax=8": ["--pg-k-max", 8],
+    "kMax=128": ["--pg-k-max", 128],
+    "tile 8, apron 1": ["--pg-local-x", 8, "--pg-local-y", 8, "--pg-apron", 1],
     "tile 16, apron 3": ["--pg-apron", 3],
 }
 

@@ -3,16 +3,12 @@
  * sample the BSDF. Writes the world direction with the mixture density (one-sample MIS) and
  * the strategy that produced it. */
 #include "shared/guiding_pixel.h"
+#include "shared/kernel_args.h"
 #include "shared/pmm.h"
 #include "shared/rng.h"
 
-__kernel void sample(__global const float4* state0, __global const float4* state1,
-                     __global const float4* shading_normal, __global const float4* view_dir,
-                     __global const float4* base_color_roughness,
-                     __global const float4* metallic_specular, __global const uint* flags,
-                     __global float4* direction_pdf, __global uint* strategy, uint width,
-                     uint height, uint seed, uint frame, uint sample_index,
-                     pg_guiding_params params) {
+__kernel void sample(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint width, uint height,
+                     uint seed, uint frame, uint sample_index, pg_kernel_settings settings) {
   uint x = get_global_id(0), y = get_global_id(1);
   if (x >= width || y >= height) return;
   uint i = y * width + x;
@@ -24,15 +20,15 @@ __kernel void sample(__global const float4* state0, __global const float4* state
   }
   float4 bcr = base_color_roughness[i];
   pg_pmm_state state = pg_pmm_initial_state();
-  if (pg_guiding_applies(f, bcr.w, params)) {
-    state.s0 = state0[i];
-    state.s1 = state1[i];
+  if (pg_guiding_applies(f, bcr.w, settings)) {
+    state.s0 = in_state0[i];
+    state.s1 = in_state1[i];
   }
-  pg_pmm_model model = pg_pmm_model_from_state(state, params);
+  pg_pmm_model model = pg_pmm_model_from_state(state, settings);
   pg_frame frame_x = pg_frame_from_normal(shading_normal[i].xyz);
   float3 wo = pg_to_local(frame_x, view_dir[i].xyz);
   pg_lobes lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), wo);
-  pg_rng rng = pg_rng_make(seed, i, frame, sample_index, 1u);
+  pg_rng rng = pg_rng_make(seed, i, frame, sample_index, PG_RNG_STREAM_FIRST_BOUNCE);
   float xi = pg_rng_next(&rng);
   float u1 = pg_rng_next(&rng);
   float u2 = pg_rng_next(&rng);

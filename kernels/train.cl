@@ -1,26 +1,21 @@
 /* Online EM training of every pixel's mixture from the VPLs of its neighbourhood (paper 3.2,
  * 4.2). Built in two variants (build option PG_TRAIN_LOCAL_TILE): 1 loads the work-group's
  * VPL tile plus an apron of `apron` pixels into local memory first (what GPUs need); 0 reads
- * the same VPLs straight from global memory (faster on PoCL's CPU device, DESIGN.md 7).
+ * the same VPLs straight from global memory (faster on PoCL's CPU device, docs/guiding.md).
  * Both give identical results. trained[i] is 1 where the state changed. */
+#include "shared/kernel_args.h"
 #include "shared/pmm_train.h"
 
 #ifndef PG_TRAIN_LOCAL_TILE
 #define PG_TRAIN_LOCAL_TILE 1
 #endif
 
-__kernel void train(__global const float4* state0, __global const float4* state1,
-                    __global float4* out_state0, __global float4* out_state1,
-                    __global const float4* position_depth, __global const float4* shading_normal,
-                    __global const float4* view_dir, __global const float4* base_color_roughness,
-                    __global const float4* metallic_specular, __global const uint* flags,
-                    __global const float4* vpl_position, __global const float4* vpl_normal,
-                    __global const float4* vpl_radiance_info, __global uchar* trained, uint width,
-                    uint height, uint seed, uint frame, pg_guiding_params params,
-                    __local float4* tile_position, __local float4* tile_normal,
-                    __local float4* tile_radiance) {
+__kernel void train(
+    PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_IN_STATE PG_ARGS_OUT_STATE __global uchar* trained,
+    uint width, uint height, uint seed, uint frame, pg_kernel_settings settings,
+    __local float4* tile_position, __local float4* tile_normal, __local float4* tile_radiance) {
   int x = (int)get_global_id(0), y = (int)get_global_id(1);
-  int apron = params.apron;
+  int apron = settings.apron;
 #if PG_TRAIN_LOCAL_TILE
   int lw = (int)get_local_size(0), lh = (int)get_local_size(1);
   int tw = lw + 2 * apron, th = lh + 2 * apron;
@@ -44,11 +39,11 @@ __kernel void train(__global const float4* state0, __global const float4* state1
 #endif
   if (x >= (int)width || y >= (int)height) return;
   int i = y * (int)width + x;
-  float4 s0 = state0[i], s1 = state1[i];
+  float4 s0 = in_state0[i], s1 = in_state1[i];
   uint f = flags[i];
   float4 bcr = base_color_roughness[i];
   uchar changed = 0;
-  if (pg_guiding_applies(f, bcr.w, params)) {
+  if (pg_guiding_applies(f, bcr.w, settings)) {
     pg_pmm_state state;
     state.s0 = s0;
     state.s1 = s1;
@@ -58,13 +53,13 @@ __kernel void train(__global const float4* state0, __global const float4* state1
     px.wo = pg_to_local(px.frame, view_dir[i].xyz);
     px.lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), px.wo);
     int side = 2 * apron + 1;
-    int n = min(min(pg_pmm_neighbour_count(s1.w, params), side * side), PG_MAX_TRAIN_SAMPLES);
-    pg_rng rng = pg_rng_make(seed, (uint)i, frame, 0u, 3u);
+    int n = min(min(pg_pmm_neighbour_count(s1.w, settings), side * side), PG_MAX_TRAIN_SAMPLES);
+    pg_rng rng = pg_rng_make(seed, (uint)i, frame, 0u, PG_RNG_STREAM_TRAIN);
     uint start = pg_rng_next_uint(&rng) % (uint)(side * side);
     float4 samples[PG_MAX_TRAIN_SAMPLES];
     int kept = 0;
     for (int s = 0; s < n; ++s) {
-      int w = pg_train_window_index(start, s, params);
+      int w = pg_train_window_index(start, s, settings);
       int dx = w % side - apron, dy = w / side - apron;
 #if PG_TRAIN_LOCAL_TILE
       int t = ((int)get_local_id(1) + apron + dy) * tw + (int)get_local_id(0) + apron + dx;
@@ -79,7 +74,7 @@ __kernel void train(__global const float4* state0, __global const float4* state1
 #endif
     }
     int updated = 0;
-    state = pg_pmm_train(state, samples, kept, params, (float)n, params.em_passes, &updated);
+    state = pg_pmm_train(state, samples, kept, settings, (float)n, settings.em_passes, &updated);
     s0 = state.s0;
     s1 = state.s1;
     changed = (uchar)updated;

@@ -13,14 +13,14 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "cl/cl_runtime.h"
+#include "rtpg/cl_runtime.h"
 #include "cl/device.h"
 #include "cl/image_kernels.h"
 #include "render/guided_first_bounce.h"
 #include "render/image_io.h"
 #include "scene/scene_loader.h"
 #include "util/atomic_file.h"
-#include "util/error.h"
+#include "rtpg/errors.h"
 #include "util/stderr_capture.h"
 
 #ifndef RTPG_SOURCE_DIR
@@ -58,11 +58,11 @@ void check_output_path(const std::string& path, const char* flag, bool png_allow
   check_output_folder(path);
 }
 
-Scene load(const CommonOptions& common) {
+Scene load(const CommonArguments& common) {
   const std::string path = common.scene.empty() ? default_scene_path() : common.scene;
-  SceneLoadOptions options;
-  options.asset_root = common.asset_root;
-  return load_quietly([&] { return load_scene(path, options); });
+  SceneLoadSettings settings;
+  settings.asset_root = common.asset_root;
+  return load_quietly([&] { return load_scene(path, settings); });
 }
 
 double median(std::vector<double> v) {
@@ -94,6 +94,39 @@ void write_output(const std::string& path, const ImageRgb& image, ClRuntime& cl,
   }
 }
 
+// The renderer names its settings; the command line names the flags that set them.
+template <class F>
+decltype(auto) with_flag_names(F&& f) {
+  try {
+    return f();
+  } catch (const RenderSettingError& e) {
+    static const std::map<std::string, std::string> flags = {
+        {"resolution", "--res"}, {"spp", "--spp"}, {"camera_path", "--camera-path"}};
+    const auto it = flags.find(e.setting());
+    throw InputError(it != flags.end() ? it->second : e.setting(), e.problem());
+  }
+}
+
+// Every guiding setting of the run, by its name in the settings table.
+nlohmann::json guiding_settings_json(const GuidingSettings& s) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const GuidingSettingInfo& row : guiding_settings_table()) {
+    if (row.int_field) {
+      out[row.name] = s.*row.int_field;
+    } else {
+      out[row.name] = s.*row.float_field;
+    }
+  }
+  out["train_memory"] = train_memory_name(s.train_memory);
+  return out;
+}
+
+nlohmann::json path_tracer_settings_json(const PathTracerSettings& s) {
+  return {{"max_bounces", s.max_bounces},
+          {"roulette_start", s.roulette_start},
+          {"next_event", s.next_event}};
+}
+
 // The flag wins, then the scene's integrator setting, then the renderer's default.
 int bounces_for(const Scene& scene, int flag) {
   if (flag < 0) throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
@@ -115,37 +148,37 @@ std::string default_scene_path() {
   return std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json";
 }
 
-int run_render(const RenderOptions& options) {
-  check_output_path(options.output, "--output", true);
-  if (!options.stats_json.empty()) check_output_folder(options.stats_json);
-  if (options.frames <= 0) throw InputError("--frames", "must be at least 1");
-  if (!options.save_frames.empty() && options.output.empty())
+int run_render(const RenderCommand& command) {
+  check_output_path(command.output, "--output", true);
+  if (!command.stats_json.empty()) check_output_folder(command.stats_json);
+  if (command.frames <= 0) throw InputError("--frames", "must be at least 1");
+  if (!command.save_frames.empty() && command.output.empty())
     throw InputError("--save-frames", "needs --output (the frames are written beside it)");
-  for (int f : options.save_frames)
-    if (f < 0 || f >= options.frames)
+  for (int f : command.save_frames)
+    if (f < 0 || f >= command.frames)
       throw InputError("--save-frames", fmt::format("frame {} is outside 0..{} (--frames {})", f,
-                                                    options.frames - 1, options.frames));
-  if (options.max_bounces < 0)
+                                                    command.frames - 1, command.frames));
+  if (command.max_bounces < 0)
     throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
   ImageRgb reference;
-  if (!options.reference.empty()) {
-    reference = load_quietly([&] { return read_image(options.reference); });
-    if (reference.width != options.settings.width || reference.height != options.settings.height)
+  if (!command.reference.empty()) {
+    reference = load_quietly([&] { return read_image(command.reference); });
+    if (reference.width != command.settings.width || reference.height != command.settings.height)
       throw InputError(
-          options.reference,
+          command.reference,
           fmt::format("reference is {}x{}, the render is {}x{}", reference.width, reference.height,
-                      options.settings.width, options.settings.height));
+                      command.settings.width, command.settings.height));
   }
   const std::string scene_path =
-      options.common.scene.empty() ? default_scene_path() : options.common.scene;
-  const Scene scene = load(options.common);
-  ClRuntime cl(options.common.device);
-  RenderSettings settings = options.settings;
-  settings.path_tracer.max_bounces = bounces_for(scene, options.max_bounces);
-  Renderer renderer(scene, settings);
-  if (options.guiding == "pmm")
+      command.common.scene.empty() ? default_scene_path() : command.common.scene;
+  const Scene scene = load(command.common);
+  ClRuntime cl(command.common.device);
+  RenderSettings settings = command.settings;
+  settings.path_tracer.max_bounces = bounces_for(scene, command.max_bounces);
+  Renderer renderer = with_flag_names([&] { return Renderer(scene, settings); });
+  if (command.guiding == "pmm")
     renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(
-        cl, options.settings.width, options.settings.height, options.guiding_config));
+        cl, command.settings.width, command.settings.height, command.guiding_settings));
 
   nlohmann::json frames = nlohmann::json::array();
   std::vector<double> totals;
@@ -153,7 +186,7 @@ int run_render(const RenderOptions& options) {
   std::uint64_t nonfinite = 0;
   // --accumulate: the running mean of all frames, kept on the device (kernels/accumulate.cl).
   std::unique_ptr<Accumulator> accumulator;
-  if (options.accumulate)
+  if (command.accumulate)
     accumulator = std::make_unique<Accumulator>(cl, settings.width, settings.height);
   std::vector<glm::vec3> previous;  // last frame, for the temporal flicker metric
   std::vector<glm::vec4> frame_rgba;
@@ -168,20 +201,21 @@ int run_render(const RenderOptions& options) {
     }
     write_output(path, out, cl,
                  {{"scene", scene_path},
-                  {"spp", std::to_string(options.settings.spp)},
-                  {"seed", std::to_string(options.settings.seed)},
+                  {"spp", std::to_string(command.settings.spp)},
+                  {"seed", std::to_string(command.settings.seed)},
                   {"frame", std::to_string(f)},
                   {"accumulated_frames", std::to_string(accumulator ? f + 1 : 1)},
                   {"render_time_ms", fmt::format("{:.3f}", totals.back())},
-                  {"guiding", options.guiding}});
+                  {"guiding", command.guiding}});
   };
-  for (int f = 0; f < options.frames; ++f) {
+  for (int f = 0; f < command.frames; ++f) {
     FrameStats stats = renderer.render_frame(f);
     totals.push_back(stats.time_ms["total"]);
     const std::vector<glm::vec3>& image = renderer.image();
     double flicker = -1.0;
     if (!previous.empty()) {
-      // Temporal flicker (DESIGN.md 5): MSE between consecutive frames over pixels and channels.
+      // Temporal flicker (docs/design.md, "Metrics"): MSE between consecutive frames over pixels
+      // and channels.
       double sum = 0.0;
       for (std::size_t i = 0; i < image.size(); ++i) {
         const glm::vec3 d = image[i] - previous[i];
@@ -208,7 +242,7 @@ int run_render(const RenderOptions& options) {
                               {"shadow", stats.shadow_rays}}}};
     for (const auto& [key, value] : stats.extra) frame[key] = value;
     if (flicker >= 0.0) frame["flicker_mse"] = flicker;
-    if (!options.reference.empty()) {
+    if (!command.reference.empty()) {
       last_relmse = relative_mse(to_image(renderer), reference);
       frame["relmse"] = last_relmse;
       if (accumulator) {
@@ -219,69 +253,73 @@ int run_render(const RenderOptions& options) {
       }
     }
     frames.push_back(frame);
-    if (std::find(options.save_frames.begin(), options.save_frames.end(), f) !=
-        options.save_frames.end())
-      write_frame(frame_output_path(options.output, f), f);
-    if (!options.common.quiet && options.frames > 1)
+    if (std::find(command.save_frames.begin(), command.save_frames.end(), f) !=
+        command.save_frames.end())
+      write_frame(frame_output_path(command.output, f), f);
+    if (!command.common.quiet && command.frames > 1)
       std::printf("frame %d: %.1f ms%s\n", f, stats.time_ms["total"],
                   last_relmse >= 0.0 ? fmt::format(", relMSE {:.4g}", last_relmse).c_str() : "");
   }
 
-  if (!options.output.empty()) write_frame(options.output, options.frames - 1);
-  if (!options.stats_json.empty()) {
+  if (!command.output.empty()) write_frame(command.output, command.frames - 1);
+  if (!command.stats_json.empty()) {
     const nlohmann::json stats = {
         {"scene", scene_path},
-        {"width", options.settings.width},
-        {"height", options.settings.height},
-        {"spp", options.settings.spp},
-        {"seed", options.settings.seed},
-        {"jitter", options.settings.jitter},
-        {"accumulate", options.accumulate},
-        {"camera_path", options.settings.camera_path},
-        {"guiding", options.guiding},
+        {"width", command.settings.width},
+        {"height", command.settings.height},
+        {"spp", command.settings.spp},
+        {"seed", command.settings.seed},
+        {"jitter", command.settings.jitter},
+        {"accumulate", command.accumulate},
+        {"camera_path", command.settings.camera_path},
+        {"guiding", command.guiding},
+        {"guiding_settings", guiding_settings_json(command.guiding_settings)},
         {"max_bounces", settings.path_tracer.max_bounces},
+        {"path_tracer", path_tracer_settings_json(settings.path_tracer)},
+        {"camera_frame", settings.camera_frame},
+        {"frame_count", command.frames},
         {"device", cl.info().device_name},
         {"threads", static_cast<int>(std::thread::hardware_concurrency())},
         {"bvh_build_ms", renderer.tracer().build_seconds() * 1e3},
         {"frames", frames}};
-    write_text_atomically(options.stats_json, stats.dump(2) + "\n");
+    write_text_atomically(command.stats_json, stats.dump(2) + "\n");
   }
-  if (!options.common.quiet) {
+  if (!command.common.quiet) {
     std::printf("rendered %s at %dx%d, %d spp, %d frame%s (guiding %s) on %s + Embree\n",
-                scene_path.c_str(), options.settings.width, options.settings.height,
-                options.settings.spp, options.frames, options.frames == 1 ? "" : "s",
-                options.guiding.c_str(), cl.info().device_name.c_str());
+                scene_path.c_str(), command.settings.width, command.settings.height,
+                command.settings.spp, command.frames, command.frames == 1 ? "" : "s",
+                command.guiding.c_str(), cl.info().device_name.c_str());
     std::printf("time per frame: %.1f ms (median of %zu)%s\n", median(totals), totals.size(),
                 nonfinite ? fmt::format(", {} non-finite samples dropped", nonfinite).c_str() : "");
     if (last_relmse >= 0.0) std::printf("relMSE of the last frame: %.5g\n", last_relmse);
-    if (!options.output.empty()) std::printf("wrote %s\n", options.output.c_str());
+    if (!command.output.empty()) std::printf("wrote %s\n", command.output.c_str());
   }
   return 0;
 }
 
-int run_reference(const ReferenceOptions& options) {
-  check_output_path(options.output, "--output", false);
-  if (options.spp <= 0) throw InputError("--spp", "must be at least 1");
-  if (options.max_bounces < 0)
+int run_reference(const ReferenceCommand& command) {
+  check_output_path(command.output, "--output", false);
+  if (command.spp <= 0) throw InputError("--spp", "must be at least 1");
+  if (command.max_bounces < 0)
     throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
-  const Scene scene = load(options.common);
+  const Scene scene = load(command.common);
   RenderSettings settings;
-  settings.width = options.width;
-  settings.height = options.height;
-  settings.seed = options.seed;
-  settings.path_tracer.max_bounces = bounces_for(scene, options.max_bounces);
-  settings.camera_path = options.camera_path;
-  if (options.frame < 0) throw InputError("--frame", "must not be negative");
-  settings.camera_frame = options.frame;
+  settings.width = command.width;
+  settings.height = command.height;
+  settings.seed = command.seed;
+  settings.path_tracer.max_bounces = bounces_for(scene, command.max_bounces);
+  settings.camera_path = command.camera_path;
+  if (command.frame < 0) throw InputError("--frame", "must not be negative");
+  settings.camera_frame = command.frame;
   // Several samples share a G-buffer; new jitter per pass gives the pixel filter's integral.
-  settings.spp = options.spp % 4 == 0 ? 4 : 1;
-  const int passes = options.spp / settings.spp;
-  Renderer renderer(scene, settings);
-  const bool progress = !options.common.quiet && ::isatty(STDERR_FILENO);
+  settings.spp = command.spp % 4 == 0 ? 4 : 1;
+  const int passes = command.spp / settings.spp;
+  Renderer renderer = with_flag_names([&] { return Renderer(scene, settings); });
+  const bool progress = !command.common.quiet && ::isatty(STDERR_FILENO);
   ImageRgb sum;
-  sum.width = options.width;
-  sum.height = options.height;
-  sum.pixels.assign(static_cast<std::size_t>(options.width) * options.height, glm::vec3(0.0f));
+  sum.width = command.width;
+  sum.height = command.height;
+  sum.pixels.assign(static_cast<std::size_t>(command.width) * command.height, glm::vec3(0.0f));
   std::uint64_t nonfinite = 0;
   const auto start = std::chrono::steady_clock::now();
   for (int p = 0; p < passes; ++p) {
@@ -291,7 +329,7 @@ int run_reference(const ReferenceOptions& options) {
     if (progress) {
       const int width = 40, filled = (p + 1) * width / passes;
       std::fprintf(stderr, "\r[%s%s] %d/%d spp", std::string(filled, '#').c_str(),
-                   std::string(width - filled, ' ').c_str(), (p + 1) * settings.spp, options.spp);
+                   std::string(width - filled, ' ').c_str(), (p + 1) * settings.spp, command.spp);
       std::fflush(stderr);
     }
   }
@@ -299,20 +337,20 @@ int run_reference(const ReferenceOptions& options) {
   for (auto& px : sum.pixels) px /= static_cast<float>(passes);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  write_exr(options.output, sum,
-            {{"scene", options.common.scene},
-             {"spp", std::to_string(options.spp)},
-             {"seed", std::to_string(options.seed)},
+  write_exr(command.output, sum,
+            {{"scene", command.common.scene},
+             {"spp", std::to_string(command.spp)},
+             {"seed", std::to_string(command.seed)},
              {"render_time_ms", fmt::format("{:.1f}", seconds * 1e3)},
              {"nonfinite_samples", std::to_string(nonfinite)}});
-  if (!options.common.quiet)
-    std::printf("reference %s: %dx%d, %d spp in %.1f s -> %s\n", options.common.scene.c_str(),
-                options.width, options.height, options.spp, seconds, options.output.c_str());
+  if (!command.common.quiet)
+    std::printf("reference %s: %dx%d, %d spp in %.1f s -> %s\n", command.common.scene.c_str(),
+                command.width, command.height, command.spp, seconds, command.output.c_str());
   return 0;
 }
 
-int run_info(const CommonOptions& options) {
-  const Scene scene = load(options);
+int run_info(const CommonArguments& command) {
+  const Scene scene = load(command);
   const SceneFeatures f = scene.features();
   std::size_t emissive_triangles = 0;
   for (const Mesh& m : scene.meshes)

@@ -10,15 +10,15 @@
 
 namespace rtpg {
 
-struct CommonOptions {
+struct CommonArguments {
   std::string scene;       // "" = the built-in default scene
   std::string asset_root;  // "" = RTPG_ASSET_ROOT or ../shared/scenes
   std::string device;      // "" = RTPG_DEVICE or a GPU, else the CPU
   bool quiet = false;
 };
 
-struct RenderOptions {
-  CommonOptions common;
+struct RenderCommand {
+  CommonArguments common;
   RenderSettings settings;
   int frames = 1;
   bool accumulate = false;       // output = running mean of all frames instead of the last one
@@ -28,12 +28,12 @@ struct RenderOptions {
   std::string reference;         // EXR to compute relMSE against
   std::string stats_json;        // "" = none
   std::string guiding = "pmm";   // "off" or "pmm"
-  GuidingConfig guiding_config;
+  GuidingSettings guiding_settings;
   std::string train_memory = "auto";
 };
 
-struct ReferenceOptions {
-  CommonOptions common;
+struct ReferenceCommand {
+  CommonArguments common;
   int width = 640, height = 360, spp = 1024;
   std::uint32_t seed = 0;
   int max_bounces = 0;      // 0 = the scene's, else the default
@@ -46,9 +46,9 @@ struct ReferenceOptions {
 // "dir/name.exr" -> "dir/name-f0007.exr".
 std::string frame_output_path(const std::string& output, int frame);
 
-int run_render(const RenderOptions& options);
-int run_reference(const ReferenceOptions& options);
-int run_info(const CommonOptions& options);
+int run_render(const RenderCommand& options);
+int run_reference(const ReferenceCommand& options);
+int run_info(const CommonArguments& options);
 int run_devices();
 
 // The scene used when none is given: scenes/cornell-box.json of the source tree or of the

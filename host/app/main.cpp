@@ -1,5 +1,6 @@
 // rtpg: real-time path guiding. Parses the command line and runs one subcommand; bad input
 // ends with a one-line message and exit code 2.
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -7,12 +8,12 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
-#include "cl/cl_error.h"
-#include "util/error.h"
+#include "rtpg/cl_error.h"
+#include "rtpg/errors.h"
 
 namespace {
 
-void add_common(CLI::App* cmd, rtpg::CommonOptions& common, bool scene_required) {
+void add_common(CLI::App* cmd, rtpg::CommonArguments& common, bool scene_required) {
   auto* scene =
       cmd->add_option("scene", common.scene, "Scene JSON file (default: scenes/cornell-box.json)");
   if (scene_required) scene->required();
@@ -24,53 +25,30 @@ void add_common(CLI::App* cmd, rtpg::CommonOptions& common, bool scene_required)
   cmd->add_flag("-q,--quiet", common.quiet, "Print nothing but errors");
 }
 
-void add_guiding_options(CLI::App* cmd, rtpg::RenderOptions& r) {
-  rtpg::GuidingConfig& g = r.guiding_config;
+// "--pg-" and the setting's name with '-' for '_': every row of the guiding settings table
+// (include/rtpg/guiding_settings.h) is a flag; values are checked against the table's range
+// by the guider (exit 2 with the setting's name).
+std::string guiding_flag(const char* name) {
+  std::string flag = std::string("--pg-") + name;
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  return flag;
+}
+
+void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
+  rtpg::GuidingSettings& g = r.guiding_settings;
   cmd->add_option("--guiding", r.guiding, "First-bounce sampling: pmm (guided) or off (BSDF)")
       ->check(CLI::IsMember({"off", "pmm"}))
       ->capture_default_str();
-  auto* grp =
-      cmd->add_option_group("Guiding", "Parameters of the PMM guider (include/rtpg/guider.h)");
-  grp->add_option("--pg-kmax", g.k_max, "Epochs after which the EM step size stops shrinking")
-      ->capture_default_str();
-  grp->add_option("--pg-n-min", g.n_min, "Neighbour VPLs per pixel at k = kMax")
-      ->capture_default_str();
-  grp->add_option("--pg-n-max", g.n_max,
-                  "Neighbour VPLs per pixel at k = 0 (n-min = n-max: fixed N)")
-      ->capture_default_str();
-  grp->add_option("--pg-apron", g.apron, "Neighbourhood radius in pixels")->capture_default_str();
-  grp->add_option("--pg-local", g.local_x, "Work-group (tile) width and height")
-      ->capture_default_str()
-      ->each([&g](const std::string&) { g.local_y = g.local_x; });
-  grp->add_option("--pg-pi-min", g.pi_min, "Lower clamp of the mixing weight")
-      ->capture_default_str();
-  grp->add_option("--pg-pi-max", g.pi_max, "Upper clamp of the mixing weight")
-      ->capture_default_str();
-  grp->add_option("--pg-pi-init", g.pi_init, "Mixing weight of a new model")->capture_default_str();
-  grp->add_option("--pg-alpha", g.step_alpha,
-                  "Step size exponent: eta_k = max((k+1)^-alpha, 1/(kMax+1))")
-      ->capture_default_str();
-  grp->add_option("--pg-sigma-eps", g.sigma_eps, "Regularisation of the covariance diagonal")
-      ->capture_default_str();
-  grp->add_option("--pg-sigma-prior", g.sigma_prior,
-                  "Prior variance, added as sigma-prior / (k + 1)")
-      ->capture_default_str();
-  grp->add_option("--pg-reseed-ratio", g.reseed_ratio,
-                  "Re-seed a lobe on a sample this many times brighter than its history")
-      ->capture_default_str();
-  grp->add_option("--pg-em-passes", g.em_passes, "E-step passes over each frame's training samples")
-      ->capture_default_str();
-  grp->add_option("--pg-weight-clamp", g.weight_clamp,
-                  "Clamp training weights to this multiple of the running mean (0 = off)")
-      ->capture_default_str();
-  grp->add_option("--pg-reproject-position", g.reproject_position,
-                  "Relative position change that rejects history")
-      ->capture_default_str();
-  grp->add_option("--pg-reproject-normal", g.reproject_normal,
-                  "Normal cosine below which history is rejected")
-      ->capture_default_str();
-  grp->add_option("--pg-roughness-skip", g.roughness_skip, "No guiding at or below this roughness")
-      ->capture_default_str();
+  auto* grp = cmd->add_option_group("Guiding",
+                                    "Settings of the PMM guider (include/rtpg/guiding_settings.h)");
+  for (const rtpg::GuidingSettingInfo& row : rtpg::guiding_settings_table()) {
+    const std::string help = std::string(row.help) + ", in " + row.range_text();
+    if (row.int_field) {
+      grp->add_option(guiding_flag(row.name), g.*row.int_field, help)->capture_default_str();
+    } else {
+      grp->add_option(guiding_flag(row.name), g.*row.float_field, help)->capture_default_str();
+    }
+  }
   grp->add_option("--pg-train-memory", r.train_memory,
                   "VPL reads of the train kernel: auto, local or global")
       ->check(CLI::IsMember({"auto", "local", "global"}))
@@ -95,7 +73,7 @@ int main(int argc, char** argv) {
   CLI::App app{"rtpg: real-time screen-space path guiding (Embree + OpenCL)"};
   app.require_subcommand(1);
 
-  rtpg::RenderOptions render;
+  rtpg::RenderCommand render;
   std::string render_res = "640x360";
   auto* render_cmd = app.add_subcommand("render", "Render frames of a scene");
   add_common(render_cmd, render.common, false);
@@ -129,7 +107,7 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--stats-json", render.stats_json, "Write per-frame statistics as JSON");
   add_guiding_options(render_cmd, render);
 
-  rtpg::ReferenceOptions reference;
+  rtpg::ReferenceCommand reference;
   std::string reference_res = "640x360";
   auto* reference_cmd = app.add_subcommand("reference", "Render a many-sample reference image");
   add_common(reference_cmd, reference.common, true);
@@ -145,7 +123,7 @@ int main(int argc, char** argv) {
   reference_cmd->add_option("--max-bounces", reference.max_bounces,
                             "Path vertices after the primary hit (default: the scene's, else 8)");
 
-  rtpg::CommonOptions info;
+  rtpg::CommonArguments info;
   auto* info_cmd = app.add_subcommand("info", "Describe a scene");
   add_common(info_cmd, info, true);
 
@@ -166,10 +144,8 @@ int main(int argc, char** argv) {
     if (*render_cmd) {
       if (!parse_resolution(render_res, render.settings.width, render.settings.height))
         throw rtpg::InputError("--res", "expected WxH, got '" + render_res + "'");
-      render.guiding_config.train_memory =
-          render.train_memory == "local"    ? rtpg::GuidingConfig::TrainMemory::Local
-          : render.train_memory == "global" ? rtpg::GuidingConfig::TrainMemory::Global
-                                            : rtpg::GuidingConfig::TrainMemory::Auto;
+      if (!rtpg::parse_train_memory(render.train_memory, render.guiding_settings.train_memory))
+        throw rtpg::InputError("--pg-train-memory", "unknown value '" + render.train_memory + "'");
       return rtpg::run_render(render);
     }
     if (*reference_cmd) {

@@ -1,4 +1,4 @@
-#include "cl/cl_error.h"
+#include "rtpg/cl_error.h"
 
 #include <sstream>
 

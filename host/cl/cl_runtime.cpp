@@ -1,10 +1,14 @@
-#include "cl/cl_runtime.h"
+#include "rtpg/cl_runtime.h"
 
+#include <map>
+#include <mutex>
 #include <utility>
 #include <vector>
 
 #include "cl/cache_dir.h"
+#include "cl/device.h"
 #include "cl/kernel_source.h"
+#include "cl/program_cache.h"
 
 namespace rtpg {
 namespace {
@@ -20,13 +24,29 @@ SelectedDevice select_or_throw(const std::string& spec) {
 
 }  // namespace
 
+struct ClRuntime::Programs {
+  explicit Programs(const std::string& dir) : disk_cache(dir) {}
+  DiskProgramCache disk_cache;
+  std::mutex mutex;  // guards everything below: program() may be called from any thread
+  std::map<std::string, std::string> embedded_sources;  // resolved embedded sources
+  std::map<std::string, cl::Program> built;             // by cache key
+  ProgramCacheStats stats;
+};
+
+ClRuntime::~ClRuntime() = default;
+
+ProgramCacheStats ClRuntime::cache_stats() const {
+  std::lock_guard<std::mutex> lock(programs_->mutex);
+  return programs_->stats;
+}
+
 ClRuntime::ClRuntime(const std::string& device_spec) : ClRuntime(select_or_throw(device_spec)) {}
 
 ClRuntime::ClRuntime(SelectedDevice selected)
     : info_(std::move(selected.info)),
       device_(std::move(selected.device)),
       cache_dir_(rtpg_cache_dir()),
-      disk_cache_(cache_dir_) {
+      programs_(std::make_unique<Programs>(cache_dir_)) {
   translate_cl_errors([&] {
     context_ = cl::Context(device_);
     queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
@@ -38,15 +58,16 @@ const std::string& ClRuntime::resolved_source(const std::string& kernel_file) {
   // is the point of the switch), so those are read again on every request.
   const std::string origin = kernel_file_origin();
   const std::string memo_key = origin + '\n' + kernel_file;
-  auto it = embedded_sources_.find(memo_key);
-  if (it == embedded_sources_.end() || origin != "embedded") {
-    it = embedded_sources_.insert_or_assign(memo_key, resolve_kernel_source(kernel_file)).first;
+  auto it = programs_->embedded_sources.find(memo_key);
+  if (it == programs_->embedded_sources.end() || origin != "embedded") {
+    it = programs_->embedded_sources.insert_or_assign(memo_key, resolve_kernel_source(kernel_file))
+             .first;
   }
   return it->second;
 }
 
 cl::Program& ClRuntime::program(const std::string& kernel_file, const std::string& build_options) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::lock_guard<std::mutex> lock(programs_->mutex);
   const std::string& source = resolved_source(kernel_file);
   const std::string options =
       build_options.empty() ? kBaseOptions : std::string(kBaseOptions) + " " + build_options;
@@ -55,21 +76,21 @@ cl::Program& ClRuntime::program(const std::string& kernel_file, const std::strin
   const std::string key = "source " + content_hash(source) + "\noptions " + options +
                           "\nplatform " + info_.platform_name + "\ndevice " + info_.device_name +
                           " | " + info_.device_version + " | " + info_.driver_version + "\n";
-  if (auto it = programs_.find(key); it != programs_.end()) {
-    ++stats_.memory_hits;
+  if (auto it = programs_->built.find(key); it != programs_->built.end()) {
+    ++programs_->stats.memory_hits;
     return it->second;
   }
-  return programs_.emplace(key, build(kernel_file, source, options, key)).first->second;
+  return programs_->built.emplace(key, build(kernel_file, source, options, key)).first->second;
 }
 
 cl::Program ClRuntime::build(const std::string& kernel_file, const std::string& source,
                              const std::string& options, const std::string& key) {
   const std::vector<cl::Device> devices{device_};
-  if (auto binary = disk_cache_.load(key)) {
+  if (auto binary = programs_->disk_cache.load(key)) {
     try {
       cl::Program program(context_, devices, cl::Program::Binaries{std::move(*binary)});
       program.build(devices, options.c_str());
-      ++stats_.disk_hits;
+      ++programs_->stats.disk_hits;
       return program;
     } catch (const cl::Error&) {
       // A binary from another driver build or a damaged file: fall through to the source.
@@ -92,11 +113,11 @@ cl::Program ClRuntime::build(const std::string& kernel_file, const std::string& 
     }
     throw ClBuildError(kernel_file, info_.device_name, log, e.err());
   }
-  ++stats_.source_builds;
+  ++programs_->stats.source_builds;
 
   try {
     const auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
-    if (binaries.size() == 1) disk_cache_.store(key, binaries.front());
+    if (binaries.size() == 1) programs_->disk_cache.store(key, binaries.front());
   } catch (const cl::Error&) {
     // A driver that cannot hand out binaries simply gets no disk cache.
   }

@@ -7,8 +7,8 @@
 #include <utility>
 
 #include "cl/cache_dir.h"
-#include "cl/cl_error.h"
-#include "util/error.h"
+#include "rtpg/cl_error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 namespace {

@@ -9,7 +9,7 @@
 
 #include <glm/glm.hpp>
 
-#include "cl/cl_runtime.h"
+#include "rtpg/cl_runtime.h"
 
 namespace rtpg {
 

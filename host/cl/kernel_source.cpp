@@ -5,7 +5,7 @@
 #include <set>
 #include <sstream>
 
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 namespace {
@@ -53,8 +53,18 @@ bool quoted_include(const std::string& line, std::string& path) {
   return true;
 }
 
+// Kernel files live under kernels/, except the public layout header the kernels share with
+// host code: "rtpg/<h>" is include/rtpg/<h> (include/rtpg/guiding_layout.h).
+bool is_public_header(const std::string& path) {
+  return path.compare(0, 5, "rtpg/") == 0;
+}
+
+std::string source_path(const std::string& path) {
+  return (is_public_header(path) ? "include/" : "kernels/") + path;
+}
+
 std::string line_directive(int line, const std::string& path) {
-  return "#line " + std::to_string(line) + " \"kernels/" + path + "\"\n";
+  return "#line " + std::to_string(line) + " \"" + source_path(path) + "\"\n";
 }
 
 class Resolver {
@@ -64,7 +74,7 @@ class Resolver {
   void include(const std::string& path, const std::string& included_from) {
     const std::optional<std::string> text = load_(path);
     if (!text) {
-      throw InputError("kernels/" + path,
+      throw InputError(source_path(path),
                        "no such kernel file" +
                            (included_from.empty() ? "" : " (included from " + included_from + ")") +
                            " in " + kernel_file_origin() + " kernel sources");
@@ -79,7 +89,7 @@ class Resolver {
         if (included_.count(target) != 0) {
           out_ += "// #include \"" + target + "\": already included above\n";
         } else {
-          include(target, "kernels/" + path + ":" + std::to_string(number));
+          include(target, source_path(path) + ":" + std::to_string(number));
           out_ += line_directive(number + 1, path);
         }
         continue;
@@ -102,7 +112,10 @@ class Resolver {
 
 std::optional<std::string> load_kernel_file(const std::string& path) {
   if (const char* dir = kernel_dir_override()) {
-    std::ifstream file(std::string(dir) + "/" + path, std::ios::binary);
+    // The public header sits beside the kernels folder: <dir>/../include/rtpg/<h>.
+    const std::string file_path =
+        std::string(dir) + (is_public_header(path) ? "/../include/" : "/") + path;
+    std::ifstream file(file_path, std::ios::binary);
     if (!file) return std::nullopt;
     std::ostringstream text;
     text << file.rdbuf();

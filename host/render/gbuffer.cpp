@@ -1,31 +1,26 @@
 #include "render/gbuffer.h"
 
+#include "shared/guiding_pixel.h"
+
 namespace rtpg {
 
 void GBuffer::resize(int w, int h) {
   width = w;
   height = h;
   const std::size_t n = pixel_count();
-  position_depth.assign(n, glm::vec4(0.0f));
-  shading_normal.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
+#define RTPG_CLEAR(name, type, bytes) name.assign(n, shared::type(0));
+  PG_GBUFFER_CHANNELS(RTPG_CLEAR)
+#undef RTPG_CLEAR
   geometric_normal.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
-  view_dir.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
-  motion.assign(n, glm::vec2(0.0f));
-  base_color_roughness.assign(n, glm::vec4(0.0f));
-  metallic_specular.assign(n, glm::vec4(0.0f));
   emission.assign(n, glm::vec4(0.0f));
-  material_id.assign(n, 0u);
+  // Unit vectors stay unit on pixels that no hit overwrites.
+  shading_normal.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
+  view_dir.assign(n, glm::vec4(0.0f, 0.0f, 1.0f, 0.0f));
   flags.assign(n, PG_GBUF_SKY);
 }
 
 shared::pg_material gbuffer_material(const GBuffer& g, std::size_t i) {
-  shared::pg_material m;
-  const glm::vec4 bc = g.base_color_roughness[i];
-  m.base_color = shared::float3(bc.x, bc.y, bc.z);
-  m.roughness = bc.w;
-  m.metallic = g.metallic_specular[i].x;
-  m.specular = g.metallic_specular[i].y;
-  return m;
+  return shared::pg_material_from_gbuffer(g.base_color_roughness[i], g.metallic_specular[i]);
 }
 
 shared::pg_frame gbuffer_frame(const GBuffer& g, std::size_t i) {

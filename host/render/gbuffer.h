@@ -1,5 +1,7 @@
-// The G-buffer of one frame: what the camera rays hit, per pixel, structure of arrays in the
-// layouts the OpenCL kernels read (float4 / uint), so it uploads without repacking.
+// The G-buffer of one frame on the host: what the camera rays hit, per pixel, structure of
+// arrays. The channels the guiding kernels read come from PG_GBUFFER_CHANNELS (their layout
+// and meaning: include/rtpg/guiding_layout.h), so the buffer uploads without repacking
+// (enqueue_upload in include/rtpg/guider.h); two more channels only the path tracer needs.
 #pragma once
 
 #include <cstdint>
@@ -7,27 +9,27 @@
 
 #include <glm/glm.hpp>
 
+#include "rtpg/guiding_layout.h"
 #include "shared/bsdf.h"
-#include "shared/gbuffer.h"
+#include "shared/compat.h"
 
 namespace rtpg {
 
 struct GBuffer {
   int width = 0, height = 0;
-  std::vector<glm::vec4> position_depth;        // xyz world position, w linear depth (0 on sky)
-  std::vector<glm::vec4> shading_normal;        // xyz, facing the camera; w unused
-  std::vector<glm::vec4> geometric_normal;      // xyz, facing the camera; w unused
-  std::vector<glm::vec4> view_dir;              // xyz unit vector from the surface to the camera
-  std::vector<glm::vec2> motion;                // pixel offset to where the point was last frame
-  std::vector<glm::vec4> base_color_roughness;  // rgb base colour, a perceptual roughness
-  std::vector<glm::vec4> metallic_specular;     // x metallic, y dielectric F0
-  std::vector<glm::vec4> emission;              // rgb emitted towards the camera (or sky radiance)
-  std::vector<std::uint32_t> material_id;
-  std::vector<std::uint32_t> flags;  // PG_GBUF_* bits
+#define RTPG_HOST_CHANNEL(name, type, bytes) std::vector<shared::type> name;
+  PG_GBUFFER_CHANNELS(RTPG_HOST_CHANNEL)
+#undef RTPG_HOST_CHANNEL
+  std::vector<glm::vec4> geometric_normal;  // xyz, facing the camera; w unused
+  std::vector<glm::vec4> emission;          // rgb emitted towards the camera (or sky radiance)
 
-  void resize(int w, int h);
-  std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
-  bool has_surface(std::size_t i) const { return (flags[i] & PG_GBUF_SKY) == 0; }
+  void resize(int w, int h);  // every pixel sky
+  std::size_t pixel_count() const {
+    return static_cast<std::size_t>(width) * height;
+  }
+  bool has_surface(std::size_t i) const {
+    return (flags[i] & PG_GBUF_SKY) == 0;
+  }
 };
 
 // Pixel i's material in the shared BSDF's terms and its shading frame (the frame the guiding

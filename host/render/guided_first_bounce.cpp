@@ -6,11 +6,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include "cl/cl_runtime.h"
-#include "guiding/guiding_params.h"
-#include "render/path_tracer.h"
-#include "shared/guiding_pixel.h"
-#include "shared/pmm.h"
+#include "rtpg/cl_runtime.h"
 
 namespace rtpg {
 namespace {
@@ -20,61 +16,30 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-template <typename T>
-void write(cl::CommandQueue& q, const cl::Buffer& b, const std::vector<T>& v) {
-  q.enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
-}
-
-shared::pg_pmm_state state_at(const std::vector<float>& s, std::size_t i) {
-  shared::pg_pmm_state st;
-  st.s0 = glm::vec4(s[i * 8 + 0], s[i * 8 + 1], s[i * 8 + 2], s[i * 8 + 3]);
-  st.s1 = glm::vec4(s[i * 8 + 4], s[i * 8 + 5], s[i * 8 + 6], s[i * 8 + 7]);
-  return st;
+// Pixel i's guiding distribution from the state read back after reprojection.
+void init_distribution(GuidingDistribution& d, const GBuffer& g, const std::vector<float>& state,
+                       std::size_t i) {
+  d.init(&state[i * PG_STATE_FLOATS_PER_PIXEL], &g.shading_normal[i].x, &g.view_dir[i].x,
+         &g.base_color_roughness[i].x, &g.metallic_specular[i].x, g.flags[i]);
 }
 
 }  // namespace
 
 GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
-                                     const GuidingConfig& config)
-    : runtime_(runtime), guider_(std::make_unique<Guider>(runtime, width, height, config)) {
-  const std::size_t n = static_cast<std::size_t>(width) * height;
-  cl::Context& ctx = runtime.context();
-  for (GuiderGBuffer& g : gbuffers_) {
-    g.position_depth = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 16);
-    g.shading_normal = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 16);
-    g.view_dir = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 16);
-    g.base_color_roughness = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 16);
-    g.metallic_specular = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 16);
-    g.flags = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 4);
-    g.material = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 4);
-    g.motion = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 8);
-  }
-  vpls_.position = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 16);
-  vpls_.normal = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 16);
-  vpls_.radiance_info = cl::Buffer(ctx, CL_MEM_READ_ONLY, n * 16);
-  samples_.direction_pdf = cl::Buffer(ctx, CL_MEM_WRITE_ONLY, n * 16);
-  samples_.strategy = cl::Buffer(ctx, CL_MEM_WRITE_ONLY, n * 4);
+                                     const GuidingSettings& settings)
+    : runtime_(runtime), guider_(std::make_unique<Guider>(runtime, width, height, settings)) {
+  for (GuiderGBuffer& g : gbuffers_) g = make_guider_gbuffer(runtime.context(), width, height);
+  vpls_ = make_guider_vpls(runtime.context(), width, height);
+  samples_ = make_guider_samples(runtime.context(), width, height);
 }
 
 GuidedFirstBounce::~GuidedFirstBounce() = default;
 
-void GuidedFirstBounce::upload(const GBuffer& g, GuiderGBuffer& dst) {
-  cl::CommandQueue& q = runtime_.queue();
-  write(q, dst.position_depth, g.position_depth);
-  write(q, dst.shading_normal, g.shading_normal);
-  write(q, dst.view_dir, g.view_dir);
-  write(q, dst.base_color_roughness, g.base_color_roughness);
-  write(q, dst.metallic_specular, g.metallic_specular);
-  write(q, dst.flags, g.flags);
-  write(q, dst.material, g.material_id);
-  write(q, dst.motion, g.motion);
-}
-
 void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& at) {
   auto t = Clock::now();
   current_ = 1 - current_;
-  upload(g, gbuffers_[current_]);
-  runtime_.queue().finish();
+  enqueue_upload(runtime_.queue(), g, gbuffers_[current_]);
+  translate_cl_errors([&] { runtime_.queue().finish(); });
   upload_ms_ = ms_since(t);
   if (have_previous_) {
     guider_->reproject(gbuffers_[current_], gbuffers_[1 - current_]);
@@ -86,7 +51,6 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   guider_->read_state(state_);
   readback_ms_ = ms_since(t);
   sample_ms_ = 0.0;
-  const shared::pg_guiding_params p = make_guiding_params(guider_->config());
   // Share of surface pixels sampling a trained model, and their mean pi (statistics only).
   struct Counts {
     std::size_t surfaces = 0, guided = 0;
@@ -95,14 +59,14 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   const Counts counts = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, g.pixel_count(), 8192), Counts{},
       [&](const tbb::blocked_range<std::size_t>& r, Counts c) {
+        GuidingDistribution d(guider_->kernel_settings());
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
           if (!g.has_surface(i)) continue;
           ++c.surfaces;
-          if (!shared::pg_guiding_applies(g.flags[i], g.base_color_roughness[i].w, p)) continue;
-          const shared::pg_pmm_model m = shared::pg_pmm_model_from_state(state_at(state_, i), p);
-          if (!m.valid) continue;
+          init_distribution(d, g, state_, i);
+          if (!d.guided()) continue;
           ++c.guided;
-          c.pi_sum += m.pi;
+          c.pi_sum += d.mixing_weight();
         }
         return c;
       },
@@ -124,47 +88,38 @@ void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
   guider_->sample(gbuffers_[current_], at.seed, at.frame, at.sample, samples_);
   sample_ms_ += guider_->last_times().sample_ms;
   const std::size_t n = g.pixel_count();
-  direction_pdf_.resize(n);
-  strategy_.resize(n);
+  host_samples_.direction_pdf.resize(n);
+  host_samples_.strategy.resize(n);
   const auto t = Clock::now();
-  runtime_.queue().enqueueReadBuffer(samples_.direction_pdf, CL_FALSE, 0, n * 16,
-                                     direction_pdf_.data());
-  runtime_.queue().enqueueReadBuffer(samples_.strategy, CL_TRUE, 0, n * 4, strategy_.data());
+  enqueue_download(runtime_.queue(), samples_, host_samples_);
+  translate_cl_errors([&] { runtime_.queue().finish(); });
   readback_ms_ += ms_since(t);
   out.resize(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8192), [&](const auto& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const glm::vec4 d = direction_pdf_[i];
+      const glm::vec4 d = host_samples_.direction_pdf[i];
       out[i].direction = glm::vec3(d);
       out[i].pdf = d.w > 0.0f && std::isfinite(d.w) ? d.w : 0.0f;
-      out[i].strategy = strategy_[i] == PG_STRATEGY_GUIDE  ? kStrategyGuide
-                        : strategy_[i] == PG_STRATEGY_BSDF ? kStrategyBsdf
-                                                           : kStrategyNone;
+      const std::uint32_t s = host_samples_.strategy[i];
+      out[i].strategy = s == PG_STRATEGY_GUIDE  ? kStrategyGuide
+                        : s == PG_STRATEGY_BSDF ? kStrategyBsdf
+                                                : kStrategyNone;
     }
   });
 }
 
 float GuidedFirstBounce::pdf(const GBuffer& g, std::size_t i, const glm::vec3& wi) const {
-  const shared::pg_guiding_params p = make_guiding_params(guider_->config());
-  const shared::pg_frame frame = gbuffer_frame(g, i);
-  const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
-  const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
-  shared::pg_pmm_state st = shared::pg_pmm_initial_state();
-  if (shared::pg_guiding_applies(g.flags[i], g.base_color_roughness[i].w, p))
-    st = state_at(state_, i);
-  const shared::pg_pmm_model model = shared::pg_pmm_model_from_state(st, p);
-  return shared::pg_pmm_pdf(model, lobes, wo, shared::pg_to_local(frame, wi));
+  GuidingDistribution d(guider_->kernel_settings());
+  init_distribution(d, g, state_, i);
+  return d.pdf(&wi.x);
 }
 
 void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
                                   const SampleCoordinates& at) {
   if (!training_) return;
   const auto t = Clock::now();
-  cl::CommandQueue& q = runtime_.queue();
-  write(q, vpls_.position, vpls.position);
-  write(q, vpls_.normal, vpls.normal);
-  write(q, vpls_.radiance_info, vpls.radiance);
-  q.finish();
+  enqueue_upload(runtime_.queue(), vpls, vpls_);
+  translate_cl_errors([&] { runtime_.queue().finish(); });
   upload_ms_ += ms_since(t);
   guider_->train(gbuffers_[current_], vpls_, at.seed, at.frame);
   std::size_t surfaces = 0;

@@ -7,7 +7,9 @@
 #include <vector>
 
 #include "render/first_bounce.h"
+#include "render/vpl_buffer.h"
 #include "rtpg/guider.h"
+#include "rtpg/guiding_distribution.h"
 
 namespace rtpg {
 
@@ -15,7 +17,7 @@ class ClRuntime;
 
 class GuidedFirstBounce final : public FirstBounceSampler {
  public:
-  GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingConfig& config);
+  GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingSettings& settings);
   ~GuidedFirstBounce() override;
 
   void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) override;
@@ -33,8 +35,6 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void set_training(bool on) { training_ = on; }
 
  private:
-  void upload(const GBuffer& g, GuiderGBuffer& dst);
-
   ClRuntime& runtime_;
   std::unique_ptr<Guider> guider_;
   GuiderGBuffer gbuffers_[2];
@@ -43,8 +43,10 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   bool training_ = true;
   GuiderVpls vpls_;
   GuiderSamples samples_;
-  std::vector<glm::vec4> direction_pdf_;
-  std::vector<std::uint32_t> strategy_;
+  struct HostSamples {  // PG_SAMPLE_CHANNELS on the host
+    std::vector<glm::vec4> direction_pdf;
+    std::vector<std::uint32_t> strategy;
+  } host_samples_;
   std::vector<float> state_;  // after reprojection: what sample() and pdf() use
   double upload_ms_ = 0.0, readback_ms_ = 0.0, sample_ms_ = 0.0;
   double guided_fraction_ = 0.0, trained_fraction_ = 0.0, mean_pi_ = 0.0;

@@ -8,7 +8,7 @@
 
 #include <OpenImageIO/imageio.h>
 
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 namespace fs = std::filesystem;

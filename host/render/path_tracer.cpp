@@ -10,7 +10,7 @@
 
 #include "render/surface.h"
 #include "shared/rng.h"
-#include "shared/vpl.h"
+#include "rtpg/guiding_layout.h"
 
 namespace rtpg {
 namespace {
@@ -47,16 +47,239 @@ Ray inactive_ray() {
 
 }  // namespace
 
-void VplBuffer::resize(std::size_t n) {
-  position.assign(n, glm::vec4(0.0f));
-  normal.assign(n, glm::vec4(0.0f));
-  radiance.assign(n, glm::vec4(0.0f));
-  info.assign(n, 0u);
-}
-
 PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer, const Lights& lights,
                        PathTracerSettings settings)
     : scene_(scene), tracer_(tracer), lights_(lights), settings_(settings) {}
+
+void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& first,
+                       const FirstBounceSampler& sampler, const SampleCoordinates& at,
+                       std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite,
+                       RayCounts& rays, PassTimes& times) {
+  const std::size_t n = g.pixel_count();
+  prepare(n, vpls);
+  auto start = Clock::now();
+  start_paths(g, first, sampler, at, vpls);
+  times.shade_ms += ms_since(start);
+  run_shadow_rays(n, rays, times);
+  apply_shadow_rays(n, nullptr);
+  compact(n, nullptr);
+
+  for (int depth = 1; depth <= settings_.max_bounces && !active_.empty(); ++depth) {
+    const std::size_t m = active_.size();
+    start = Clock::now();
+    tracer_.intersect(rays_.data(), hits_.data(), m);
+    times.trace_ms += ms_since(start);
+    rays.secondary += m;
+
+    start = Clock::now();
+    shade_bounce(depth, m, vpls);
+    times.shade_ms += ms_since(start);
+    run_shadow_rays(m, rays, times);
+    apply_shadow_rays(m, &active_);
+    compact(m, &active_);
+  }
+  gather(radiance, vpls, nonfinite);
+}
+
+void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
+  paths_.resize(n);
+  if (vpls) vpls->resize(n);
+  shadow_rays_.resize(n);
+  shadow_work_.resize(n);
+  rays_.resize(n);
+  hits_.resize(n);
+  alive_.assign(n, 0);
+  next_event_on_ = settings_.next_event && !lights_.empty();
+}
+
+template <class CompetingPdf>
+bool PathTracer::next_event(const glm::vec3& position, const glm::vec3& ng,
+                            const shared::pg_frame& frame, const glm::vec3& wo,
+                            const shared::pg_lobes& lobes, const glm::vec3& origin, float u_select,
+                            float u1, float u2, const CompetingPdf& competing_pdf,
+                            glm::vec3& contribution, Ray& shadow) const {
+  LightSample ls;
+  if (!lights_.sample(position, u_select, u1, u2, ls) || glm::dot(ls.direction, ng) <= 0.0f)
+    return false;
+  const glm::vec3 wi = shared::pg_to_local(frame, ls.direction);
+  const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
+  if (is_black(f)) return false;
+  const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, competing_pdf(ls.direction, wi));
+  contribution = f * ls.radiance * (w / ls.pdf);
+  shadow = shadow_ray(origin, ls);
+  return true;
+}
+
+void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSample>& first,
+                             const FirstBounceSampler& sampler, const SampleCoordinates& at,
+                             VplBuffer* vpls) {
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, g.pixel_count(), kGrain), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          PathState& p = paths_[i];
+          p.radiance = glm::vec3(g.emission[i]);
+          p.vpl_radiance = glm::vec3(0.0f);
+          p.throughput = glm::vec3(0.0f);
+          p.vpl_throughput = glm::vec3(1.0f);
+          shadow_rays_[i] = inactive_ray();
+          rays_[i] = inactive_ray();
+          alive_[i] = 0;
+          if (!g.has_surface(i)) continue;
+          shared::pg_rng rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
+                                                   at.sample, PG_RNG_STREAM_PATH);
+          const glm::vec3 x0(g.position_depth[i]);
+          const glm::vec3 ng(g.geometric_normal[i]);
+          const shared::pg_frame frame = gbuffer_frame(g, i);
+          const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
+          const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
+          const glm::vec3 origin = offset_ray_origin(x0, ng);
+
+          const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
+                      u2 = shared::pg_rng_next(&rng);
+          // The first bounce's own sampler competes with the light here (the guided mixture).
+          const auto first_bounce_pdf = [&](const glm::vec3& direction, const glm::vec3&) {
+            return sampler.pdf(g, i, direction);
+          };
+          glm::vec3 c;
+          Ray shadow;
+          if (next_event_on_ && next_event(x0, ng, frame, wo, lobes, origin, u_sel, u1, u2,
+                                           first_bounce_pdf, c, shadow)) {
+            shadow_work_[i].contribution = c;
+            shadow_work_[i].vpl_contribution = glm::vec3(0.0f);
+            shadow_rays_[i] = shadow;
+          }
+
+          const FirstBounceSample& fs = first[i];
+          if (fs.pdf > 0.0f && glm::dot(fs.direction, ng) > 0.0f) {
+            const glm::vec3 wi = shared::pg_to_local(frame, fs.direction);
+            const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
+            p.throughput = f / fs.pdf;
+            if (vpls) {
+              // The VPL keeps the density of the strategy that made it: trained samples are BSDF
+              // samples, distributed by the BSDF alone (paper 3.2). Area measure comes later.
+              const float bsdf_pdf = shared::pg_bsdf_pdf(lobes, wo, wi);
+              vpls->position[i].w = fs.strategy == kStrategyBsdf ? bsdf_pdf : fs.pdf;
+              vpls->info[i] = fs.strategy << PG_VPL_STRATEGY_SHIFT;
+            }
+            if (!is_black(p.throughput) && is_finite(p.throughput)) {
+              Ray r;
+              r.origin = origin;
+              r.direction = fs.direction;
+              rays_[i] = r;
+              p.prev_pdf = fs.pdf;
+              p.prev_position = x0;
+              alive_[i] = 1;
+            }
+          }
+          p.rng = rng.state;
+        }
+      });
+}
+
+void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls) {
+  const bool nee = next_event_on_;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
+    for (std::size_t j = range.begin(); j != range.end(); ++j) {
+      const std::uint32_t i = active_[j];
+      PathState& p = paths_[i];
+      const Ray ray = rays_[j];
+      const Hit& hit = hits_[j];
+      shadow_rays_[j] = inactive_ray();
+      alive_[j] = 0;
+      const glm::vec3 dir = glm::normalize(ray.direction);
+      if (!hit.valid()) {
+        const glm::vec3 le = lights_.escaped_radiance(dir);
+        const float w = nee ? power_heuristic(p.prev_pdf, lights_.pdf_escaped(dir)) : 1.0f;
+        p.radiance += p.throughput * le * w;
+        if (depth == 1) {
+          // With next-event estimation at x0 the light's own direction is NEE's job: the
+          // guide learns only what arrives indirectly (emission at y stays out).
+          if (!nee) p.vpl_radiance += le;
+          if (vpls) {
+            vpls->position[i] = glm::vec4(dir, vpls->position[i].w);
+            vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
+          }
+        } else {
+          p.vpl_radiance += p.vpl_throughput * le * w;
+        }
+        continue;
+      }
+      const SurfacePoint sp = make_surface_point(scene_, ray, hit);
+      if (!is_black(sp.emission)) {
+        const float w =
+            nee ? power_heuristic(p.prev_pdf,
+                                  lights_.pdf_triangle(hit.mesh, hit.triangle, p.prev_position,
+                                                       sp.position, sp.geometric_normal))
+                : 1.0f;
+        p.radiance += p.throughput * sp.emission * w;
+        if (depth > 1) {
+          p.vpl_radiance += p.vpl_throughput * sp.emission * w;
+        } else if (!nee) {
+          p.vpl_radiance += sp.emission;  // see the escaped case above
+        }
+      }
+      if (depth == 1 && vpls) {
+        // Density in area measure at y: solid angle at x0 times cos(theta_y) / d^2.
+        const glm::vec3 to = sp.position - p.prev_position;
+        const float d2 = glm::dot(to, to);
+        const float cos_y = std::fabs(glm::dot(sp.geometric_normal, dir));
+        vpls->position[i] = glm::vec4(sp.position, vpls->position[i].w * cos_y / d2);
+        vpls->normal[i] = glm::vec4(sp.geometric_normal, 0.0f);
+        vpls->info[i] |= PG_VPL_VALID;
+      }
+      if (depth == settings_.max_bounces) continue;
+
+      shared::pg_rng rng;
+      rng.state = p.rng;
+      const shared::pg_frame frame = shared::pg_frame_from_normal(sp.shading_normal);
+      const glm::vec3 wo = shared::pg_to_local(frame, -dir);
+      const shared::pg_lobes lobes = shared::pg_make_lobes(sp.material, wo);
+      const glm::vec3 origin = offset_ray_origin(sp.position, sp.geometric_normal);
+      const glm::vec3 vpl_throughput = depth == 1 ? glm::vec3(1.0f) : p.vpl_throughput;
+
+      const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
+                  u2 = shared::pg_rng_next(&rng);
+      // Beyond the first bounce the BSDF sampler competes with the light.
+      const auto bsdf_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
+        return shared::pg_bsdf_pdf(lobes, wo, wi);
+      };
+      glm::vec3 c;
+      Ray shadow;
+      if (nee && next_event(sp.position, sp.geometric_normal, frame, wo, lobes, origin, u_sel, u1,
+                            u2, bsdf_pdf, c, shadow)) {
+        shadow_work_[j].contribution = p.throughput * c;
+        shadow_work_[j].vpl_contribution = vpl_throughput * c;
+        shadow_rays_[j] = shadow;
+      }
+
+      const float u_lobe = shared::pg_rng_next(&rng), v1 = shared::pg_rng_next(&rng),
+                  v2 = shared::pg_rng_next(&rng), u_rr = shared::pg_rng_next(&rng);
+      p.rng = rng.state;
+      const shared::pg_bsdf_sample_t bs = shared::pg_bsdf_sample(lobes, wo, u_lobe, v1, v2);
+      if (bs.pdf <= 0.0f) continue;
+      const glm::vec3 wi_world = shared::pg_to_world(frame, bs.wi);
+      if (glm::dot(wi_world, sp.geometric_normal) <= 0.0f) continue;
+      const glm::vec3 weight = shared::pg_bsdf_eval(lobes, wo, bs.wi) * (bs.wi.z / bs.pdf);
+      p.throughput *= weight;
+      p.vpl_throughput = vpl_throughput * weight;
+      if (depth >= settings_.roulette_start) {
+        const float q =
+            std::min(0.95f, std::max(p.throughput.x, std::max(p.throughput.y, p.throughput.z)));
+        if (!(u_rr < q)) continue;
+        p.throughput /= q;
+        p.vpl_throughput /= q;
+      }
+      if (is_black(p.throughput) || !is_finite(p.throughput)) continue;
+      p.prev_pdf = bs.pdf;
+      p.prev_position = sp.position;
+      Ray next;
+      next.origin = origin;
+      next.direction = wi_world;
+      rays_[j] = next;
+      alive_[j] = 1;
+    }
+  });
+}
 
 void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times) {
   const auto start = Clock::now();
@@ -68,229 +291,29 @@ void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& 
   rays.shadow += valid;
 }
 
-void PathTracer::apply_shadow_rays(std::size_t count, const std::vector<std::uint32_t>& owners) {
+void PathTracer::apply_shadow_rays(std::size_t count, const std::vector<std::uint32_t>* owners) {
   for (std::size_t j = 0; j < count; ++j) {
     if (occluded_[j] || shadow_rays_[j].tmin > shadow_rays_[j].tmax) continue;
-    PathState& p = paths_[owners[j]];
+    PathState& p = paths_[owners ? (*owners)[j] : j];
     p.radiance += shadow_work_[j].contribution;
     p.vpl_radiance += shadow_work_[j].vpl_contribution;
   }
 }
 
-void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& first,
-                       const FirstBounceSampler& sampler, const SampleCoordinates& at,
-                       std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite,
-                       RayCounts& rays, PassTimes& times) {
-  const std::size_t n = g.pixel_count();
-  paths_.resize(n);
+void PathTracer::compact(std::size_t count, const std::vector<std::uint32_t>* owners) {
+  next_active_.clear();
+  for (std::size_t j = 0; j < count; ++j)
+    if (alive_[j]) {
+      rays_[next_active_.size()] = rays_[j];
+      next_active_.push_back(owners ? (*owners)[j] : static_cast<std::uint32_t>(j));
+    }
+  active_.swap(next_active_);
+}
+
+void PathTracer::gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls,
+                        std::uint64_t& nonfinite) const {
+  const std::size_t n = paths_.size();
   radiance.assign(n, glm::vec3(0.0f));
-  if (vpls) vpls->resize(n);
-  shadow_rays_.resize(n);
-  shadow_work_.resize(n);
-  rays_.resize(n);
-  hits_.resize(n);
-  std::vector<std::uint8_t> alive(n, 0);
-  const bool nee = settings_.next_event && !lights_.empty();
-
-  // Stage 0, at the primary hit x0: emission, next-event estimation, the first bounce ray.
-  auto start = Clock::now();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      PathState& p = paths_[i];
-      p.radiance = glm::vec3(g.emission[i]);
-      p.vpl_radiance = glm::vec3(0.0f);
-      p.throughput = glm::vec3(0.0f);
-      p.vpl_throughput = glm::vec3(1.0f);
-      shadow_rays_[i] = inactive_ray();
-      rays_[i] = inactive_ray();
-      alive[i] = 0;
-      if (!g.has_surface(i)) continue;
-      shared::pg_rng rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
-                                               at.sample, /*stream_tag=*/0u);
-      const glm::vec3 x0(g.position_depth[i]);
-      const glm::vec3 ng(g.geometric_normal[i]);
-      const shared::pg_frame frame = gbuffer_frame(g, i);
-      const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
-      const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
-      const glm::vec3 origin = offset_ray_origin(x0, ng);
-
-      const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
-                  u2 = shared::pg_rng_next(&rng);
-      LightSample ls;
-      if (nee && lights_.sample(x0, u_sel, u1, u2, ls) && glm::dot(ls.direction, ng) > 0.0f) {
-        const glm::vec3 wi = shared::pg_to_local(frame, ls.direction);
-        const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
-        if (!is_black(f)) {
-          const float w =
-              ls.delta ? 1.0f : power_heuristic(ls.pdf, sampler.pdf(g, i, ls.direction));
-          shadow_work_[i].contribution = f * ls.radiance * (w / ls.pdf);
-          shadow_work_[i].vpl_contribution = glm::vec3(0.0f);
-          shadow_rays_[i] = shadow_ray(origin, ls);
-        }
-      }
-
-      const FirstBounceSample& fs = first[i];
-      if (fs.pdf > 0.0f && glm::dot(fs.direction, ng) > 0.0f) {
-        const glm::vec3 wi = shared::pg_to_local(frame, fs.direction);
-        const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
-        p.throughput = f / fs.pdf;
-        if (vpls) {
-          // The VPL keeps the density of the strategy that made it: trained samples are BSDF
-          // samples, distributed by the BSDF alone (paper 3.2). Area measure comes later.
-          const float bsdf_pdf = shared::pg_bsdf_pdf(lobes, wo, wi);
-          vpls->position[i].w = fs.strategy == kStrategyBsdf ? bsdf_pdf : fs.pdf;
-          vpls->info[i] = fs.strategy << PG_VPL_STRATEGY_SHIFT;
-        }
-        if (!is_black(p.throughput) && is_finite(p.throughput)) {
-          Ray r;
-          r.origin = origin;
-          r.direction = fs.direction;
-          rays_[i] = r;
-          p.prev_pdf = fs.pdf;
-          p.prev_position = x0;
-          alive[i] = 1;
-        }
-      }
-      p.rng = rng.state;
-    }
-  });
-  times.shade_ms += ms_since(start);
-  run_shadow_rays(n, rays, times);
-  shadow_owner_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) shadow_owner_[i] = static_cast<std::uint32_t>(i);
-  apply_shadow_rays(n, shadow_owner_);
-
-  active_.clear();
-  for (std::size_t i = 0; i < n; ++i)
-    if (alive[i]) {
-      rays_[active_.size()] = rays_[i];
-      active_.push_back(static_cast<std::uint32_t>(i));
-    }
-
-  for (int depth = 1; depth <= settings_.max_bounces && !active_.empty(); ++depth) {
-    const std::size_t m = active_.size();
-    start = Clock::now();
-    tracer_.intersect(rays_.data(), hits_.data(), m);
-    times.trace_ms += ms_since(start);
-    rays.secondary += m;
-
-    start = Clock::now();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
-      for (std::size_t j = range.begin(); j != range.end(); ++j) {
-        const std::uint32_t i = active_[j];
-        PathState& p = paths_[i];
-        const Ray ray = rays_[j];
-        const Hit& hit = hits_[j];
-        shadow_rays_[j] = inactive_ray();
-        alive[j] = 0;
-        const glm::vec3 dir = glm::normalize(ray.direction);
-        if (!hit.valid()) {
-          const glm::vec3 le = lights_.escaped_radiance(dir);
-          const float w = nee ? power_heuristic(p.prev_pdf, lights_.pdf_escaped(dir)) : 1.0f;
-          p.radiance += p.throughput * le * w;
-          if (depth == 1) {
-            // With next-event estimation at x0 the light's own direction is NEE's job: the
-            // guide learns only what arrives indirectly (emission at y stays out).
-            if (!nee) p.vpl_radiance += le;
-            if (vpls) {
-              vpls->position[i] = glm::vec4(dir, vpls->position[i].w);
-              vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
-            }
-          } else {
-            p.vpl_radiance += p.vpl_throughput * le * w;
-          }
-          continue;
-        }
-        const SurfacePoint sp = make_surface_point(scene_, ray, hit);
-        if (!is_black(sp.emission)) {
-          const float w =
-              nee ? power_heuristic(p.prev_pdf,
-                                    lights_.pdf_triangle(hit.mesh, hit.triangle, p.prev_position,
-                                                         sp.position, sp.geometric_normal))
-                  : 1.0f;
-          p.radiance += p.throughput * sp.emission * w;
-          if (depth > 1) {
-            p.vpl_radiance += p.vpl_throughput * sp.emission * w;
-          } else if (!nee) {
-            p.vpl_radiance += sp.emission;  // see the escaped case above
-          }
-        }
-        if (depth == 1 && vpls) {
-          // Density in area measure at y: solid angle at x0 times cos(theta_y) / d^2.
-          const glm::vec3 to = sp.position - p.prev_position;
-          const float d2 = glm::dot(to, to);
-          const float cos_y = std::fabs(glm::dot(sp.geometric_normal, dir));
-          vpls->position[i] = glm::vec4(sp.position, vpls->position[i].w * cos_y / d2);
-          vpls->normal[i] = glm::vec4(sp.geometric_normal, 0.0f);
-          vpls->info[i] |= PG_VPL_VALID;
-        }
-        if (depth == settings_.max_bounces) continue;
-
-        shared::pg_rng rng;
-        rng.state = p.rng;
-        const shared::pg_frame frame = shared::pg_frame_from_normal(sp.shading_normal);
-        const glm::vec3 wo = shared::pg_to_local(frame, -dir);
-        const shared::pg_lobes lobes = shared::pg_make_lobes(sp.material, wo);
-        const glm::vec3 origin = offset_ray_origin(sp.position, sp.geometric_normal);
-        const glm::vec3 vpl_throughput = depth == 1 ? glm::vec3(1.0f) : p.vpl_throughput;
-
-        const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
-                    u2 = shared::pg_rng_next(&rng);
-        LightSample ls;
-        if (nee && lights_.sample(sp.position, u_sel, u1, u2, ls) &&
-            glm::dot(ls.direction, sp.geometric_normal) > 0.0f) {
-          const glm::vec3 wi = shared::pg_to_local(frame, ls.direction);
-          const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
-          if (!is_black(f)) {
-            const float w =
-                ls.delta ? 1.0f : power_heuristic(ls.pdf, shared::pg_bsdf_pdf(lobes, wo, wi));
-            const glm::vec3 c = f * ls.radiance * (w / ls.pdf);
-            shadow_work_[j].contribution = p.throughput * c;
-            shadow_work_[j].vpl_contribution = vpl_throughput * c;
-            shadow_rays_[j] = shadow_ray(origin, ls);
-          }
-        }
-
-        const float u_lobe = shared::pg_rng_next(&rng), v1 = shared::pg_rng_next(&rng),
-                    v2 = shared::pg_rng_next(&rng), u_rr = shared::pg_rng_next(&rng);
-        p.rng = rng.state;
-        const shared::pg_bsdf_sample_t bs = shared::pg_bsdf_sample(lobes, wo, u_lobe, v1, v2);
-        if (bs.pdf <= 0.0f) continue;
-        const glm::vec3 wi_world = shared::pg_to_world(frame, bs.wi);
-        if (glm::dot(wi_world, sp.geometric_normal) <= 0.0f) continue;
-        const glm::vec3 weight = shared::pg_bsdf_eval(lobes, wo, bs.wi) * (bs.wi.z / bs.pdf);
-        p.throughput *= weight;
-        p.vpl_throughput = vpl_throughput * weight;
-        if (depth >= settings_.roulette_start) {
-          const float q =
-              std::min(0.95f, std::max(p.throughput.x, std::max(p.throughput.y, p.throughput.z)));
-          if (!(u_rr < q)) continue;
-          p.throughput /= q;
-          p.vpl_throughput /= q;
-        }
-        if (is_black(p.throughput) || !is_finite(p.throughput)) continue;
-        p.prev_pdf = bs.pdf;
-        p.prev_position = sp.position;
-        Ray next;
-        next.origin = origin;
-        next.direction = wi_world;
-        rays_[j] = next;
-        alive[j] = 1;
-      }
-    });
-    times.shade_ms += ms_since(start);
-    run_shadow_rays(m, rays, times);
-    apply_shadow_rays(m, active_);
-
-    next_active_.clear();
-    for (std::size_t j = 0; j < m; ++j)
-      if (alive[j]) {
-        rays_[next_active_.size()] = rays_[j];
-        next_active_.push_back(active_[j]);
-      }
-    active_.swap(next_active_);
-  }
-
   for (std::size_t i = 0; i < n; ++i) {
     const PathState& p = paths_[i];
     if (is_finite(p.radiance)) {
@@ -302,8 +325,8 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
       const glm::vec3 vpl_l = p.vpl_radiance;
       if (!is_finite(vpl_l) || !(vpls->position[i].w > 0.0f) || !std::isfinite(vpls->position[i].w))
         vpls->info[i] &= ~PG_VPL_VALID;
-      // The kernels read the info bits from radiance.w (exact: small integers).
-      vpls->radiance[i] =
+      // The kernels read the info bits from radiance_info.w (exact: small integers).
+      vpls->radiance_info[i] =
           glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f), static_cast<float>(vpls->info[i]));
     }
   }

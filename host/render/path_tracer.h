@@ -12,6 +12,7 @@
 #include "render/first_bounce.h"
 #include "render/gbuffer.h"
 #include "render/lights.h"
+#include "render/vpl_buffer.h"
 #include "scene/scene.h"
 #include "trace/embree_scene.h"
 
@@ -21,14 +22,6 @@ struct PathTracerSettings {
   int max_bounces = 8;     // path vertices after the primary hit
   int roulette_start = 3;  // first bounce at which Russian roulette may end a path
   bool next_event = true;  // false: BSDF sampling only (emitters found by chance)
-};
-
-// The VPL buffer the guiding trainer reads (layout: kernels/shared/vpl.h); radiance.w
-// repeats info as a float for the kernels.
-struct VplBuffer {
-  std::vector<glm::vec4> position, normal, radiance;
-  std::vector<std::uint32_t> info;
-  void resize(std::size_t n);
 };
 
 struct RayCounts {
@@ -69,8 +62,30 @@ class PathTracer {
     glm::vec3 vpl_contribution;  // to the VPL radiance, if unoccluded
   };
 
+  // The steps of trace(), in order.
+  void prepare(std::size_t n, VplBuffer* vpls);
+  // At the primary hit x0 of every pixel: emission, next-event estimation, the first bounce.
+  void start_paths(const GBuffer& g, const std::vector<FirstBounceSample>& first,
+                   const FirstBounceSampler& sampler, const SampleCoordinates& at, VplBuffer* vpls);
+  // The hits of the m live paths at path vertex `depth`: emission found by the bounce (MIS),
+  // the VPL at depth 1, next-event estimation, BSDF sampling and Russian roulette.
+  void shade_bounce(int depth, std::size_t m, VplBuffer* vpls);
+  // Next-event estimation at a surface point, once for every vertex: samples a light and,
+  // where the BSDF sees it, returns true with the contribution an unoccluded shadow ray adds
+  // (BSDF x cosine x radiance x MIS weight / pdf; competing_pdf(world_dir, local_dir) is the
+  // density of the strategy that could have found the same light) and the shadow ray.
+  template <class CompetingPdf>
+  bool next_event(const glm::vec3& position, const glm::vec3& geometric_normal,
+                  const shared::pg_frame& frame, const glm::vec3& wo, const shared::pg_lobes& lobes,
+                  const glm::vec3& origin, float u_select, float u1, float u2,
+                  const CompetingPdf& competing_pdf, glm::vec3& contribution, Ray& shadow) const;
   void run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times);
-  void apply_shadow_rays(std::size_t count, const std::vector<std::uint32_t>& owners);
+  void apply_shadow_rays(std::size_t count, const std::vector<std::uint32_t>* owners);
+  // Keeps the rays of the paths still alive at the front of rays_; active_ becomes their
+  // pixels (owners[j] of slot j, or j itself when owners is null).
+  void compact(std::size_t count, const std::vector<std::uint32_t>* owners);
+  // Pixel estimates (non-finite ones dropped and counted) and the VPLs' radiance.
+  void gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite) const;
 
   const Scene& scene_;
   const EmbreeScene& tracer_;
@@ -79,7 +94,9 @@ class PathTracer {
 
   // Scratch, reused across frames.
   std::vector<PathState> paths_;
-  std::vector<std::uint32_t> active_, next_active_, shadow_owner_;
+  bool next_event_on_ = true;  // next-event estimation this frame (settings and lights)
+  std::vector<std::uint32_t> active_, next_active_;
+  std::vector<std::uint8_t> alive_;  // per slot: the path goes on after this vertex
   std::vector<Ray> rays_, shadow_rays_;
   std::vector<Hit> hits_;
   std::vector<std::uint8_t> occluded_;

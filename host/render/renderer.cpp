@@ -9,7 +9,7 @@
 
 #include "render/surface.h"
 #include "shared/rng.h"
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 namespace {
@@ -24,22 +24,24 @@ double ms_since(Clock::time_point start) {
 Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
     : scene_(scene), settings_(settings) {
   if (settings.width <= 0 || settings.height <= 0)
-    throw InputError("--res", "resolution must be positive, got " + std::to_string(settings.width) +
-                                  "x" + std::to_string(settings.height));
+    throw RenderSettingError("resolution", "must be positive, got " +
+                                               std::to_string(settings.width) + "x" +
+                                               std::to_string(settings.height));
   const std::uint64_t pixels = static_cast<std::uint64_t>(settings.width) * settings.height;
   if (pixels > kMaxPixels)
-    throw InputError("--res", std::to_string(settings.width) + "x" +
-                                  std::to_string(settings.height) + " is too large (at most " +
-                                  std::to_string(kMaxPixels) + " pixels)");
-  if (settings.spp <= 0) throw InputError("--spp", "must be at least 1");
+    throw RenderSettingError(
+        "resolution", std::to_string(settings.width) + "x" + std::to_string(settings.height) +
+                          " is too large (at most " + std::to_string(kMaxPixels) + " pixels)");
+  if (settings.spp <= 0) throw RenderSettingError("spp", "must be at least 1");
   if (!settings.camera_path.empty() && !scene.camera.paths.count(settings.camera_path))
-    throw InputError("--camera-path",
-                     "scene has no camera path named '" + settings.camera_path + "'");
+    throw RenderSettingError("camera_path",
+                             "scene has no camera path named '" + settings.camera_path + "'");
   try {
     gbuffer_.resize(settings.width, settings.height);
     image_.assign(pixels, glm::vec3(0.0f));
   } catch (const std::bad_alloc&) {
-    throw InputError("--res", "not enough memory for " + std::to_string(pixels) + " pixels");
+    throw RenderSettingError("resolution",
+                             "not enough memory for " + std::to_string(pixels) + " pixels");
   }
   tracer_ = std::make_unique<EmbreeScene>(scene);
   lights_ = std::make_unique<Lights>(scene);
@@ -116,7 +118,7 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
                                             sp.material.base_color.z, sp.material.roughness);
       g.metallic_specular[i] = glm::vec4(sp.material.metallic, sp.material.specular, 0.0f, 0.0f);
       g.emission[i] = glm::vec4(sp.emission, 0.0f);
-      g.material_id[i] = sp.material_id;
+      g.material[i] = sp.material_id;
       std::uint32_t flags = 0;
       if (sp.emission.x > 0.0f || sp.emission.y > 0.0f || sp.emission.z > 0.0f)
         flags |= PG_GBUF_EMITTER;

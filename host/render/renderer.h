@@ -1,4 +1,4 @@
-// One frame, as data flows (DESIGN.md section 2): camera rays -> Embree primary hits ->
+// One frame, as data flows (docs/design.md, "One frame"): camera rays -> Embree primary hits ->
 // G-buffer -> first-bounce sampler -> host path tracer -> (guiding: training on the VPLs).
 // The renderer is the one place that joins scene, tracer and first-bounce sampler.
 #pragma once
@@ -15,6 +15,7 @@
 #include "render/gbuffer.h"
 #include "render/lights.h"
 #include "render/path_tracer.h"
+#include "rtpg/errors.h"
 #include "scene/scene.h"
 #include "trace/embree_scene.h"
 
@@ -39,9 +40,23 @@ struct FrameStats {
   std::map<std::string, double> extra;  // sampler-specific figures (e.g. guided fraction)
 };
 
+// A RenderSettings field the renderer cannot work with: what() reads "<setting>: <problem>"
+// (setting: resolution, spp, camera_path); the command line names its flag instead.
+class RenderSettingError : public InputError {
+ public:
+  RenderSettingError(const std::string& setting, const std::string& problem)
+      : InputError(setting, problem), setting_(setting), problem_(problem) {}
+  const std::string& setting() const { return setting_; }
+  const std::string& problem() const { return problem_; }
+
+ private:
+  std::string setting_, problem_;
+};
+
 class Renderer {
  public:
-  // Throws InputError when the resolution is zero or too large to allocate.
+  // Throws RenderSettingError when the resolution is zero or too large to allocate, spp is
+  // below 1 or the camera path does not exist.
   Renderer(const Scene& scene, const RenderSettings& settings);
   ~Renderer();
 

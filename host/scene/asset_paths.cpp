@@ -36,7 +36,7 @@ bool is_folder(const fs::path& p) {
 
 }  // namespace
 
-std::string resolve_asset_root(const std::string& json_path, const SceneLoadOptions& options) {
+std::string resolve_asset_root(const std::string& json_path, const SceneLoadSettings& options) {
   // An explicit choice is returned even when it does not exist, so that "not found"
   // messages show the folder the user pointed at instead of silently looking elsewhere.
   if (!options.asset_root.empty()) return absolute_normal(options.asset_root).string();

@@ -11,7 +11,7 @@
 #include <assimp/material.h>
 #include <assimp/scene.h>
 
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 

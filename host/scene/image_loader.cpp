@@ -10,7 +10,7 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 

@@ -15,7 +15,7 @@
 
 #include "scene/assimp_material.h"
 #include "scene/ply_check.h"
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 

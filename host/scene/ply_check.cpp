@@ -8,7 +8,7 @@
 #include <sstream>
 #include <vector>
 
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 

@@ -21,7 +21,7 @@
 #include "scene/shapes.h"
 #include "scene/texture_cache.h"
 #include "scene/transform_json.h"
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 
@@ -110,7 +110,7 @@ nlohmann::json parse_file(const std::string& path) {
 // Everything one load needs; lives for the duration of load_scene.
 class SceneBuilder {
  public:
-  SceneBuilder(const std::string& path, const SceneLoadOptions& options, Scene& scene)
+  SceneBuilder(const std::string& path, const SceneLoadSettings& options, Scene& scene)
       : path_(path),
         scene_(scene),
         assets_(path, resolve_asset_root(path, options)),
@@ -156,7 +156,7 @@ class SceneBuilder {
     for (const std::string& s : searched) where += (where.empty() ? "" : ", ") + s;
     std::string hint;
     if (assets_.asset_root().empty())
-      hint = " (no asset root: set RTPG_ASSET_ROOT or SceneLoadOptions::asset_root)";
+      hint = " (no asset root: set RTPG_ASSET_ROOT or SceneLoadSettings::asset_root)";
     value.fail("file '" + written + "' not found; looked in: " + where + hint);
   }
 
@@ -343,7 +343,7 @@ class SceneBuilder {
 
 }  // namespace
 
-Scene load_scene(const std::string& json_path, const SceneLoadOptions& options) {
+Scene load_scene(const std::string& json_path, const SceneLoadSettings& options) {
   const nlohmann::json document = parse_file(json_path);
   Scene scene;
   scene.source_path = json_path;

@@ -7,7 +7,7 @@
 
 namespace rtpg {
 
-struct SceneLoadOptions {
+struct SceneLoadSettings {
   // Where asset paths that are not found next to the scene file are looked up. Empty: the
   // RTPG_ASSET_ROOT environment variable, else ../shared/scenes relative to the working
   // directory and to the scene file's folder, when that exists.
@@ -15,9 +15,9 @@ struct SceneLoadOptions {
 };
 
 // Throws InputError naming the file (scene, mesh, texture, environment map) and the problem.
-Scene load_scene(const std::string& json_path, const SceneLoadOptions& options = {});
+Scene load_scene(const std::string& json_path, const SceneLoadSettings& options = {});
 
 // The asset root load_scene would use with these options ("" when none exists).
-std::string resolve_asset_root(const std::string& json_path, const SceneLoadOptions& options);
+std::string resolve_asset_root(const std::string& json_path, const SceneLoadSettings& options);
 
 }  // namespace rtpg

@@ -3,7 +3,7 @@
 
 #include <filesystem>
 
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 

@@ -6,7 +6,7 @@
 
 #include <unistd.h>
 
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 

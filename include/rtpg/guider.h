@@ -1,84 +1,103 @@
 // rtpg's guiding library: screen-space path guiding with a per-pixel parametric mixture
 // (one 2D Gaussian in Shirley-Chiu square space plus the BSDF lobe), trained online by EM
 // from the VPLs of neighbouring pixels and carried across frames by reprojection (paper
-// "Real-Time Path-Guiding Based on Parametric Mixture Models").
+// "Real-Time Path-Guiding Based on Parametric Mixture Models"; docs/design.md).
 //
-// A renderer that uses it keeps its own G-buffer and VPL buffers on the device, in the
-// layouts of kernels/shared/gbuffer.h and vpl.h (one entry per pixel, row-major):
-//   per frame:  guider.reproject(current, previous)   state of last frame -> this frame
-//               guider.sample(current, ..., out)        first-bounce directions + pdf
-//               ... the renderer traces its paths and writes one VPL per pixel ...
-//               guider.train(current, vpls, ...)        one EM step per pixel
-// Only the guider knows its state; it knows nothing of scenes, files or ray tracing.
+// In Open PGL's terms: the Guider is the field (the per-pixel mixtures, on the device), the
+// GuiderVpls are its sample storage (one VPL per pixel, filled by the renderer), and
+// GuidingDistribution (include/rtpg/guiding_distribution.h) is the surface sampling
+// distribution a CPU renderer evaluates for its MIS weights.
+//
+// A renderer keeps its own G-buffer and VPL buffers on the device, in the layouts of
+// include/rtpg/guiding_layout.h, and per frame calls
+//   guider.reproject(current, previous)   state of last frame -> this frame
+//   guider.sample(current, ..., out)        first-bounce directions + pdf
+//   ... the renderer traces its paths and writes one VPL per pixel ...
+//   guider.train(current, vpls, ...)        one EM step per pixel
+// Only the guider knows its state; it knows nothing of scenes, files or ray tracing. Every
+// method throws GuiderError for misuse and ClError (include/rtpg/cl_error.h) when OpenCL
+// fails.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "cl/cl_include.h"
+#include "rtpg/cl_error.h"
+#include "rtpg/cl_runtime.h"
+#include "rtpg/errors.h"
+#include "rtpg/guiding_layout.h"
+#include "rtpg/guiding_settings.h"
+#include "rtpg/opencl.h"
 
 namespace rtpg {
 
-class ClRuntime;
-
-// Misuse of the guider: buffers of the wrong size, a tile that does not fit in the device's
-// local memory, a local size the device refuses.
-class GuiderError : public std::invalid_argument {
- public:
-  using std::invalid_argument::invalid_argument;
+// Device buffers, one cl::Buffer per channel of include/rtpg/guiding_layout.h.
+#define RTPG_DEVICE_CHANNEL(name, type, bytes) cl::Buffer name;
+struct GuiderGBuffer {  // one frame's G-buffer (PG_GBUFFER_CHANNELS)
+  PG_GBUFFER_CHANNELS(RTPG_DEVICE_CHANNEL)
 };
-
-// Every parameter of guiding, with the defaults we measured or took from the paper.
-struct GuidingConfig {
-  float pi_min = 0.05f;  // clamp of the Gaussian's mixing weight (paper 3.2)
-  float pi_max = 0.95f;
-  float pi_init = 0.05f;       // weight of a new model (paper 3.1)
-  int k_max = 32;              // epochs; the step size stops shrinking after k_max updates
-  float step_alpha = 1.0f;     // eta_k = max((k+1)^-alpha, 1/(k_max+1)): 1 = plain mean until k_max
-  float sigma_eps = 1e-4f;     // regularisation of Sigma's diagonal (square units^2)
-  float sigma_prior = 5e-2f;   // prior variance, added as sigma_prior / (k + 1)
-  float reseed_ratio = 10.0f;  // a sample with weight > ratio * W outside the lobe re-seeds it
-  float weight_clamp = 0.0f;   // training weights clamped to weight_clamp * W (0 = no clamp)
-  int em_passes = 3;           // E-step passes over each frame's samples
-  float max_correlation = 0.95f;
-  float roughness_skip = 0.05f;      // roughness at or below: BSDF only, no training
-  int n_min = 5, n_max = 20;         // N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2);
-                                     // n_min == n_max gives a fixed N
-  int apron = 2;                     // neighbourhood radius: a (2*apron+1)^2 window of VPLs
-  float max_weight = 1e8f;           // training weights above this are dropped as absurd
-  float reproject_position = 0.05f;  // relative distance (to the depth) that rejects history
-  float reproject_normal = 0.9f;     // normal cosine below which history is rejected
-  int local_x = 16, local_y = 16;    // work-group size of the kernels (the VPL tile)
-  enum class TrainMemory { Auto, Local, Global };
-  // Local: VPL tile in local memory (GPUs); Global: direct reads (faster on PoCL). Auto
-  // picks Global on CPU devices and Local elsewhere.
-  TrainMemory train_memory = TrainMemory::Auto;
+struct GuiderVpls {  // one VPL per pixel (PG_VPL_CHANNELS)
+  PG_VPL_CHANNELS(RTPG_DEVICE_CHANNEL)
 };
-
-// One frame's G-buffer on the device (float4 / uint / float2 per pixel).
-struct GuiderGBuffer {
-  cl::Buffer position_depth;        // float4: xyz position, w linear depth
-  cl::Buffer shading_normal;        // float4: xyz
-  cl::Buffer view_dir;              // float4: xyz, unit, towards the camera
-  cl::Buffer base_color_roughness;  // float4
-  cl::Buffer metallic_specular;     // float4: x metallic, y dielectric F0
-  cl::Buffer flags;                 // uint: PG_GBUF_* bits
-  cl::Buffer material;              // uint: material id (reprojection test)
-  cl::Buffer motion;                // float2: offset to the pixel's position last frame
+struct GuiderSamples {  // what sample() writes (PG_SAMPLE_CHANNELS)
+  PG_SAMPLE_CHANNELS(RTPG_DEVICE_CHANNEL)
 };
+#undef RTPG_DEVICE_CHANNEL
 
-// One VPL per pixel (kernels/shared/vpl.h), radiance_info.w holding the info bits.
-struct GuiderVpls {
-  cl::Buffer position, normal, radiance_info;  // float4 each
-};
+// Buffers for width x height pixels (inputs read-only, samples write-only for the kernels).
+GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height);
+GuiderVpls make_guider_vpls(cl::Context& context, int width, int height);
+GuiderSamples make_guider_samples(cl::Context& context, int width, int height);
 
-// What sample() writes: float4 (world direction, mixture pdf) and uint strategy per pixel.
-struct GuiderSamples {
-  cl::Buffer direction_pdf, strategy;
-};
+namespace detail {
+template <std::size_t Bytes, class Channel>
+void enqueue_write(cl::CommandQueue& queue, const cl::Buffer& buffer, const Channel& host,
+                   const char* name) {
+  static_assert(sizeof(typename Channel::value_type) == Bytes,
+                "a host channel's element size differs from include/rtpg/guiding_layout.h");
+  const std::size_t bytes = host.size() * Bytes;
+  translate_cl_errors([&] {
+    if (bytes > buffer.getInfo<CL_MEM_SIZE>())
+      throw GuiderError(std::string("upload of ") + name + ": " + std::to_string(bytes) +
+                        " bytes do not fit in its device buffer");
+    queue.enqueueWriteBuffer(buffer, CL_FALSE, 0, bytes, host.data());
+  });
+}
+template <std::size_t Bytes, class Channel>
+void enqueue_read(cl::CommandQueue& queue, const cl::Buffer& buffer, Channel& host) {
+  static_assert(sizeof(typename Channel::value_type) == Bytes,
+                "a host channel's element size differs from include/rtpg/guiding_layout.h");
+  translate_cl_errors(
+      [&] { queue.enqueueReadBuffer(buffer, CL_FALSE, 0, host.size() * Bytes, host.data()); });
+}
+}  // namespace detail
+
+// Host <-> device copies of every channel, for any host struct whose members are named as the
+// channels and hold them contiguously (std::vector<glm::vec4>, std::vector<uint32_t>, ...).
+// Non-blocking: the host data must live until the queue has finished them.
+template <class HostGBuffer>
+void enqueue_upload(cl::CommandQueue& queue, const HostGBuffer& host, const GuiderGBuffer& dev) {
+#define RTPG_UPLOAD(name, type, bytes) \
+  detail::enqueue_write<bytes>(queue, dev.name, host.name, #name);
+  PG_GBUFFER_CHANNELS(RTPG_UPLOAD)
+#undef RTPG_UPLOAD
+}
+template <class HostVpls>
+void enqueue_upload(cl::CommandQueue& queue, const HostVpls& host, const GuiderVpls& dev) {
+#define RTPG_UPLOAD(name, type, bytes) \
+  detail::enqueue_write<bytes>(queue, dev.name, host.name, #name);
+  PG_VPL_CHANNELS(RTPG_UPLOAD)
+#undef RTPG_UPLOAD
+}
+// host's channels must already have their size (width * height).
+template <class HostSamples>
+void enqueue_download(cl::CommandQueue& queue, const GuiderSamples& dev, HostSamples& host) {
+#define RTPG_DOWNLOAD(name, type, bytes) detail::enqueue_read<bytes>(queue, dev.name, host.name);
+  PG_SAMPLE_CHANNELS(RTPG_DOWNLOAD)
+#undef RTPG_DOWNLOAD
+}
 
 struct GuiderTimes {
   double reproject_ms = 0.0, sample_ms = 0.0, train_ms = 0.0;  // from profiling events
@@ -86,15 +105,18 @@ struct GuiderTimes {
 
 class Guider {
  public:
-  // Throws GuiderError when the configuration cannot run on the runtime's device.
-  Guider(ClRuntime& runtime, int width, int height, const GuidingConfig& config = {});
+  // Throws GuiderError when the settings are out of range (validate()) or cannot run on the
+  // runtime's device.
+  Guider(ClRuntime& runtime, int width, int height, const GuidingSettings& settings = {});
   ~Guider();
   Guider(const Guider&) = delete;
   Guider& operator=(const Guider&) = delete;
 
   int width() const { return width_; }
   int height() const { return height_; }
-  const GuidingConfig& config() const { return config_; }
+  const GuidingSettings& settings() const { return settings_; }
+  // What the kernels receive (to_kernel_settings(settings()), built once).
+  const pg_kernel_settings& kernel_settings() const { return kernel_settings_; }
   bool train_uses_local_memory() const { return local_tile_; }
 
   void reset();  // every pixel back to the initial state (k = 0: BSDF sampling)
@@ -105,7 +127,8 @@ class Guider {
   void train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::uint32_t seed,
              std::uint32_t frame);
 
-  // The state, 8 floats per pixel (s0.xyzw then s1.xyzw; kernels/shared/pmm.h).
+  // The state, PG_STATE_FLOATS_PER_PIXEL floats per pixel (state0 then state1;
+  // include/rtpg/guiding_layout.h).
   void read_state(std::vector<float>& state);
   void write_state(const std::vector<float>& state);
   // Pixels whose state the last train() changed (reads a byte per pixel back).
@@ -121,9 +144,13 @@ class Guider {
 
   ClRuntime& runtime_;
   int width_, height_;
-  GuidingConfig config_;
+  GuidingSettings settings_;
+  pg_kernel_settings kernel_settings_;
   bool local_tile_ = false;
-  cl::Buffer state0_[2], state1_[2];
+  struct State {  // the mixtures of every pixel (PG_STATE_CHANNELS)
+    cl::Buffer state0, state1;
+  };
+  State state_[2];  // last frame's and this frame's
   cl::Buffer trained_;
   int current_ = 0;  // index of the buffers holding this frame's state
   cl::Kernel reproject_, sample_, train_;

@@ -3,45 +3,26 @@
  * its density, its sampler, the online (stepwise) EM step that trains it from VPLs
  * (paper 3.2, DESIGN.md section 3) and the change of hemisphere frame used by reprojection.
  *
- * State, 8 floats per pixel (paper 3.1): running averages of the EM sufficient statistics
- *   s0 = (W, S0, Sx, Sy)   W = E[a], S0 = E[a gamma], (Sx, Sy) = E[a gamma u]
- *   s1 = (Sxx, Syy, Sxy, k) second moments E[a gamma u u^T] and the epoch count k
- * with a = lum(L_i f_r cos) / r (importance weight of a training sample), gamma the
- * Gaussian's responsibility and u = M^-1(w) in the unit square. The model follows:
- *   pi = clamp(S0 / W), mu = S1 / S0, Sigma = S2 / S0 - mu mu^T + eps I.
- * k = 0 means "no model": the pixel samples its BSDF only (paper 3.1, invalid history). */
+ * State, 8 floats per pixel (paper 3.1; buffers: include/rtpg/guiding_layout.h): running averages
+ * of the EM sufficient statistics s0 = (W, S0, Sx, Sy)   W = E[a], S0 = E[a gamma], (Sx, Sy) = E[a
+ * gamma u] s1 = (Sxx, Syy, Sxy, k) second moments E[a gamma u u^T] and the epoch count k with a =
+ * lum(L_i f_r cos) / r (importance weight of a training sample), gamma the Gaussian's
+ * responsibility and u = M^-1(w) in the unit square. The model follows: pi = clamp(S0 / W), mu = S1
+ * / S0, Sigma = S2 / S0 - mu mu^T + eps I. k = 0 means "no model": the pixel samples its BSDF only
+ * (paper 3.1, invalid history). */
 #ifndef RTPG_SHARED_PMM_H
 #define RTPG_SHARED_PMM_H
 
 #include "shared/bsdf.h"
 #include "shared/compat.h"
 #include "shared/mapping.h"
+#include "rtpg/guiding_layout.h"
 
 PG_NAMESPACE_BEGIN
 
-/* Every tunable of the guiding step, passed to the kernels by value. Plain 4-byte fields
- * only, so host and device agree on the layout (checked by static_assert on the host). */
-typedef struct {
-  float pi_min;          /* clamp of the mixing weight (paper: 0.05) */
-  float pi_max;          /* (paper: 0.95) */
-  float pi_init;         /* weight of a new model (paper: 0.05) */
-  float k_max;           /* epochs after which the step size stops shrinking */
-  float step_alpha;      /* eta_k = max((k+1)^-alpha, 1/(k_max+1)) */
-  float sigma_eps;       /* added to Sigma's diagonal: keeps it positive definite */
-  float max_correlation; /* |rho| bound: keeps the Cholesky factor well conditioned */
-  float roughness_skip;  /* no guiding where roughness is at or below this */
-  float n_min;           /* N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2) */
-  float n_max;
-  float max_weight;       /* training weights above this are treated as absurd input */
-  float reproject_depth;  /* relative position difference that rejects history */
-  float reproject_normal; /* cosine below which normals reject history */
-  float sigma_prior;      /* prior variance added as sigma_prior / (k + 1) */
-  float reseed_ratio;     /* a sample with a > reseed_ratio * W outside the lobe re-seeds */
-  float weight_clamp;     /* training weights are clamped to weight_clamp * W (0 = off) */
-  int em_passes;          /* E-step passes over a frame's samples (pg_pmm_train) */
-  int apron;              /* neighbourhood radius in pixels (window 2*apron+1 squared) */
-  int stride;             /* step through the window, coprime with its size */
-} pg_guiding_params;
+#ifndef __OPENCL_C_VERSION__
+using ::rtpg::pg_kernel_settings; /* C++: the layout header's type, seen from rtpg::shared */
+#endif
 
 typedef struct {
   float4 s0; /* W, S0, Sx, Sy */
@@ -73,7 +54,7 @@ PG_FN float3 pg_pmm_raw_covariance(pg_pmm_state s, float mx, float my) {
   return pg_make_float3(s.s1.x * inv - mx * mx, s.s1.y * inv - my * my, s.s1.z * inv - mx * my);
 }
 
-PG_FN pg_pmm_model pg_pmm_model_from_state(pg_pmm_state s, pg_guiding_params p) {
+PG_FN pg_pmm_model pg_pmm_model_from_state(pg_pmm_state s, pg_kernel_settings p) {
   pg_pmm_model m;
   m.valid = 0;
   m.pi = 0.0f;
@@ -127,14 +108,10 @@ PG_FN float pg_pmm_pdf(pg_pmm_model m, pg_lobes lobes, float3 wo, float3 wi) {
   return m.pi * g + (1.0f - m.pi) * bsdf;
 }
 
-#define PG_STRATEGY_NONE 0u
-#define PG_STRATEGY_BSDF 1u
-#define PG_STRATEGY_GUIDE 2u
-
 typedef struct {
   float3 wi;     /* local direction */
   float pdf;     /* D(wi); 0 = no sample (a Gaussian sample outside the square) */
-  uint strategy; /* PG_STRATEGY_* */
+  uint strategy; /* PG_STRATEGY_* (include/rtpg/guiding_layout.h) */
 } pg_pmm_sample_t;
 
 /* One-sample MIS over the two components (paper 3.1): xi < pi picks the Gaussian (Box-Muller
@@ -188,7 +165,7 @@ PG_FN pg_pmm_batch pg_pmm_batch_empty(void) {
 /* E-step for one sample: weight a (>= 0), square point u, direction wi, BSDF density of wi.
  * A model that does not exist yet takes every sample at the initial weight (so its first
  * M-step gives the weighted moments and pi = pi_init). */
-PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_guiding_params p, float a,
+PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_settings p, float a,
                                     float2 u, float bsdf_pdf, float history_weight) {
   if (!(a >= 0.0f) || !(a <= p.max_weight)) return b; /* NaN, negative or absurd: dropped */
   /* VPL radiance is a one-path estimate with a heavy tail: a single firefly would drag the
@@ -230,7 +207,7 @@ PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_guiding_p
 }
 
 /* Number of neighbour VPLs a pixel trains on at epoch k (paper 4.2). */
-PG_FN int pg_pmm_neighbour_count(float k, pg_guiding_params p) {
+PG_FN int pg_pmm_neighbour_count(float k, pg_kernel_settings p) {
   float t = clamp(1.0f - k / p.k_max, 0.0f, 1.0f);
   return (int)(t * (p.n_max - p.n_min) + p.n_min + 0.5f);
 }
@@ -239,7 +216,7 @@ PG_FN int pg_pmm_neighbour_count(float k, pg_guiding_params p) {
  * Moulines 2009). target_count is the number of samples asked for: fewer kept samples make
  * a proportionally smaller step, so a starved frame cannot overwrite the history.
  * *updated is set to 1 when the state changed. */
-PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_guiding_params p,
+PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_kernel_settings p,
                                  float target_count, PG_PRIVATE int* updated) {
   *updated = 0;
   if (!(b.count > 0.0f) || !(b.a > 0.0f)) return s;
@@ -273,16 +250,13 @@ PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_guiding_para
   return out;
 }
 
-/* Largest neighbour count a pixel trains on in one frame (bounds the private sample array). */
-#define PG_MAX_TRAIN_SAMPLES 32
-
 /* One frame's training of one pixel from its n samples (x = weight a, y/z = square point u,
  * w = BSDF density), with `passes` E-step passes: each pass re-evaluates the responsibilities
  * under the model the previous pass's M-step would give, so a lobe that sits off its target
  * moves there within the frame instead of over many frames (DESIGN.md section 3 notes that a
  * single pass converges slowly). Only the last pass's statistics enter the state. */
 PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples, int n,
-                                pg_guiding_params p, float target_count, int passes,
+                                pg_kernel_settings p, float target_count, int passes,
                                 PG_PRIVATE int* updated) {
   pg_pmm_model m = pg_pmm_model_from_state(s, p);
   pg_pmm_state base = s, out = s;

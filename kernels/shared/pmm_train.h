@@ -5,12 +5,12 @@
 #ifndef RTPG_SHARED_PMM_TRAIN_H
 #define RTPG_SHARED_PMM_TRAIN_H
 
+#include "rtpg/guiding_layout.h"
 #include "shared/bsdf.h"
 #include "shared/compat.h"
 #include "shared/guiding_pixel.h"
 #include "shared/pmm.h"
 #include "shared/rng.h"
-#include "shared/vpl.h"
 
 PG_NAMESPACE_BEGIN
 
@@ -28,7 +28,7 @@ typedef struct {
 PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float4 normal,
                                    float4 radiance_info, PG_PRIVATE float4* sample) {
   uint info = (uint)radiance_info.w;
-  if ((info & PG_VPL_VALID) == 0u || pg_vpl_strategy(info) != PG_STRATEGY_BSDF) return 0;
+  if ((info & PG_VPL_VALID) == 0u || PG_VPL_STRATEGY(info) != PG_STRATEGY_BSDF) return 0;
   float3 w;
   float r; /* density of w as seen from this pixel */
   if ((info & PG_VPL_DISTANT) != 0u) {
@@ -60,7 +60,7 @@ PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float
 }
 
 /* The window offset of the s-th neighbour of this frame's walk through the window. */
-PG_FN int pg_train_window_index(uint start, int s, pg_guiding_params p) {
+PG_FN int pg_train_window_index(uint start, int s, pg_kernel_settings p) {
   int side = 2 * p.apron + 1;
   int size = side * side;
   return (int)((start + (uint)(s * p.stride)) % (uint)size);

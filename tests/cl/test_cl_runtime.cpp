@@ -8,12 +8,12 @@
 
 #include <gtest/gtest.h>
 
-#include "cl/cl_error.h"
-#include "cl/cl_runtime.h"
+#include "rtpg/cl_error.h"
+#include "rtpg/cl_runtime.h"
 #include "cl/device.h"
 #include "cl/image_kernels.h"
 #include "support/test_env.h"
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 namespace {

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "cl/kernel_source.h"
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace rtpg {
 namespace {

@@ -1,6 +1,6 @@
-// The guider as a user sees it: include/rtpg/guider.h and a ClRuntime for the context, nothing
-// else (its own translation unit, so that no shared header is visible). Buffer layouts and
-// bit values are the ones the header documents (kernels/shared/gbuffer.h and vpl.h).
+// The guider as a user sees it: the public headers under include/rtpg/ and nothing else (its
+// own translation unit, so that no private header is visible). Buffer layouts and bit values
+// are the ones include/rtpg/guiding_layout.h documents.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,14 +9,17 @@
 #include <random>
 #include <vector>
 
-#include "cl/cl_runtime.h"
+#include "rtpg/cl_runtime.h"
 #include "rtpg/guider.h"
+#include "rtpg/guiding_distribution.h"
 
 namespace {
 
-constexpr std::uint32_t kSky = 1u;              // PG_GBUF_SKY
-constexpr float kValidBsdfVpl = 1.0f + 256.0f;  // PG_VPL_VALID | PG_STRATEGY_BSDF << 8
-constexpr std::uint32_t kNone = 0u, kBsdf = 1u, kGuide = 2u;  // PG_STRATEGY_*
+constexpr std::uint32_t kSky = PG_GBUF_SKY;
+constexpr float kValidBsdfVpl =
+    static_cast<float>(PG_VPL_VALID | (PG_STRATEGY_BSDF << PG_VPL_STRATEGY_SHIFT));
+constexpr std::uint32_t kNone = PG_STRATEGY_NONE, kBsdf = PG_STRATEGY_BSDF,
+                        kGuide = PG_STRATEGY_GUIDE;
 
 template <typename T>
 cl::Buffer upload(rtpg::ClRuntime& rt, const std::vector<T>& v) {
@@ -24,12 +27,19 @@ cl::Buffer upload(rtpg::ClRuntime& rt, const std::vector<T>& v) {
                     const_cast<T*>(v.data()));
 }
 
-// A rough floor (normal +z) seen from above; the first row is sky.
-rtpg::GuiderGBuffer floor_gbuffer(rtpg::ClRuntime& rt, int w, int h) {
+// A rough floor (normal +z) seen from above; the first row is sky. Host arrays, 4 or 2 floats
+// per pixel for the vector channels.
+struct FloorHost {
+  std::vector<float> position, normal, view, bcr, ms, motion;
+  std::vector<std::uint32_t> flags, material;
+};
+
+FloorHost floor_host(int w, int h) {
   const std::size_t n = static_cast<std::size_t>(w) * h;
-  std::vector<float> position(4 * n), normal(4 * n), view(4 * n), bcr(4 * n), ms(4 * n),
-      motion(2 * n, 0.0f);
-  std::vector<std::uint32_t> flags(n, 0u), material(n, 1u);
+  FloorHost f{std::vector<float>(4 * n),         std::vector<float>(4 * n),
+              std::vector<float>(4 * n),         std::vector<float>(4 * n),
+              std::vector<float>(4 * n),         std::vector<float>(2 * n, 0.0f),
+              std::vector<std::uint32_t>(n, 0u), std::vector<std::uint32_t>(n, 1u)};
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
@@ -37,24 +47,32 @@ rtpg::GuiderGBuffer floor_gbuffer(rtpg::ClRuntime& rt, int w, int h) {
       const float v[4] = {-px, -py, 3.0f, 0.0f};
       const float len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
       for (int c = 0; c < 4; ++c) {
-        position[4 * i + c] = c == 0 ? px : c == 1 ? py : c == 2 ? 0.0f : len;
-        normal[4 * i + c] = c == 2 ? 1.0f : 0.0f;
-        view[4 * i + c] = v[c] / len;
-        bcr[4 * i + c] = c == 3 ? 0.6f : 0.7f;
-        ms[4 * i + c] = c == 1 ? 0.04f : 0.0f;
+        f.position[4 * i + c] = c == 0 ? px : c == 1 ? py : c == 2 ? 0.0f : len;
+        f.normal[4 * i + c] = c == 2 ? 1.0f : 0.0f;
+        f.view[4 * i + c] = v[c] / len;
+        f.bcr[4 * i + c] = c == 3 ? 0.6f : 0.7f;
+        f.ms[4 * i + c] = c == 1 ? 0.04f : 0.0f;
       }
-      if (y == 0) flags[i] = kSky;
+      if (y == 0) f.flags[i] = kSky;
     }
+  return f;
+}
+
+rtpg::GuiderGBuffer floor_gbuffer(rtpg::ClRuntime& rt, const FloorHost& f) {
   rtpg::GuiderGBuffer g;
-  g.position_depth = upload(rt, position);
-  g.shading_normal = upload(rt, normal);
-  g.view_dir = upload(rt, view);
-  g.base_color_roughness = upload(rt, bcr);
-  g.metallic_specular = upload(rt, ms);
-  g.flags = upload(rt, flags);
-  g.material = upload(rt, material);
-  g.motion = upload(rt, motion);
+  g.position_depth = upload(rt, f.position);
+  g.shading_normal = upload(rt, f.normal);
+  g.view_dir = upload(rt, f.view);
+  g.base_color_roughness = upload(rt, f.bcr);
+  g.metallic_specular = upload(rt, f.ms);
+  g.flags = upload(rt, f.flags);
+  g.material = upload(rt, f.material);
+  g.motion = upload(rt, f.motion);
   return g;
+}
+
+rtpg::GuiderGBuffer floor_gbuffer(rtpg::ClRuntime& rt, int w, int h) {
+  return floor_gbuffer(rt, floor_host(w, h));
 }
 
 }  // namespace
@@ -164,4 +182,58 @@ TEST(GuiderApi, CreateResetReprojectSampleTrainAndStateRoundTrip) {
     for (int c = 0; c < 8; ++c) ASSERT_TRUE(std::isfinite(state[8 * i + c]));
   }
   EXPECT_GE(guider.last_times().train_ms, 0.0);
+}
+
+// The host distribution (include/rtpg/guiding_distribution.h) is the device sampler's: for every
+// direction the sample kernel drew, its density is the kernel's, and its own samples carry
+// their own density.
+TEST(GuiderApi, HostDistributionHasTheSampleKernelsDensity) {
+  rtpg::ClRuntime rt;
+  const int w = 13, h = 9;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  rtpg::Guider guider(rt, w, h);
+  // A tilted, correlated lobe (mean (0.62, 0.41)), pi = 0.5, k = 7.
+  std::vector<float> lobe(8 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float s0 = 2.0f, pi = 0.5f, mx = 0.62f, my = 0.41f;
+    const float v[8] = {s0 / pi,
+                        s0,
+                        mx * s0,
+                        my * s0,
+                        s0 * (0.01f + mx * mx),
+                        s0 * (0.006f + my * my),
+                        s0 * (0.003f + mx * my),
+                        7.0f};
+    std::memcpy(&lobe[8 * i], v, sizeof v);
+  }
+  guider.write_state(lobe);
+  const FloorHost f = floor_host(w, h);
+  const rtpg::GuiderGBuffer g = floor_gbuffer(rt, f);
+  rtpg::GuiderSamples samples = rtpg::make_guider_samples(rt.context(), w, h);
+  rtpg::GuidingDistribution d(guider.kernel_settings());
+  std::size_t checked = 0, guided_pixels = 0;
+  for (std::uint32_t frame = 0; frame < 3; ++frame) {
+    guider.sample(g, 7u, frame, 0u, samples);
+    std::vector<float> dir(4 * n);
+    rt.queue().enqueueReadBuffer(samples.direction_pdf, CL_TRUE, 0, n * 16, dir.data());
+    for (std::size_t i = static_cast<std::size_t>(w); i < n; ++i) {
+      d.init(&lobe[8 * i], &f.normal[4 * i], &f.view[4 * i], &f.bcr[4 * i], &f.ms[4 * i],
+             f.flags[i]);
+      guided_pixels += d.guided();
+      EXPECT_FLOAT_EQ(d.mixing_weight(), 0.5f);
+      if (dir[4 * i + 3] <= 0.0f) continue;
+      EXPECT_NEAR(d.pdf(&dir[4 * i]), dir[4 * i + 3], 1e-5f * dir[4 * i + 3]) << i;
+      ++checked;
+      const rtpg::GuidingDirection s = d.sample(0.3f, 0.25f + 0.5f * (i % 2), 0.6f);
+      if (s.pdf > 0.0f) {
+        EXPECT_NEAR(d.pdf(s.direction), s.pdf, 1e-5f * s.pdf) << i;
+      }
+    }
+  }
+  EXPECT_EQ(guided_pixels, 3 * (n - static_cast<std::size_t>(w)));
+  EXPECT_GT(checked, 2 * (n - static_cast<std::size_t>(w)));
+  // A sky pixel gets the BSDF alone: no Gaussian.
+  d.init(&lobe[0], &f.normal[0], &f.view[0], &f.bcr[0], &f.ms[0], f.flags[0]);
+  EXPECT_FALSE(d.guided());
+  EXPECT_EQ(d.mixing_weight(), 0.0f);
 }

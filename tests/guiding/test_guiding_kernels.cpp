@@ -20,14 +20,15 @@
 #include <string>
 #include <vector>
 
-#include "cl/cl_runtime.h"
-#include "guiding/guiding_params.h"
+#include "rtpg/cl_runtime.h"
+#include "rtpg/guiding_settings.h"
 #include "rtpg/guider.h"
+#include "support/guiding_buffers.h"
 #include "shared/guiding_pixel.h"
 #include "shared/pmm.h"
 #include "shared/pmm_train.h"
 #include "shared/rng.h"
-#include "shared/vpl.h"
+#include "rtpg/guiding_layout.h"
 
 namespace rtpg {
 namespace {
@@ -42,55 +43,11 @@ bool simulated(const ClRuntime& rt) {
   return rt.info().platform_name.find("Oclgrind") != std::string::npos;
 }
 
-// ---- host-side buffers ---------------------------------------------------------------------
+// ---- host-side buffers (tests/support/guiding_buffers.h) --------------------------------
 
-struct HostGBuffer {
-  int width = 0, height = 0;
-  std::vector<float4> position_depth, shading_normal, view_dir, base_color_roughness,
-      metallic_specular;
-  std::vector<std::uint32_t> flags, material;
-  std::vector<float2> motion;
-
-  HostGBuffer(int w, int h)
-      : width(w),
-        height(h),
-        position_depth(n()),
-        shading_normal(n()),
-        view_dir(n()),
-        base_color_roughness(n()),
-        metallic_specular(n()),
-        flags(n()),
-        material(n()),
-        motion(n()) {}
-  std::size_t n() const { return static_cast<std::size_t>(width) * height; }
-};
-
-struct HostVpls {
-  std::vector<float4> position, normal, radiance_info;
-};
-
-template <typename T>
-cl::Buffer upload(ClRuntime& rt, const std::vector<T>& v) {
-  return cl::Buffer(rt.context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, v.size() * sizeof(T),
-                    const_cast<T*>(v.data()));
-}
-
-GuiderGBuffer upload(ClRuntime& rt, const HostGBuffer& g) {
-  GuiderGBuffer d;
-  d.position_depth = upload(rt, g.position_depth);
-  d.shading_normal = upload(rt, g.shading_normal);
-  d.view_dir = upload(rt, g.view_dir);
-  d.base_color_roughness = upload(rt, g.base_color_roughness);
-  d.metallic_specular = upload(rt, g.metallic_specular);
-  d.flags = upload(rt, g.flags);
-  d.material = upload(rt, g.material);
-  d.motion = upload(rt, g.motion);
-  return d;
-}
-
-GuiderVpls upload(ClRuntime& rt, const HostVpls& v) {
-  return {upload(rt, v.position), upload(rt, v.normal), upload(rt, v.radiance_info)};
-}
+using testing::HostGBuffer;
+using testing::HostVpls;
+using testing::upload;
 
 // The guider's state layout: 8 floats per pixel, s0.xyzw then s1.xyzw.
 sh::pg_pmm_state state_at(const std::vector<float>& s, std::size_t i) {
@@ -232,7 +189,7 @@ enum Outcome { kSkipped, kOutside, kRejected, kCopied, kReframed };
 
 // reproject.cl.
 std::vector<float> host_reproject(const std::vector<float>& prev_state, const HostGBuffer& prev,
-                                  const HostGBuffer& cur, const sh::pg_guiding_params& p,
+                                  const HostGBuffer& cur, const pg_kernel_settings& p,
                                   std::vector<int>& outcome) {
   const int w = cur.width, h = cur.height;
   std::vector<float> out(8 * cur.n(), 0.0f);
@@ -247,13 +204,11 @@ std::vector<float> host_reproject(const std::vector<float>& prev_state, const Ho
       outcome[i] = kOutside;
       if (px < 0 || py < 0 || px >= w || py >= h) continue;
       const std::size_t j = static_cast<std::size_t>(py) * w + px;
-      const float4 pp = cur.position_depth[i], q = prev.position_depth[j];
       const float3 n = sh::pg_float4_xyz(cur.shading_normal[i]);
       const float3 m = sh::pg_float4_xyz(prev.shading_normal[j]);
-      const float3 d = sh::pg_float4_xyz(pp) - sh::pg_float4_xyz(q);
-      const bool same = std::sqrt(sh::dot(d, d)) <= p.reproject_depth * std::fmax(pp.w, 1e-6f) &&
-                        sh::dot(n, m) >= p.reproject_normal &&
-                        prev.material[j] == cur.material[i] && q.w > 0.0f;
+      const bool same =
+          sh::pg_same_surface(cur.position_depth[i], n, cur.material[i], prev.position_depth[j], m,
+                              prev.material[j], p.reproject_depth, p.reproject_normal);
       outcome[i] = kRejected;
       if (!same) continue;
       sh::pg_pmm_state s = state_at(prev_state, j);
@@ -279,7 +234,7 @@ struct PixelMixture {
 
 // sample.cl.
 void host_sample(const std::vector<float>& state, const HostGBuffer& g, std::uint32_t seed,
-                 std::uint32_t frame, std::uint32_t sample_index, const sh::pg_guiding_params& p,
+                 std::uint32_t frame, std::uint32_t sample_index, const pg_kernel_settings& p,
                  std::vector<float4>& direction_pdf, std::vector<std::uint32_t>& strategy,
                  std::vector<PixelMixture>& mixture) {
   direction_pdf.assign(g.n(), float4(0.0f));
@@ -299,7 +254,8 @@ void host_sample(const std::vector<float>& state, const HostGBuffer& g, std::uin
     m.frame = sh::pg_frame_from_normal(sh::pg_float4_xyz(g.shading_normal[i]));
     m.wo = sh::pg_to_local(m.frame, sh::pg_float4_xyz(g.view_dir[i]));
     m.lobes = sh::pg_make_lobes(sh::pg_material_from_gbuffer(bcr, g.metallic_specular[i]), m.wo);
-    sh::pg_rng rng = sh::pg_rng_make(seed, static_cast<std::uint32_t>(i), frame, sample_index, 1u);
+    sh::pg_rng rng = sh::pg_rng_make(seed, static_cast<std::uint32_t>(i), frame, sample_index,
+                                     PG_RNG_STREAM_FIRST_BOUNCE);
     const float xi = sh::pg_rng_next(&rng), u1 = sh::pg_rng_next(&rng), u2 = sh::pg_rng_next(&rng);
     const sh::pg_pmm_sample_t smp = sh::pg_pmm_sample(m.model, m.lobes, m.wo, xi, u1, u2);
     const float3 w = sh::pg_to_world(m.frame, smp.wi);
@@ -343,7 +299,7 @@ double ggx_relative_error(const PixelMixture& m, float3 wi) {
 // is what skipping those window cells does here).
 std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer& g,
                               const HostVpls& v, std::uint32_t seed, std::uint32_t frame,
-                              const sh::pg_guiding_params& p, std::vector<int>& trained) {
+                              const pg_kernel_settings& p, std::vector<int>& trained) {
   const int w = g.width, h = g.height;
   std::vector<float> out = state;
   trained.assign(g.n(), 0);
@@ -362,7 +318,8 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
       const int side = 2 * p.apron + 1;
       const int n = std::min(std::min(sh::pg_pmm_neighbour_count(s.s1.w, p), side * side),
                              PG_MAX_TRAIN_SAMPLES);
-      sh::pg_rng rng = sh::pg_rng_make(seed, static_cast<std::uint32_t>(i), frame, 0u, 3u);
+      sh::pg_rng rng =
+          sh::pg_rng_make(seed, static_cast<std::uint32_t>(i), frame, 0u, PG_RNG_STREAM_TRAIN);
       const std::uint32_t start =
           sh::pg_rng_next_uint(&rng) % static_cast<std::uint32_t>(side * side);
       float4 samples[PG_MAX_TRAIN_SAMPLES];
@@ -488,12 +445,12 @@ TEST(GuidingKernels, ReprojectMatchesHostReference) {
   Random r(101);
   std::size_t pixels = 0, count[5] = {0, 0, 0, 0, 0};
   for (const KernelCase& kc : kernel_cases(rt)) {
-    GuidingConfig config;
-    config.local_x = kc.local_x;
-    config.local_y = kc.local_y;
-    config.apron = kc.apron;
-    const sh::pg_guiding_params p = make_guiding_params(config);
-    Guider guider(rt, kc.width, kc.height, config);
+    GuidingSettings settings;
+    settings.local_x = kc.local_x;
+    settings.local_y = kc.local_y;
+    settings.apron = kc.apron;
+    const pg_kernel_settings p = to_kernel_settings(settings);
+    Guider guider(rt, kc.width, kc.height, settings);
     HostGBuffer prev(1, 1), cur(1, 1);
     make_reprojection_pair(r, kc.width, kc.height, prev, cur);
     const std::vector<float> prev_state = random_states(r, prev.n(), p.k_max, true);
@@ -551,11 +508,11 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
   Random r(202);
   std::size_t pixels = 0, guided = 0, near_threshold = 0, ill_conditioned = 0, mismatched = 0;
   for (const KernelCase& kc : kernel_cases(rt)) {
-    GuidingConfig config;
-    config.local_x = kc.local_x;
-    config.local_y = kc.local_y;
-    const sh::pg_guiding_params p = make_guiding_params(config);
-    Guider guider(rt, kc.width, kc.height, config);
+    GuidingSettings settings;
+    settings.local_x = kc.local_x;
+    settings.local_y = kc.local_y;
+    const pg_kernel_settings p = to_kernel_settings(settings);
+    Guider guider(rt, kc.width, kc.height, settings);
     const HostGBuffer g = random_gbuffer(r, kc.width, kc.height);
     const GuiderGBuffer dg = upload(rt, g);
     const std::vector<float> state = random_states(r, g.n(), p.k_max, false);
@@ -626,18 +583,18 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInBothMemoryVariants) {
     const HostGBuffer g = random_gbuffer(r, kc.width, kc.height);
     const HostVpls v = random_vpls(r, g.n());
     const GuiderGBuffer dg = upload(rt, g);
-    const GuiderVpls dv = upload(rt, v);
-    GuidingConfig config;
-    config.local_x = kc.local_x;
-    config.local_y = kc.local_y;
-    config.apron = kc.apron;
-    const sh::pg_guiding_params p = make_guiding_params(config);
+    const GuiderVpls dv = upload(rt, v, g.width, g.height);
+    GuidingSettings settings;
+    settings.local_x = kc.local_x;
+    settings.local_y = kc.local_y;
+    settings.apron = kc.apron;
+    const pg_kernel_settings p = to_kernel_settings(settings);
     std::vector<float> state = random_states(r, g.n(), p.k_max, false);
     std::vector<float> per_variant[2];
     for (int variant = 0; variant < 2; ++variant) {
-      config.train_memory =
-          variant == 0 ? GuidingConfig::TrainMemory::Local : GuidingConfig::TrainMemory::Global;
-      Guider guider(rt, kc.width, kc.height, config);
+      settings.train_memory =
+          variant == 0 ? GuidingSettings::TrainMemory::Local : GuidingSettings::TrainMemory::Global;
+      Guider guider(rt, kc.width, kc.height, settings);
       ASSERT_EQ(guider.train_uses_local_memory(), variant == 0);
       std::vector<float> s = state;
       // Two frames: the second starts from the first's result (models seeded at k = 0 train on).
@@ -811,8 +768,8 @@ TEST(GuidingKernels, ReprojectionFollowsAMovingCamera) {
   const glm::dvec3 light = glm::normalize(glm::dvec3(0.3, -0.4, 1.0));
   const float3 lf(float(light.x), float(light.y), float(light.z));
 
-  GuidingConfig config;
-  Guider guider(rt, w, h, config);
+  GuidingSettings settings;
+  Guider guider(rt, w, h, settings);
   std::vector<float> state0(8 * g0.n(), 0.0f);
   for (std::size_t j = 0; j < g0.n(); ++j) {
     if (hits0[j].object == 0) continue;
@@ -829,7 +786,7 @@ TEST(GuidingKernels, ReprojectionFollowsAMovingCamera) {
 
   std::size_t kept = 0, kept_reframed = 0, outside = 0, disoccluded = 0, sky = 0;
   double worst = 0.0;
-  const sh::pg_guiding_params p = make_guiding_params(config);
+  const pg_kernel_settings p = to_kernel_settings(settings);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
@@ -925,7 +882,7 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
   Random r(404);
   const HostGBuffer hg = random_gbuffer(r, w, h);
   const GuiderGBuffer good = upload(rt, hg);
-  const GuiderVpls vpls = upload(rt, random_vpls(r, hg.n()));
+  const GuiderVpls vpls = upload(rt, random_vpls(r, hg.n()), w, h);
   cl::Buffer dir(rt.context(), CL_MEM_READ_WRITE, hg.n() * 16);
   cl::Buffer strategy(rt.context(), CL_MEM_READ_WRITE, hg.n() * 4);
   Guider guider(rt, w, h);
@@ -938,14 +895,9 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
     cl::Buffer GuiderGBuffer::*field;
     std::size_t element;
   };
-  const Member members[] = {{"position_depth", &GuiderGBuffer::position_depth, 16},
-                            {"shading_normal", &GuiderGBuffer::shading_normal, 16},
-                            {"view_dir", &GuiderGBuffer::view_dir, 16},
-                            {"base_color_roughness", &GuiderGBuffer::base_color_roughness, 16},
-                            {"metallic_specular", &GuiderGBuffer::metallic_specular, 16},
-                            {"flags", &GuiderGBuffer::flags, 4},
-                            {"material", &GuiderGBuffer::material, 4},
-                            {"motion", &GuiderGBuffer::motion, 8}};
+#define RTPG_MEMBER(name, type, bytes) {#name, &GuiderGBuffer::name, bytes},
+  const Member members[] = {PG_GBUFFER_CHANNELS(RTPG_MEMBER)};
+#undef RTPG_MEMBER
   for (const Member& m : members) {
     GuiderGBuffer bad = good;
     bad.*m.field = cl::Buffer(rt.context(), CL_MEM_READ_WRITE, (hg.n() - 1) * m.element);
@@ -1000,16 +952,16 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
 TEST(GuiderMisuse, ConfigurationsTheDeviceCannotRunAreRefused) {
   ClRuntime rt;
   // Invalid parameters.
-  GuidingConfig bad;
+  GuidingSettings bad;
   bad.apron = 9;
   expect_guider_error([&] { Guider g(rt, 8, 8, bad); }, "apron");
-  bad = GuidingConfig{};
+  bad = GuidingSettings{};
   bad.pi_min = 0.9f;
   bad.pi_max = 0.5f;
   expect_guider_error([&] { Guider g(rt, 8, 8, bad); }, "pi_min");
   expect_guider_error([&] { Guider g(rt, 0, 8); }, "resolution");
   // A local size no device accepts.
-  GuidingConfig huge;
+  GuidingSettings huge;
   huge.local_x = 4096;
   huge.local_y = 4096;
   expect_guider_error([&] { Guider g(rt, 64, 64, huge); }, "local size");
@@ -1020,18 +972,18 @@ TEST(GuiderMisuse, ConfigurationsTheDeviceCannotRunAreRefused) {
   for (cl::Kernel k : {rt.kernel("reproject.cl", "reproject"), rt.kernel("sample.cl", "sample"),
                        rt.kernel("train.cl", "train", "-DPG_TRAIN_LOCAL_TILE=1")})
     largest = std::min(largest, k.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(rt.device()));
-  GuidingConfig tile;
+  GuidingSettings tile;
   tile.local_x = static_cast<int>(largest);
   tile.local_y = 1;
   tile.apron = 8;
-  tile.train_memory = GuidingConfig::TrainMemory::Local;
+  tile.train_memory = GuidingSettings::TrainMemory::Local;
   const std::size_t bytes = (largest + 16) * 17 * 48;
   if (bytes <= rt.info().local_mem_size) {
     GTEST_SKIP() << "a " << bytes << "-byte tile fits in " << rt.info().local_mem_size << " bytes";
   }
   expect_guider_error([&] { Guider g(rt, 64, 64, tile); }, "local memory");
   // The same local size reading VPLs from global memory needs no tile.
-  tile.train_memory = GuidingConfig::TrainMemory::Global;
+  tile.train_memory = GuidingSettings::TrainMemory::Global;
   EXPECT_NO_THROW(Guider(rt, 64, 64, tile));
 }
 

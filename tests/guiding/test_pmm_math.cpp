@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "guiding/guiding_params.h"
+#include "rtpg/guiding_settings.h"
 #include "shared/bsdf.h"
 #include "shared/mapping.h"
 #include "shared/pmm.h"
@@ -22,8 +22,8 @@ using namespace rtpg::shared;
 
 namespace {
 
-pg_guiding_params default_params() {
-  return rtpg::make_guiding_params(rtpg::GuidingConfig{});
+pg_kernel_settings default_params() {
+  return rtpg::to_kernel_settings(rtpg::GuidingSettings{});
 }
 
 // A state whose model has mean (mx, my), raw covariance (sxx, syy, sxy) (before the model's
@@ -52,7 +52,7 @@ Cov model_covariance(const pg_pmm_model& m) {
 
 // The model's properties every state must give: a usable Cholesky factor, pi within its
 // clamps and the mean inside the square.
-::testing::AssertionResult model_is_sane(const pg_pmm_model& m, const pg_guiding_params& p) {
+::testing::AssertionResult model_is_sane(const pg_pmm_model& m, const pg_kernel_settings& p) {
   if (!m.valid) return ::testing::AssertionSuccess();
   if (!(m.l11 > 0.0f) || !(m.l22 > 0.0f) || !std::isfinite(m.l11) || !std::isfinite(m.l22) ||
       !std::isfinite(m.l21))
@@ -72,11 +72,11 @@ struct SamplerCase {
   pg_pmm_state state;
   pg_material material;
   float3 wo;
-  pg_guiding_params params;
+  pg_kernel_settings params;
 };
 
 std::vector<SamplerCase> sampler_cases() {
-  const pg_guiding_params p = default_params();
+  const pg_kernel_settings p = default_params();
   const pg_material lambert{float3(0.8f), 1.0f, 0.0f, 0.0f};
   const pg_material plastic{float3(0.3f, 0.5f, 0.7f), 0.5f, 0.0f, 0.04f};
   const pg_material metal{float3(0.9f, 0.7f, 0.4f), 0.3f, 1.0f, 0.04f};
@@ -90,7 +90,7 @@ std::vector<SamplerCase> sampler_cases() {
                make_state(0.45f, 0.55f, 0.02f, 0.02f, 0.019998f, 0.6f, 32.0f), lambert,
                direction(20.0f, 100.0f), p});
   // A thin ridge: correlation bound raised to 0.999, no prior (minor std 0.006 in the square).
-  pg_guiding_params ridge = p;
+  pg_kernel_settings ridge = p;
   ridge.max_correlation = 0.999f;
   ridge.sigma_prior = 0.0f;
   c.push_back({"near_singular_ridge", make_state(0.4f, 0.5f, 0.02f, 0.02f, -0.019999f, 0.7f, 32.0f),
@@ -197,7 +197,7 @@ TEST(PmmSampler, ReportsItsOwnPdfAndStrategy) {
 // off by 0.02 in the square (a sixth of its standard deviation), or whose correlation has the
 // wrong sign, is rejected far below any reasonable level.
 TEST(PmmSampler, ChiSquareRejectsAWrongDensity) {
-  const pg_guiding_params p = default_params();
+  const pg_kernel_settings p = default_params();
   const pg_material plastic{float3(0.3f, 0.5f, 0.7f), 0.5f, 0.0f, 0.04f};
   const float3 wo = direction(40.0f, 30.0f);
   const pg_lobes lobes = pg_make_lobes(plastic, wo);
@@ -242,7 +242,7 @@ struct Gauss2 {
 // 1/(2 pi)), weighted by a = target / proposal with `target` a density over solid angle, as
 // train.cl does for VPLs.
 template <typename Target>
-pg_pmm_state run_em(const pg_guiding_params& p, const pg_lobes& lobes, float3 wo,
+pg_pmm_state run_em(const pg_kernel_settings& p, const pg_lobes& lobes, float3 wo,
                     const Target& target, int epochs, int per_epoch, uint seed) {
   pg_pmm_state s = pg_pmm_initial_state();
   std::vector<float4> samples;
@@ -273,9 +273,9 @@ pg_pmm_state run_em(const pg_guiding_params& p, const pg_lobes& lobes, float3 wo
 // tails (beyond ~2.5 sigma) are partly explained by the BSDF lobe at pi = pi_max, which
 // shrinks Sigma by a few percent. Hence 0.008 on the mean and 15% on Sigma (plus sigma_eps).
 TEST(PmmEm, RecoversAGaussianTarget) {
-  rtpg::GuidingConfig config;
-  config.sigma_prior = 0.0f;
-  const pg_guiding_params p = rtpg::make_guiding_params(config);
+  rtpg::GuidingSettings settings;
+  settings.sigma_prior = 0.0f;
+  const pg_kernel_settings p = rtpg::to_kernel_settings(settings);
   const pg_material lambert{float3(0.8f), 1.0f, 0.0f, 0.0f};
   const float3 wo = direction(30.0f, 0.0f);
   const pg_lobes lobes = pg_make_lobes(lambert, wo);
@@ -317,9 +317,9 @@ TEST(PmmEm, RecoversAGaussianTarget) {
 // (the state averages ~k_max = 32 epochs of 2000 samples; the Monte Carlo standard deviation
 // of pi is about 0.003).
 TEST(PmmEm, MixingWeightConvergesToTheTargetsShare) {
-  rtpg::GuidingConfig config;
-  config.sigma_prior = 0.0f;
-  const pg_guiding_params p = rtpg::make_guiding_params(config);
+  rtpg::GuidingSettings settings;
+  settings.sigma_prior = 0.0f;
+  const pg_kernel_settings p = rtpg::to_kernel_settings(settings);
   struct Case {
     float w;
     pg_material material;
@@ -350,7 +350,7 @@ TEST(PmmEm, MixingWeightConvergesToTheTargetsShare) {
 
 namespace {
 
-pg_pmm_state update_with(const pg_pmm_state& s, const pg_guiding_params& p,
+pg_pmm_state update_with(const pg_pmm_state& s, const pg_kernel_settings& p,
                          const std::vector<std::pair<float, float2>>& samples, int* updated) {
   const pg_pmm_model m = pg_pmm_model_from_state(s, p);
   const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
@@ -370,7 +370,7 @@ bool same_state(const pg_pmm_state& a, const pg_pmm_state& b) {
 // A batch made only of unusable weights (zero, NaN, +-Inf, negative, above max_weight) must
 // leave the state as it was, whether or not a model exists.
 TEST(PmmEm, UnusableWeightsLeaveTheStateUnchanged) {
-  const pg_guiding_params p = default_params();
+  const pg_kernel_settings p = default_params();
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();
   const float bad[] = {0.0f, nan, inf, -inf, -1.0f, p.max_weight * 2.0f, 3e38f};
@@ -394,7 +394,7 @@ TEST(PmmEm, UnusableWeightsLeaveTheStateUnchanged) {
 // pg_pmm_batch_add documents that NaN, negative and absurd weights are dropped: mixed into a
 // good batch they change nothing (compared to the good batch alone, up to float rounding).
 TEST(PmmEm, UnusableWeightsMixedIntoAGoodBatchAreDropped) {
-  const pg_guiding_params p = default_params();
+  const pg_kernel_settings p = default_params();
   std::mt19937 gen(5);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   const float junk[] = {std::numeric_limits<float>::quiet_NaN(), -2.0f,
@@ -434,7 +434,7 @@ TEST(PmmEm, UnusableWeightsMixedIntoAGoodBatchAreDropped) {
 // kinks and the mean sits on the clamp): the empirical covariance is exactly zero, yet the
 // model keeps a positive definite Sigma and its mean at the sample.
 TEST(PmmEm, RepeatedSamplesAndCornersKeepSigmaPositiveDefinite) {
-  const pg_guiding_params p = default_params();
+  const pg_kernel_settings p = default_params();
   const float2 points[] = {float2(0.37f, 0.81f), float2(0, 0),      float2(1, 0),
                            float2(0, 1),         float2(1, 1),      float2(0.5f, 0),
                            float2(1, 0.5f),      float2(0.5f, 0.5f)};
@@ -467,7 +467,7 @@ TEST(PmmEm, RepeatedSamplesAndCornersKeepSigmaPositiveDefinite) {
 // a state with k > 0 gives a valid model with a positive definite Sigma, and the model's
 // sampler and density produce finite values.
 TEST(PmmEm, SurvivesAHundredThousandJunkUpdates) {
-  const pg_guiding_params p = default_params();
+  const pg_kernel_settings p = default_params();
   std::mt19937 gen(77);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -580,7 +580,7 @@ double angle(float3 a, float3 b) {
 // where the probe crosses a kink of M (the square's diagonals, excluded within 2e-3): 2% of
 // sqrt(Sxx Syy) per entry (0.6% measured).
 TEST(PmmReframe, IdentityFrameKeepsTheState) {
-  const pg_guiding_params p = default_params();
+  const pg_kernel_settings p = default_params();
   std::mt19937 gen(11);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   int checked = 0;
@@ -621,7 +621,7 @@ TEST(PmmReframe, IdentityFrameKeepsTheState) {
 // det J = 1): the median relative change must be below 1% (0.12% measured; single cases are
 // off where the central differences straddle a kink of M, up to 2x).
 TEST(PmmReframe, RotationKeepsTheMeansWorldDirection) {
-  const pg_guiding_params p = default_params();
+  const pg_kernel_settings p = default_params();
   std::mt19937 gen(12);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   int carried = 0, dropped = 0;

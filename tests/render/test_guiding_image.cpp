@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "cl/cl_runtime.h"
+#include "rtpg/cl_runtime.h"
 #include "render/guided_first_bounce.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
@@ -39,7 +39,7 @@ TileSeries run(const Scene& scene, bool guided, int size, int frames, ClRuntime&
   Renderer renderer(scene, settings);
   if (guided)
     renderer.set_first_bounce_sampler(
-        std::make_unique<GuidedFirstBounce>(cl, size, size, GuidingConfig{}));
+        std::make_unique<GuidedFirstBounce>(cl, size, size, GuidingSettings{}));
   TileSeries s;
   s.tiles_x = s.tiles_y = size / s.tile;
   s.per_tile.assign(s.tiles_x * s.tiles_y, {});
@@ -144,7 +144,7 @@ TEST(GuidingImage, HalvesErrorOnCornellIndirect) {
     Renderer renderer(scene, settings);
     if (guided)
       renderer.set_first_bounce_sampler(
-          std::make_unique<GuidedFirstBounce>(cl, size, size, GuidingConfig{}));
+          std::make_unique<GuidedFirstBounce>(cl, size, size, GuidingSettings{}));
     for (int f = 0; f < 32; ++f) {
       renderer.render_frame(f);
       if (f >= 24)

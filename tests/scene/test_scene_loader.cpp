@@ -23,7 +23,7 @@
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
 #include "scene/texture.h"
-#include "util/error.h"
+#include "rtpg/errors.h"
 
 namespace fs = std::filesystem;
 
@@ -522,7 +522,7 @@ TEST(SceneLoader, AssetsFallBackToTheAssetRoot) {
   write_ply(dir / "assets/shared/floor.ply");
   write_file(dir / "scenes/s.json", std::string("{") + kCamera + ", " + kLightSource +
                                         R"(, "meshes": [{"file": "shared/floor.ply"}]})");
-  SceneLoadOptions options;
+  SceneLoadSettings options;
   options.asset_root = dir / "assets";
   const Scene scene = load_scene(dir / "scenes/s.json", options);
   EXPECT_EQ(scene.triangle_count(), 2u);
@@ -550,7 +550,7 @@ TEST(SceneLoader, SharedCornellBox) {
   write_file(dir / "cornell.json",
              std::string("{") + kCamera +
                  R"(, "meshes": [{"file": "cornell-box/CornellBox-Original.obj"}]})");
-  SceneLoadOptions options;
+  SceneLoadSettings options;
   options.asset_root = root;
   const Scene scene = load_scene(dir / "cornell.json", options);
   EXPECT_EQ(scene.triangle_count(), 36u);

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "cl/cl_runtime.h"
+#include "rtpg/cl_runtime.h"
 #include "render/guided_first_bounce.h"
 #include "render/renderer.h"
 #include "scene/scene_loader.h"
@@ -153,7 +153,7 @@ TEST_P(SceneSuite, LoadsAndRenders) {
     Renderer renderer(scene, settings);
     if (guided)
       renderer.set_first_bounce_sampler(
-          std::make_unique<GuidedFirstBounce>(cl_runtime(), width, height, GuidingConfig{}));
+          std::make_unique<GuidedFirstBounce>(cl_runtime(), width, height, GuidingSettings{}));
     double mean = 0.0;
     for (int f = 0; f < frames; ++f) {
       const FrameStats stats = renderer.render_frame(f);

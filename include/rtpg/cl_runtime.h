@@ -3,16 +3,38 @@
 // build options, caching and error reporting are decided here once.
 #pragma once
 
-#include <map>
-#include <mutex>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <string>
 
-#include "cl/cl_error.h"
-#include "cl/cl_include.h"
-#include "cl/device.h"
-#include "cl/program_cache.h"
+#include "rtpg/cl_error.h"
+#include "rtpg/opencl.h"
 
 namespace rtpg {
+
+// What rtpg knows of an OpenCL device (list_devices() in host/cl/device.h fills it).
+struct DeviceInfo {
+  int platform_index = 0;  // position in clGetPlatformIDs order
+  int device_index = 0;    // position among that platform's devices
+  std::string platform_name;
+  std::string device_name;
+  std::string type;              // "gpu", "cpu", "accelerator" or "other"
+  std::string opencl_c_version;  // CL_DEVICE_OPENCL_C_VERSION, e.g. "OpenCL C 1.2 pocl"
+  std::string driver_version;    // CL_DRIVER_VERSION: part of the program cache key
+  std::string device_version;    // CL_DEVICE_VERSION
+  std::uint32_t compute_units = 0;
+  std::uint64_t local_mem_size = 0;  // bytes
+  std::size_t max_work_group_size = 0;
+  std::uint64_t global_mem_size = 0;  // bytes
+
+  // "P:D", the index form of a device spec.
+  std::string spec() const;
+  // One line for listings and error messages: "0:0 <name> (cpu, <platform>, <OpenCL C>)".
+  std::string summary() const;
+};
+
+struct SelectedDevice;
 
 // How program() requests were served since construction (tests and logs read these).
 struct ProgramCacheStats {
@@ -25,7 +47,10 @@ class ClRuntime {
  public:
   // device_spec as select_device() reads it ("" = $RTPG_DEVICE or the default device).
   // Throws InputError for a spec matching no device, ClError when OpenCL fails.
+  //   spec: "" ($RTPG_DEVICE, else the first GPU, else the CPU), "gpu", "cpu", "P:D" (platform
+  //   and device index) or part of a device's name.
   explicit ClRuntime(const std::string& device_spec = "");
+  ~ClRuntime();
 
   // Programs and kernels point into this context: neither copied nor moved.
   ClRuntime(const ClRuntime&) = delete;
@@ -51,11 +76,12 @@ class ClRuntime {
   // END - START of a finished command in milliseconds, from its profiling info.
   static double event_ms(const cl::Event& event);
 
-  const ProgramCacheStats& cache_stats() const { return stats_; }
+  ProgramCacheStats cache_stats() const;
   // The rtpg cache folder this runtime uses (rtpg_cache_dir() at construction; "" = off).
   const std::string& cache_dir() const { return cache_dir_; }
 
  private:
+  struct Programs;  // the program cache in memory and on disk (host/cl/cl_runtime.cpp)
   explicit ClRuntime(SelectedDevice selected);
   const std::string& resolved_source(const std::string& kernel_file);
   cl::Program build(const std::string& kernel_file, const std::string& source,
@@ -66,12 +92,7 @@ class ClRuntime {
   cl::Context context_;
   cl::CommandQueue queue_;
   std::string cache_dir_;
-  DiskProgramCache disk_cache_;
-
-  std::mutex mutex_;  // guards everything below: program() may be called from any thread
-  std::map<std::string, std::string> embedded_sources_;  // resolved embedded sources
-  std::map<std::string, cl::Program> programs_;          // by cache key
-  ProgramCacheStats stats_;
+  std::unique_ptr<Programs> programs_;
 };
 
 }  // namespace rtpg

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "cl/cl_include.h"
+#include "rtpg/opencl.h"
 
 namespace rtpg {
 

@@ -1,0 +1,162 @@
+#include "rtpg/guiding_settings.h"
+
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+
+#include "rtpg/errors.h"
+
+namespace rtpg {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+using S = GuidingSettings;
+
+GuidingSettingInfo real(const char* name, float S::*field, double min, double max,
+                        bool min_exclusive, bool max_exclusive, const char* help) {
+  return {name, help, min, max, min_exclusive, max_exclusive, field, nullptr};
+}
+GuidingSettingInfo integer(const char* name, int S::*field, double min, double max,
+                           const char* help) {
+  return {name, help, min, max, false, false, nullptr, field};
+}
+
+// A step through the neighbourhood window that visits every cell once: coprime with its size.
+int window_stride(int apron) {
+  const int size = (2 * apron + 1) * (2 * apron + 1);
+  for (int s = std::max(1, size / 3); s < size; ++s)
+    if (std::gcd(s, size) == 1) return s;
+  return 1;
+}
+
+std::string number(double v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+}  // namespace
+
+const std::vector<GuidingSettingInfo>& guiding_settings_table() {
+  // The bounds are what the kernels' arithmetic needs (docs/guiding.md explains the values).
+  static const std::vector<GuidingSettingInfo> table = {
+      real("pi_min", &S::pi_min, 0, 1, false, true, "Lower clamp of the mixing weight"),
+      real("pi_max", &S::pi_max, 0, 1, false, true, "Upper clamp of the mixing weight"),
+      real("pi_init", &S::pi_init, 0, 1, true, true, "Mixing weight of a new model"),
+      integer("k_max", &S::k_max, 1, 1e6, "Epochs after which the EM step size stops shrinking"),
+      real("step_alpha", &S::step_alpha, 0, 1, true, false,
+           "Step size exponent: eta_k = max((k+1)^-alpha, 1/(k_max+1))"),
+      real("sigma_eps", &S::sigma_eps, 0, kInf, true, false,
+           "Regularisation of the covariance diagonal"),
+      real("sigma_prior", &S::sigma_prior, 0, kInf, false, false,
+           "Prior variance, added as sigma_prior / (k + 1)"),
+      real("reseed_ratio", &S::reseed_ratio, 0, kInf, true, false,
+           "Re-seed a lobe on a sample this many times brighter than its history"),
+      real("weight_clamp", &S::weight_clamp, 0, kInf, false, false,
+           "Clamp training weights to this multiple of the running mean (0 = off)"),
+      integer("em_passes", &S::em_passes, 1, 8, "E-step passes over each frame's training samples"),
+      real("max_correlation", &S::max_correlation, 0, 1, true, true,
+           "Bound of the Gaussian's correlation coefficient"),
+      real("roughness_skip", &S::roughness_skip, 0, 1, false, false,
+           "No guiding at or below this roughness"),
+      integer("n_min", &S::n_min, 1, PG_MAX_TRAIN_SAMPLES, "Neighbour VPLs per pixel at k = k_max"),
+      integer("n_max", &S::n_max, 1, PG_MAX_TRAIN_SAMPLES,
+              "Neighbour VPLs per pixel at k = 0 (n_min = n_max: a fixed N)"),
+      integer("apron", &S::apron, 0, 8, "Neighbourhood radius in pixels"),
+      real("max_weight", &S::max_weight, 0, kInf, true, false,
+           "Training weights above this are dropped as absurd"),
+      real("reproject_position", &S::reproject_position, 0, kInf, false, false,
+           "Position change, relative to the depth, that rejects history"),
+      real("reproject_normal", &S::reproject_normal, -1, 1, false, false,
+           "Normal cosine below which history is rejected"),
+      integer("local_x", &S::local_x, 1, 65536, "Work-group (VPL tile) width"),
+      integer("local_y", &S::local_y, 1, 65536, "Work-group (VPL tile) height"),
+  };
+  return table;
+}
+
+double GuidingSettingInfo::get(const GuidingSettings& s) const {
+  return float_field ? static_cast<double>(s.*float_field) : static_cast<double>(s.*int_field);
+}
+
+void GuidingSettingInfo::set(GuidingSettings& s, double value) const {
+  if (float_field) {
+    s.*float_field = static_cast<float>(value);
+  } else {
+    s.*int_field = static_cast<int>(std::lround(value));
+  }
+}
+
+bool GuidingSettingInfo::in_range(double v) const {
+  const bool above = min_exclusive ? v > min : v >= min;
+  const bool below = max_exclusive ? v < max : v <= max;
+  return above && below;  // false for NaN
+}
+
+std::string GuidingSettingInfo::range_text() const {
+  return std::string(min_exclusive ? "(" : "[") + number(min) + ", " + number(max) +
+         (max_exclusive ? ")" : "]");
+}
+
+const char* train_memory_name(GuidingSettings::TrainMemory memory) {
+  switch (memory) {
+    case GuidingSettings::TrainMemory::Local:
+      return "local";
+    case GuidingSettings::TrainMemory::Global:
+      return "global";
+    case GuidingSettings::TrainMemory::Auto:
+      break;
+  }
+  return "auto";
+}
+
+bool parse_train_memory(const std::string& word, GuidingSettings::TrainMemory& memory) {
+  for (auto m : {GuidingSettings::TrainMemory::Auto, GuidingSettings::TrainMemory::Local,
+                 GuidingSettings::TrainMemory::Global})
+    if (word == train_memory_name(m)) {
+      memory = m;
+      return true;
+    }
+  return false;
+}
+
+void validate(const GuidingSettings& s) {
+  auto fail = [](const std::string& what) { throw GuiderError("guiding settings: " + what); };
+  for (const GuidingSettingInfo& row : guiding_settings_table()) {
+    const double v = row.get(s);
+    if (!row.in_range(v))
+      fail(std::string(row.name) + " = " + number(v) + " is outside " + row.range_text());
+  }
+  if (s.pi_min > s.pi_max)
+    fail("pi_min (" + number(s.pi_min) + ") must not exceed pi_max (" + number(s.pi_max) + ")");
+  if (s.n_min > s.n_max)
+    fail("n_min (" + number(s.n_min) + ") must not exceed n_max (" + number(s.n_max) + ")");
+}
+
+pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {
+  pg_kernel_settings p{};
+  p.pi_min = c.pi_min;
+  p.pi_max = c.pi_max;
+  p.pi_init = c.pi_init;
+  p.k_max = static_cast<float>(c.k_max);
+  p.step_alpha = c.step_alpha;
+  p.sigma_eps = c.sigma_eps;
+  p.max_correlation = c.max_correlation;
+  p.roughness_skip = c.roughness_skip;
+  p.n_min = static_cast<float>(c.n_min);
+  p.n_max = static_cast<float>(c.n_max);
+  p.max_weight = c.max_weight;
+  p.reproject_depth = c.reproject_position;
+  p.reproject_normal = c.reproject_normal;
+  p.sigma_prior = c.sigma_prior;
+  p.reseed_ratio = c.reseed_ratio;
+  p.weight_clamp = c.weight_clamp;
+  p.em_passes = c.em_passes;
+  p.apron = c.apron;
+  p.stride = window_stride(c.apron);
+  return p;
+}
+
+}  // namespace rtpg

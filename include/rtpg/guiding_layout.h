@@ -1,0 +1,123 @@
+/* rtpg's data layouts: the one description of every per-pixel buffer the guiding kernels
+ * read or write, their flag bits and strategies, the random-stream tags, and the settings
+ * block the kernels take by value. Plain C: the OpenCL C kernels include it (kernels/, every .cl),
+ * the C++ host includes it (include/rtpg/guider.h), and so can a C renderer.
+ *
+ * Every buffer is one entry per pixel, row-major (pixel i = y * width + x), structure of
+ * arrays. The channel lists below are X-macros: X(name, type, bytes) with type an OpenCL C
+ * type name (float4, float2, uint) and bytes its size. Host structs, allocation, uploads,
+ * size checks and kernel arguments are all generated from them (docs/design.md, "Data
+ * layouts"), so a channel is added or changed here and nowhere else. */
+#ifndef RTPG_GUIDING_LAYOUT_H
+#define RTPG_GUIDING_LAYOUT_H
+
+/* ---- G-buffer: what the camera ray hit, per pixel -------------------------------------- */
+/* position_depth       xyz world position of the primary hit, w its linear depth (0 on sky)
+ * shading_normal       xyz unit shading normal facing the camera (the guiding hemisphere), w 0
+ * view_dir             xyz unit vector from the surface towards the camera, w 0
+ * base_color_roughness rgb base colour, w perceptual roughness (alpha = roughness^2)
+ * metallic_specular    x metallic, y dielectric F0 (0 = no GGX lobe), zw 0
+ * flags                PG_GBUF_* bits
+ * material             material id: reprojection keeps history only on the same material
+ * motion               offset in pixels from this pixel to where its point was last frame */
+#define PG_GBUFFER_CHANNELS(X)        \
+  X(position_depth, float4, 16)       \
+  X(shading_normal, float4, 16)       \
+  X(view_dir, float4, 16)             \
+  X(base_color_roughness, float4, 16) \
+  X(metallic_specular, float4, 16)    \
+  X(flags, uint, 4)                   \
+  X(material, uint, 4)                \
+  X(motion, float2, 8)
+
+/* Pixels guiding skips (paper, section 5: sky, emitters, transmission, roughness near 0). */
+#define PG_GBUF_SKY 1u          /* camera ray escaped: no surface */
+#define PG_GBUF_EMITTER 2u      /* surface emits towards the camera */
+#define PG_GBUF_DELTA 4u        /* roughness at or below the delta threshold */
+#define PG_GBUF_TRANSMISSIVE 8u /* transmissive material */
+
+/* ---- VPLs: the first-bounce hit y of every pixel's path, the trainer's input -------------
+ * (paper, section 3.1: the texture Pi)
+ * position       xyz hit point y (or the unit direction of an escaped ray); w the density
+ *                that generated y, in area measure at y (solid angle for an escaped ray), so
+ *                that a neighbouring pixel can convert it to its own solid angle
+ * normal         xyz geometric normal at y (facing the pixel's point), w 0
+ * radiance_info  rgb radiance leaving y towards the pixel's point; w the info word as a float
+ *                (exact: small integers): PG_VPL_* bits, the strategy in bits 8..15 */
+#define PG_VPL_CHANNELS(X) \
+  X(position, float4, 16)  \
+  X(normal, float4, 16)    \
+  X(radiance_info, float4, 16)
+
+#define PG_VPL_VALID 1u
+#define PG_VPL_DISTANT 2u /* escaped ray: position holds a direction */
+#define PG_VPL_STRATEGY_SHIFT 8u
+#define PG_VPL_STRATEGY(info) (((info) >> PG_VPL_STRATEGY_SHIFT) & 0xffu)
+
+/* ---- Samples: what the sample kernel writes ---------------------------------------------
+ * direction_pdf  xyz unit world direction of the first bounce, w the mixture's density in
+ *                solid angle (0 = no sample)
+ * strategy       PG_STRATEGY_* that produced it */
+#define PG_SAMPLE_CHANNELS(X)  \
+  X(direction_pdf, float4, 16) \
+  X(strategy, uint, 4)
+
+#define PG_STRATEGY_NONE 0u  /* no surface, or no sample */
+#define PG_STRATEGY_BSDF 1u  /* the BSDF component: the only samples that train (paper 3.2) */
+#define PG_STRATEGY_GUIDE 2u /* the Gaussian component */
+
+/* ---- Guiding state: the per-pixel mixture, kept by the guider --------------------------
+ * state0  (W, S0, Sx, Sy)    running means of the EM sufficient statistics
+ * state1  (Sxx, Syy, Sxy, k) second moments and the epoch count k (0 = no model)
+ * (the model they define: kernels/shared/pmm.h). Host copies interleave them: 8 floats per
+ * pixel, state0 then state1. */
+#define PG_STATE_CHANNELS(X) \
+  X(state0, float4, 16)      \
+  X(state1, float4, 16)
+#define PG_STATE_FLOATS_PER_PIXEL 8
+
+/* ---- Random streams ---------------------------------------------------------------------
+ * Every consumer draws from its own stream per (seed, pixel, frame, sample) (kernels/shared/
+ * rng.h): these tags keep the consumers independent. */
+#define PG_RNG_STREAM_PATH 0u         /* the host path tracer */
+#define PG_RNG_STREAM_FIRST_BOUNCE 1u /* first-bounce sampling: sample kernel, BSDF sampler */
+#define PG_RNG_STREAM_TRAIN 3u        /* the train kernel's walk through the neighbourhood */
+
+/* At most this many neighbour VPLs train a pixel per frame (the train kernel's array). */
+#define PG_MAX_TRAIN_SAMPLES 32
+
+/* ---- Kernel settings --------------------------------------------------------------------
+ * Every tunable of the guiding kernels, passed by value. Plain 4-byte fields only, so host
+ * and device agree on the layout (checked by static_assert on the host). The host builds it
+ * once from rtpg::GuidingSettings (include/rtpg/guiding_settings.h), which documents each. */
+#ifdef __cplusplus
+namespace rtpg {
+#endif
+
+typedef struct pg_kernel_settings {
+  float pi_min;          /* clamp of the mixing weight (paper: 0.05) */
+  float pi_max;          /* (paper: 0.95) */
+  float pi_init;         /* weight of a new model (paper: 0.05) */
+  float k_max;           /* epochs after which the step size stops shrinking */
+  float step_alpha;      /* eta_k = max((k+1)^-alpha, 1/(k_max+1)) */
+  float sigma_eps;       /* added to Sigma's diagonal: keeps it positive definite */
+  float max_correlation; /* |rho| bound: keeps the Cholesky factor well conditioned */
+  float roughness_skip;  /* no guiding where roughness is at or below this */
+  float n_min;           /* N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2) */
+  float n_max;
+  float max_weight;       /* training weights above this are treated as absurd input */
+  float reproject_depth;  /* relative position difference that rejects history */
+  float reproject_normal; /* cosine below which normals reject history */
+  float sigma_prior;      /* prior variance added as sigma_prior / (k + 1) */
+  float reseed_ratio;     /* a sample with a > reseed_ratio * W outside the lobe re-seeds */
+  float weight_clamp;     /* training weights are clamped to weight_clamp * W (0 = off) */
+  int em_passes;          /* E-step passes over a frame's samples (pg_pmm_train) */
+  int apron;              /* neighbourhood radius in pixels (window 2*apron+1 squared) */
+  int stride;             /* step through the window, coprime with its size */
+} pg_kernel_settings;
+
+#ifdef __cplusplus
+} /* namespace rtpg */
+#endif
+
+#endif /* RTPG_GUIDING_LAYOUT_H */

@@ -1,0 +1,71 @@
+// Every setting of guiding, its default, bounds and meaning, in one table. The command line
+// builds its --pg-* flags from the table, the guider validates against it, and the stats JSON
+// records every row (host/app); the kernels receive the settings as one pg_kernel_settings
+// block (include/rtpg/guiding_layout.h), built once per Guider.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rtpg/guiding_layout.h"
+
+namespace rtpg {
+
+struct GuidingSettings {
+  float pi_min = 0.05f;  // clamp of the Gaussian's mixing weight (paper 3.2)
+  float pi_max = 0.95f;
+  float pi_init = 0.05f;       // weight of a new model (paper 3.1)
+  int k_max = 32;              // epochs; the step size stops shrinking after k_max updates
+  float step_alpha = 1.0f;     // eta_k = max((k+1)^-alpha, 1/(k_max+1)): 1 = plain mean until k_max
+  float sigma_eps = 1e-4f;     // regularisation of Sigma's diagonal (square units^2)
+  float sigma_prior = 5e-2f;   // prior variance, added as sigma_prior / (k + 1)
+  float reseed_ratio = 10.0f;  // a sample with weight > ratio * W outside the lobe re-seeds it
+  float weight_clamp = 0.0f;   // training weights clamped to weight_clamp * W (0 = no clamp)
+  int em_passes = 3;           // E-step passes over each frame's samples
+  float max_correlation = 0.95f;
+  float roughness_skip = 0.05f;      // roughness at or below: BSDF only, no training
+  int n_min = 5, n_max = 20;         // N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2);
+                                     // n_min == n_max gives a fixed N
+  int apron = 2;                     // neighbourhood radius: a (2*apron+1)^2 window of VPLs
+  float max_weight = 1e8f;           // training weights above this are dropped as absurd
+  float reproject_position = 0.05f;  // relative distance (to the depth) that rejects history
+  float reproject_normal = 0.9f;     // normal cosine below which history is rejected
+  int local_x = 16, local_y = 16;    // work-group size of the kernels (the VPL tile)
+  enum class TrainMemory { Auto, Local, Global };
+  // Local: VPL tile in local memory (GPUs); Global: direct reads (faster on PoCL). Auto
+  // picks Global on CPU devices and Local elsewhere.
+  TrainMemory train_memory = TrainMemory::Auto;
+};
+
+// One numeric setting: its name (the field's), meaning and valid range. Exactly one of
+// float_field and int_field is set.
+struct GuidingSettingInfo {
+  const char* name;
+  const char* help;
+  double min, max;
+  bool min_exclusive, max_exclusive;
+  float GuidingSettings::*float_field;
+  int GuidingSettings::*int_field;
+
+  double get(const GuidingSettings& s) const;
+  void set(GuidingSettings& s, double value) const;  // rounds for an integer field
+  bool in_range(double value) const;
+  std::string range_text() const;  // "[0, 1)", "(0, inf)", ...
+};
+
+// Every numeric field of GuidingSettings, in declaration order.
+const std::vector<GuidingSettingInfo>& guiding_settings_table();
+
+// "auto", "local", "global" and back; parse returns false for another word.
+const char* train_memory_name(GuidingSettings::TrainMemory memory);
+bool parse_train_memory(const std::string& word, GuidingSettings::TrainMemory& memory);
+
+// Throws GuiderError ("guiding settings: <name> ...") for a value outside its row's range or
+// a broken relation between two rows (pi_min <= pi_max, n_min <= n_max).
+void validate(const GuidingSettings& settings);
+
+// The block the kernels read. Host code that evaluates the mixture itself (the
+// GuidingDistribution) uses the same block.
+pg_kernel_settings to_kernel_settings(const GuidingSettings& settings);
+
+}  // namespace rtpg

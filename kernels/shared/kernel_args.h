@@ -1,0 +1,26 @@
+/* Kernel parameter lists generated from the channel lists of include/rtpg/guiding_layout.h,
+ * so that a kernel's signature, the host's clSetKernelArg calls (host/guiding/kernel_args.h)
+ * and the buffers themselves come from one description. OpenCL C only.
+ *
+ * A guiding kernel's parameters come in this order: the current G-buffer (every channel, in
+ * list order), then whatever lists the kernel needs (PG_ARGS_*), then its scalars. */
+#ifndef RTPG_SHARED_KERNEL_ARGS_H
+#define RTPG_SHARED_KERNEL_ARGS_H
+
+#include "rtpg/guiding_layout.h"
+
+#define PG_ARG_IN(name, type, bytes) __global const type *name,
+#define PG_ARG_IN_PREV(name, type, bytes) __global const type *prev_##name,
+#define PG_ARG_IN_VPL(name, type, bytes) __global const type *vpl_##name,
+#define PG_ARG_IN_STATE(name, type, bytes) __global const type *in_##name,
+#define PG_ARG_OUT_STATE(name, type, bytes) __global type *out_##name,
+#define PG_ARG_OUT(name, type, bytes) __global type *name,
+
+#define PG_ARGS_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_IN)           /* this frame's G-buffer */
+#define PG_ARGS_PREV_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_IN_PREV) /* last frame's */
+#define PG_ARGS_VPLS PG_VPL_CHANNELS(PG_ARG_IN_VPL)
+#define PG_ARGS_IN_STATE PG_STATE_CHANNELS(PG_ARG_IN_STATE)
+#define PG_ARGS_OUT_STATE PG_STATE_CHANNELS(PG_ARG_OUT_STATE)
+#define PG_ARGS_SAMPLES PG_SAMPLE_CHANNELS(PG_ARG_OUT)
+
+#endif
