@@ -15,7 +15,7 @@
 
 #include "rtpg/cl_runtime.h"
 #include "cl/device.h"
-#include "cl/image_kernels.h"
+#include "render/image_kernels.h"
 #include "render/guided_first_bounce.h"
 #include "render/image_io.h"
 #include "scene/scene_loader.h"

@@ -18,7 +18,7 @@ const std::map<std::string, std::string>& embedded_kernel_files();
 // The text of kernels/<path> (include/<path> for "rtpg/..."), or nullopt. When
 // $RTPG_KERNEL_DIR is set the file is read
 // from that folder instead of the embedded copy (a developer switch: edit kernels and rerun
-// without rebuilding; point it at the source tree, RTPG_KERNEL_SOURCE_DIR at build time;
+// without rebuilding; point it at the source tree's kernels/ or the installed share/rtpg/kernels;
 // "rtpg/..." is then read from $RTPG_KERNEL_DIR/../include).
 // The switch replaces the embedded set as a whole, so a half-copied folder fails loudly.
 std::optional<std::string> load_kernel_file(const std::string& path);

@@ -11,7 +11,7 @@
 #include "rtpg/cl_error.h"
 #include "rtpg/cl_runtime.h"
 #include "cl/device.h"
-#include "cl/image_kernels.h"
+#include "render/image_kernels.h"
 #include "support/test_env.h"
 #include "rtpg/errors.h"
 

@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "cl/image_kernels.h"
+#include "render/image_kernels.h"
 #include "shared/tonemap.h"
 
 namespace rtpg {

@@ -1,4 +1,4 @@
-#include "cl/image_kernels.h"
+#include "render/image_kernels.h"
 
 #include <algorithm>
 #include <stdexcept>
