@@ -15,7 +15,8 @@ using S = GuidingSettings;
 
 GuidingSettingInfo real(const char* name, float S::*field, double min, double max,
                         bool min_exclusive, bool max_exclusive, const char* help) {
-  return {name, help, min, max, min_exclusive, max_exclusive, field, nullptr};
+  // An unbounded range still excludes infinity: every setting is a finite number.
+  return {name, help, min, max, min_exclusive, max_exclusive || std::isinf(max), field, nullptr};
 }
 GuidingSettingInfo integer(const char* name, int S::*field, double min, double max,
                            const char* help) {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "rtpg/cl_runtime.h"
@@ -236,4 +237,49 @@ TEST(GuiderApi, HostDistributionHasTheSampleKernelsDensity) {
   d.init(&lobe[0], &f.normal[0], &f.view[0], &f.bcr[0], &f.ms[0], f.flags[0]);
   EXPECT_FALSE(d.guided());
   EXPECT_EQ(d.mixing_weight(), 0.0f);
+}
+
+// The settings table is the one place ranges live: the defaults pass, and every row refuses
+// NaN, infinities and the first values outside its range, naming itself.
+TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
+  EXPECT_NO_THROW(rtpg::validate(rtpg::GuidingSettings{}));
+  const auto& table = rtpg::guiding_settings_table();
+  EXPECT_EQ(table.size(), 20u);
+  for (const rtpg::GuidingSettingInfo& row : table) {
+    ASSERT_TRUE((row.float_field != nullptr) != (row.int_field != nullptr)) << row.name;
+    EXPECT_TRUE(row.in_range(row.get(rtpg::GuidingSettings{}))) << row.name;
+    std::vector<double> bad;
+    if (row.float_field) {
+      bad = {std::nan(""), INFINITY, -INFINITY};
+      bad.push_back(row.min_exclusive ? row.min : row.min - 1.0);
+      if (std::isfinite(row.max)) bad.push_back(row.max_exclusive ? row.max : row.max + 1.0);
+    } else {
+      bad = {row.min - 1.0, row.max + 1.0};
+    }
+    for (double v : bad) {
+      rtpg::GuidingSettings s;
+      row.set(s, v);
+      try {
+        rtpg::validate(s);
+        ADD_FAILURE() << row.name << " = " << v << " passed";
+      } catch (const rtpg::GuiderError& e) {
+        EXPECT_NE(std::string(e.what()).find(row.name), std::string::npos) << e.what();
+      }
+    }
+  }
+  rtpg::GuidingSettings s;
+  s.n_min = 9;
+  s.n_max = 8;
+  EXPECT_THROW(rtpg::validate(s), rtpg::GuiderError);
+  // The kernels' block carries the values (integers as floats where the kernels want them).
+  s = rtpg::GuidingSettings{};
+  s.k_max = 17;
+  s.apron = 3;
+  const rtpg::pg_kernel_settings k = rtpg::to_kernel_settings(s);
+  EXPECT_EQ(k.k_max, 17.0f);
+  EXPECT_EQ(k.apron, 3);
+  EXPECT_EQ(k.reproject_depth, s.reproject_position);
+  // The window walk's stride visits all 49 cells of a 7x7 window: coprime with 49.
+  EXPECT_GT(k.stride, 0);
+  EXPECT_NE(k.stride % 7, 0);
 }
