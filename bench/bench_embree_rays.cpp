@@ -10,7 +10,8 @@
 //
 // Packet8 benchmarks also trace the same set one ray at a time in every iteration
 // (interleaved, not timed) and report packet_speedup = single time / packet time: the host
-// drifts by 10-30% within minutes (DESIGN.md 7), so ratios are taken inside one iteration.
+// drifts by 10-30% within minutes (docs/design.md, "PoCL and OpenCL facts"), so ratios are taken
+// inside one iteration.
 #include "bench_common.h"
 
 #include <map>

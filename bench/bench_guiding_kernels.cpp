@@ -50,7 +50,6 @@
 #include "shared/guiding_pixel.h"
 #include "shared/pmm.h"
 #include "shared/pmm_train.h"
-#include "rtpg/guiding_layout.h"
 
 namespace rtpg::bench {
 namespace {
@@ -266,7 +265,7 @@ void count_bytes(Inputs& in, const pg_kernel_settings& p) {
                        m = sh::pg_float4_xyz(in.prev.shading_normal[j]);
           if (sh::pg_same_surface(in.cur.position_depth[i], n, in.cur.material[i],
                                   in.prev.position_depth[j], m, in.prev.material[j],
-                                  p.reproject_depth, p.reproject_normal))
+                                  p.reproject_position, p.reproject_normal))
             r += 32;
         }
       }

@@ -207,8 +207,8 @@ def equal_time(ctx, scene):
 
 
 def flicker(ctx, scene):
-    """Temporal flicker (DESIGN.md 5): mean MSE between consecutive frames of a static camera
-    with jitter off, over the last 8 frame pairs of a run (PG has trained by then)."""
+    """Temporal flicker (docs/design.md, "Metrics"): mean MSE between consecutive frames of a
+    static camera with jitter off, over the last 8 frame pairs of a run (PG has trained by then)."""
     m = ctx.mode
     out = ctx.out / "flicker" / scene
     result = {"scene": scene, "frames": m["flicker_frames"], "methods": {}}

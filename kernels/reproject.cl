@@ -23,7 +23,8 @@ __kernel void reproject(PG_ARGS_GBUFFER PG_ARGS_PREV_GBUFFER PG_ARGS_IN_STATE PG
       uint j = (uint)py * width + (uint)px;
       float3 n = pg_float4_xyz(shading_normal[i]), m = pg_float4_xyz(prev_shading_normal[j]);
       if (pg_same_surface(position_depth[i], n, material[i], prev_position_depth[j], m,
-                          prev_material[j], settings.reproject_depth, settings.reproject_normal)) {
+                          prev_material[j], settings.reproject_position,
+                          settings.reproject_normal)) {
         pg_pmm_state s;
         s.s0 = in_state0[j];
         s.s1 = in_state1[j];

@@ -1,4 +1,4 @@
-"""Error metrics of the suite (DESIGN.md section 5).
+"""Error metrics of the suite (docs/design.md, "Metrics").
 
 - relMSE on linear radiance: mean over pixels and channels of (I - R)^2 / (R^2 + 0.01);
 - LDR-FLIP on the tonemapped sRGB image (the renderer's documented PNG transform, below) and

@@ -96,7 +96,7 @@ def _flicker(ex, settings):
     lines = ["## Temporal flicker (static camera, jitter off)", "",
              f"Mean MSE between consecutive 1-spp frames, over the last {min(8, settings['flicker_frames'] - 1)} "
              f"frame pairs of {settings['flicker_frames']} frames "
-             "(DESIGN.md section 5; the paper's flicker claim is for SVGF output, which comes later).", "",
+             "(docs/design.md, \"Metrics\"; the paper's flicker claim is for SVGF output, which comes later).", "",
              "| scene | flicker PT | flicker PG | PG/PT |", "|---|---|---|---|"]
     for scene, r in ex.items():
         pt, pg = r["methods"]["off"], r["methods"]["pmm"]

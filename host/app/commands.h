@@ -1,4 +1,4 @@
-// The subcommands of the rtpg program. main.cpp parses flags into these options.
+// The subcommands of the rtpg program. main.cpp parses flags into these commands.
 #pragma once
 
 #include <cstdint>
@@ -46,9 +46,9 @@ struct ReferenceCommand {
 // "dir/name.exr" -> "dir/name-f0007.exr".
 std::string frame_output_path(const std::string& output, int frame);
 
-int run_render(const RenderCommand& options);
-int run_reference(const ReferenceCommand& options);
-int run_info(const CommonArguments& options);
+int run_render(const RenderCommand& command);
+int run_reference(const ReferenceCommand& command);
+int run_info(const CommonArguments& command);
 int run_devices();
 
 // The scene used when none is given: scenes/cornell-box.json of the source tree or of the

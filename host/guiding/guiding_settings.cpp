@@ -149,7 +149,7 @@ pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {
   p.n_min = static_cast<float>(c.n_min);
   p.n_max = static_cast<float>(c.n_max);
   p.max_weight = c.max_weight;
-  p.reproject_depth = c.reproject_position;
+  p.reproject_position = c.reproject_position;
   p.reproject_normal = c.reproject_normal;
   p.sigma_prior = c.sigma_prior;
   p.reseed_ratio = c.reseed_ratio;

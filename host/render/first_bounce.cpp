@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "rtpg/guiding_layout.h"
 #include "shared/rng.h"
 
 namespace rtpg {
@@ -16,7 +17,7 @@ void BsdfFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
       s = FirstBounceSample{};
       if (!g.has_surface(i)) continue;
       shared::pg_rng rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
-                                               at.sample, /*stream_tag=*/1u);
+                                               at.sample, PG_RNG_STREAM_FIRST_BOUNCE);
       const shared::pg_frame frame = gbuffer_frame(g, i);
       const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
       const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);

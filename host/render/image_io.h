@@ -25,7 +25,7 @@ void write_png(const std::string& path, int width, int height,
 // Reads any image OpenImageIO can (EXR for references); throws InputError(path, problem).
 ImageRgb read_image(const std::string& path);
 
-// relMSE = mean over pixels and channels of (I - R)^2 / (R^2 + 0.01) (DESIGN.md section 5).
+// relMSE = mean over pixels and channels of (I - R)^2 / (R^2 + 0.01) (docs/design.md, "Metrics").
 double relative_mse(const ImageRgb& image, const ImageRgb& reference);
 
 }  // namespace rtpg

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "render/surface.h"
+#include "rtpg/guiding_layout.h"
 #include "shared/rng.h"
 #include "rtpg/errors.h"
 
@@ -77,8 +78,9 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
       const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
       float jx = 0.5f, jy = 0.5f;
       if (settings_.jitter) {
-        shared::pg_rng rng = shared::pg_rng_make(settings_.seed, static_cast<shared::uint>(i),
-                                                 static_cast<shared::uint>(frame), 0u, 2u);
+        shared::pg_rng rng =
+            shared::pg_rng_make(settings_.seed, static_cast<shared::uint>(i),
+                                static_cast<shared::uint>(frame), 0u, PG_RNG_STREAM_CAMERA);
         jx = shared::pg_rng_next(&rng);
         jy = shared::pg_rng_next(&rng);
       }

@@ -36,10 +36,10 @@ bool is_folder(const fs::path& p) {
 
 }  // namespace
 
-std::string resolve_asset_root(const std::string& json_path, const SceneLoadSettings& options) {
+std::string resolve_asset_root(const std::string& json_path, const SceneLoadSettings& settings) {
   // An explicit choice is returned even when it does not exist, so that "not found"
   // messages show the folder the user pointed at instead of silently looking elsewhere.
-  if (!options.asset_root.empty()) return absolute_normal(options.asset_root).string();
+  if (!settings.asset_root.empty()) return absolute_normal(settings.asset_root).string();
   if (const char* env = std::getenv("RTPG_ASSET_ROOT"); env && *env)
     return absolute_normal(env).string();
   std::error_code ec;

@@ -110,10 +110,10 @@ nlohmann::json parse_file(const std::string& path) {
 // Everything one load needs; lives for the duration of load_scene.
 class SceneBuilder {
  public:
-  SceneBuilder(const std::string& path, const SceneLoadSettings& options, Scene& scene)
+  SceneBuilder(const std::string& path, const SceneLoadSettings& settings, Scene& scene)
       : path_(path),
         scene_(scene),
-        assets_(path, resolve_asset_root(path, options)),
+        assets_(path, resolve_asset_root(path, settings)),
         cache_(scene.textures) {}
 
   void build(const JsonNode& root) {
@@ -343,11 +343,11 @@ class SceneBuilder {
 
 }  // namespace
 
-Scene load_scene(const std::string& json_path, const SceneLoadSettings& options) {
+Scene load_scene(const std::string& json_path, const SceneLoadSettings& settings) {
   const nlohmann::json document = parse_file(json_path);
   Scene scene;
   scene.source_path = json_path;
-  SceneBuilder builder(json_path, options, scene);
+  SceneBuilder builder(json_path, settings, scene);
   builder.build(JsonNode(document, json_path, ""));
   return scene;
 }

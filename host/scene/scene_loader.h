@@ -15,9 +15,9 @@ struct SceneLoadSettings {
 };
 
 // Throws InputError naming the file (scene, mesh, texture, environment map) and the problem.
-Scene load_scene(const std::string& json_path, const SceneLoadSettings& options = {});
+Scene load_scene(const std::string& json_path, const SceneLoadSettings& settings = {});
 
-// The asset root load_scene would use with these options ("" when none exists).
-std::string resolve_asset_root(const std::string& json_path, const SceneLoadSettings& options);
+// The asset root load_scene would use with these settings ("" when none exists).
+std::string resolve_asset_root(const std::string& json_path, const SceneLoadSettings& settings);
 
 }  // namespace rtpg

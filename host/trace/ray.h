@@ -26,7 +26,8 @@ struct Hit {
 };
 
 // How a batch is handed to Embree. Packets of 8 pay off only for coherent rays (camera and
-// shadow rays towards one light); incoherent bounces are as fast one by one (DESIGN.md 7).
+// shadow rays towards one light); incoherent bounces are as fast one by one (docs/design.md,
+// "PoCL and OpenCL facts").
 enum class RayMode { Single, Packet8 };
 
 }  // namespace rtpg

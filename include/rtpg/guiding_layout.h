@@ -81,6 +81,7 @@
  * rng.h): these tags keep the consumers independent. */
 #define PG_RNG_STREAM_PATH 0u         /* the host path tracer */
 #define PG_RNG_STREAM_FIRST_BOUNCE 1u /* first-bounce sampling: sample kernel, BSDF sampler */
+#define PG_RNG_STREAM_CAMERA 2u       /* the camera ray's sub-pixel jitter */
 #define PG_RNG_STREAM_TRAIN 3u        /* the train kernel's walk through the neighbourhood */
 
 /* At most this many neighbour VPLs train a pixel per frame (the train kernel's array). */
@@ -105,15 +106,15 @@ typedef struct pg_kernel_settings {
   float roughness_skip;  /* no guiding where roughness is at or below this */
   float n_min;           /* N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2) */
   float n_max;
-  float max_weight;       /* training weights above this are treated as absurd input */
-  float reproject_depth;  /* relative position difference that rejects history */
-  float reproject_normal; /* cosine below which normals reject history */
-  float sigma_prior;      /* prior variance added as sigma_prior / (k + 1) */
-  float reseed_ratio;     /* a sample with a > reseed_ratio * W outside the lobe re-seeds */
-  float weight_clamp;     /* training weights are clamped to weight_clamp * W (0 = off) */
-  int em_passes;          /* E-step passes over a frame's samples (pg_pmm_train) */
-  int apron;              /* neighbourhood radius in pixels (window 2*apron+1 squared) */
-  int stride;             /* step through the window, coprime with its size */
+  float max_weight;         /* training weights above this are treated as absurd input */
+  float reproject_position; /* relative position difference that rejects history */
+  float reproject_normal;   /* cosine below which normals reject history */
+  float sigma_prior;        /* prior variance added as sigma_prior / (k + 1) */
+  float reseed_ratio;       /* a sample with a > reseed_ratio * W outside the lobe re-seeds */
+  float weight_clamp;       /* training weights are clamped to weight_clamp * W (0 = off) */
+  int em_passes;            /* E-step passes over a frame's samples (pg_pmm_train) */
+  int apron;                /* neighbourhood radius in pixels (window 2*apron+1 squared) */
+  int stride;               /* step through the window, coprime with its size */
 } pg_kernel_settings;
 
 #ifdef __cplusplus

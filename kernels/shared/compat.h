@@ -1,7 +1,8 @@
 /* The one place that knows whether shared math is compiled as OpenCL C 1.2 or as C++17.
  *
- * Everything under kernels/shared/ includes only this file (and each other), so the same
- * functions run in kernels and in host code and tests (as Cycles' compat.h and pbrt-v4's
+ * Everything under kernels/shared/ includes only this file, each other and the public layout
+ * header (include/rtpg/guiding_layout.h, plain C), so the same functions run in kernels and
+ * in host code and tests (as Cycles' compat.h and pbrt-v4's
  * PBRT_CPU_GPU do). Shared code follows these rules so that both languages accept it:
  *   - vectors are float2/float3/float4 built with pg_make_float*; no swizzles, no vector
  *     ternaries, no vector literals;

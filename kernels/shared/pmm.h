@@ -1,7 +1,8 @@
 /* The per-pixel parametric mixture model of the paper (eq. 2):
  *   D(w) = pi * N(M^-1(w); mu, Sigma) / (2 pi) + (1 - pi) * p_bsdf(w)
  * its density, its sampler, the online (stepwise) EM step that trains it from VPLs
- * (paper 3.2, DESIGN.md section 3) and the change of hemisphere frame used by reprojection.
+ * (paper 3.2; docs/design.md, "The guiding model") and the change of hemisphere frame used by
+ * reprojection.
  *
  * State, 8 floats per pixel (paper 3.1; buffers: include/rtpg/guiding_layout.h): running averages
  * of the EM sufficient statistics s0 = (W, S0, Sx, Sy)   W = E[a], S0 = E[a gamma], (Sx, Sy) = E[a
@@ -253,8 +254,8 @@ PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_kernel_setti
 /* One frame's training of one pixel from its n samples (x = weight a, y/z = square point u,
  * w = BSDF density), with `passes` E-step passes: each pass re-evaluates the responsibilities
  * under the model the previous pass's M-step would give, so a lobe that sits off its target
- * moves there within the frame instead of over many frames (DESIGN.md section 3 notes that a
- * single pass converges slowly). Only the last pass's statistics enter the state. */
+ * moves there within the frame instead of over many frames (a single pass converges slowly:
+ * docs/guiding.md, "Training"). Only the last pass's statistics enter the state. */
 PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples, int n,
                                 pg_kernel_settings p, float target_count, int passes,
                                 PG_PRIVATE int* updated) {

@@ -278,7 +278,7 @@ TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
   const rtpg::pg_kernel_settings k = rtpg::to_kernel_settings(s);
   EXPECT_EQ(k.k_max, 17.0f);
   EXPECT_EQ(k.apron, 3);
-  EXPECT_EQ(k.reproject_depth, s.reproject_position);
+  EXPECT_EQ(k.reproject_position, s.reproject_position);
   // The window walk's stride visits all 49 cells of a 7x7 window: coprime with 49.
   EXPECT_GT(k.stride, 0);
   EXPECT_NE(k.stride % 7, 0);

@@ -208,7 +208,7 @@ std::vector<float> host_reproject(const std::vector<float>& prev_state, const Ho
       const float3 m = sh::pg_float4_xyz(prev.shading_normal[j]);
       const bool same =
           sh::pg_same_surface(cur.position_depth[i], n, cur.material[i], prev.position_depth[j], m,
-                              prev.material[j], p.reproject_depth, p.reproject_normal);
+                              prev.material[j], p.reproject_position, p.reproject_normal);
       outcome[i] = kRejected;
       if (!same) continue;
       sh::pg_pmm_state s = state_at(prev_state, j);
