@@ -39,7 +39,8 @@ class FirstBounceSampler {
   // Before the frame's first sample(): the G-buffer of the frame is final (guiding
   // reprojects its state here).
   virtual void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) {}
-  // After the frame's first path-tracing pass, with its VPLs (guiding trains here).
+  // After the frame's last sample, with the VPLs of its first path-tracing pass (guiding
+  // trains here; every sample of a frame uses the model begin_frame made).
   virtual void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls,
                          const SampleCoordinates& at) {}
   virtual bool wants_vpls() const { return false; }

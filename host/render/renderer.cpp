@@ -162,15 +162,17 @@ FrameStats Renderer::render_frame(int index) {
     const bool keep_vpls = s == 0 && sampler_->wants_vpls();
     path_tracer_->trace(gbuffer_, first_, *sampler_, at, pass_, keep_vpls ? &vpls_ : nullptr,
                         stats.nonfinite_samples, rays, times);
-    if (keep_vpls) {
-      t = Clock::now();
-      sampler_->end_frame(gbuffer_, vpls_, frame_at);
-      stats.time_ms["guiding_end"] = ms_since(t);
-    }
     t = Clock::now();
     const float weight = 1.0f / static_cast<float>(settings_.spp);
     for (std::size_t i = 0; i < n; ++i) image_[i] += pass_[i] * weight;
     stats.time_ms["accumulate"] += ms_since(t);
+  }
+  // Training changes the model, so it waits for the frame's last sample: every sample of the
+  // frame is drawn from one model, the one next-event MIS at the primary hit weighs against.
+  if (sampler_->wants_vpls()) {
+    t = Clock::now();
+    sampler_->end_frame(gbuffer_, vpls_, frame_at);
+    stats.time_ms["guiding_end"] = ms_since(t);
   }
   stats.time_ms["trace"] = times.trace_ms;
   stats.time_ms["shade"] = times.shade_ms;

@@ -30,9 +30,19 @@ struct TileSeries {
   std::vector<double> whole;                  // [frame]
 };
 
-TileSeries run(const Scene& scene, bool guided, int size, int frames, ClRuntime& cl) {
+// How a run is rendered beyond the method: samples per pixel per frame and a camera path
+// (empty: the scene's static camera).
+struct RunShape {
+  int spp = 1;
+  std::string camera_path;
+};
+
+TileSeries run(const Scene& scene, bool guided, int size, int frames, ClRuntime& cl,
+               const RunShape& shape) {
   RenderSettings settings;
   settings.width = settings.height = size;
+  settings.spp = shape.spp;
+  settings.camera_path = shape.camera_path;
   settings.jitter = false;  // both methods estimate the same integral per pixel
   settings.seed = guided ? 11u : 12u;
   settings.path_tracer.max_bounces = scene.max_bounces > 0 ? scene.max_bounces : 8;
@@ -84,12 +94,12 @@ double z_bound(int m) {
   return hi;
 }
 
-void expect_same_means(const char* name, int frames) {
+void expect_same_means(const char* name, int frames, const RunShape& shape = {}) {
   const Scene scene = load_scene(scene_file(name));
   ClRuntime cl;
   const int size = 64;
-  const TileSeries pt = run(scene, false, size, frames, cl);
-  const TileSeries pg = run(scene, true, size, frames, cl);
+  const TileSeries pt = run(scene, false, size, frames, cl, shape);
+  const TileSeries pg = run(scene, true, size, frames, cl, shape);
   const int comparisons = static_cast<int>(pt.per_tile.size()) + 1;
   const double z = z_bound(comparisons);
   auto check = [&](const std::vector<double>& a, const std::vector<double>& b,
@@ -113,6 +123,18 @@ TEST(GuidingImage, UnbiasedOnCornellBox) {
 
 TEST(GuidingImage, UnbiasedOnCornellIndirect) {
   expect_same_means("cornell-indirect.json", 160);
+}
+
+// Several samples per frame: every sample of a frame is drawn from one model and next-event
+// MIS weighs against that same model (training waits for the frame's last sample).
+TEST(GuidingImage, UnbiasedAtFourSppOnCornellBox) {
+  expect_same_means("cornell-box.json", 80, RunShape{4, ""});
+}
+
+// A moving camera: every frame reprojects the state before sampling. Both methods render the
+// same camera at the same frame index, so their means over the frames agree.
+TEST(GuidingImage, UnbiasedAlongCameraPathAtTwoSpp) {
+  expect_same_means("cornell-box.json", 120, RunShape{2, "pan"});
 }
 
 // The acceptance figure of the guiding issue: cornell-indirect, 128x128, fixed seed, 32 frames at

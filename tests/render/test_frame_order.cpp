@@ -1,0 +1,64 @@
+// The order in which the renderer drives a first-bounce sampler within a frame. Training
+// changes the model, so it must come after the frame's last sample: samples drawn after it
+// would use a model other than the one next-event MIS at the primary hit evaluates (a bias at
+// more than one sample per pixel, invisible at one).
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/first_bounce.h"
+#include "render/renderer.h"
+#include "render/vpl_buffer.h"
+#include "scene/scene_loader.h"
+
+namespace rtpg {
+namespace {
+
+// BSDF sampling that records every call it receives.
+class RecordingSampler final : public FirstBounceSampler {
+ public:
+  explicit RecordingSampler(std::vector<std::string>& log) : log_(log) {}
+  void begin_frame(const GBuffer&, const SampleCoordinates& at) override {
+    log_.push_back("begin " + std::to_string(at.frame));
+  }
+  void end_frame(const GBuffer&, const VplBuffer& vpls, const SampleCoordinates& at) override {
+    std::size_t valid = 0;
+    for (std::uint32_t info : vpls.info) valid += (info & PG_VPL_VALID) != 0u;
+    log_.push_back("end " + std::to_string(at.frame) + (valid > 0 ? " with vpls" : " no vpls"));
+  }
+  bool wants_vpls() const override { return true; }
+  void sample(const GBuffer& g, const SampleCoordinates& at,
+              std::vector<FirstBounceSample>& out) override {
+    log_.push_back("sample " + std::to_string(at.frame) + "." + std::to_string(at.sample));
+    bsdf_.sample(g, at, out);
+  }
+  float pdf(const GBuffer& g, std::size_t i, const glm::vec3& wi) const override {
+    return bsdf_.pdf(g, i, wi);
+  }
+
+ private:
+  std::vector<std::string>& log_;
+  BsdfFirstBounce bsdf_;
+};
+
+TEST(FrameOrder, TrainingFollowsTheFramesLastSample) {
+  const Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
+  RenderSettings settings;
+  settings.width = 23;
+  settings.height = 17;
+  settings.spp = 3;
+  Renderer renderer(scene, settings);
+  std::vector<std::string> log;
+  renderer.set_first_bounce_sampler(std::make_unique<RecordingSampler>(log));
+  renderer.render_frame(0);
+  renderer.render_frame(1);
+  const std::vector<std::string> expected = {
+      "begin 0", "sample 0.0", "sample 0.1", "sample 0.2", "end 0 with vpls",
+      "begin 1", "sample 1.0", "sample 1.1", "sample 1.2", "end 1 with vpls"};
+  EXPECT_EQ(log, expected);
+}
+
+}  // namespace
+}  // namespace rtpg
