@@ -457,7 +457,8 @@ void tbb_train(const Inputs& in, const pg_kernel_settings& params, std::uint32_t
         const std::uint32_t f = in.cur.flags[i];
         const float4 bcr = in.cur.base_color_roughness[i];
         std::uint8_t changed = 0;
-        if (sh::pg_guiding_applies(f, bcr.w, params)) {
+        if (sh::pg_guiding_applies(f, bcr.w, params) &&
+            sh::pg_train_this_frame(s1.w, x, y, frame, params)) {
           sh::pg_pmm_state st;
           st.s0 = s0;
           st.s1 = s1;
@@ -481,7 +482,7 @@ void tbb_train(const Inputs& in, const pg_kernel_settings& params, std::uint32_t
             if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
             const int j = sy * w + sx;
             kept += sh::pg_train_sample_from_vpl(px, in.vpls.position[j], in.vpls.normal[j],
-                                                 in.vpls.radiance_info[j], &samples[kept]);
+                                                 in.vpls.radiance_info[j], params, &samples[kept]);
           }
           int updated = 0;
           st = sh::pg_pmm_train(st, samples, kept, params, static_cast<float>(n), params.em_passes,

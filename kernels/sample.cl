@@ -1,7 +1,7 @@
 /* The first-bounce direction of every surface pixel from its mixture (paper eq. 2, 3.1):
  * the Gaussian with probability pi, else the BSDF; skipped pixels and pixels without a model
- * sample the BSDF. Writes the world direction with the mixture density (one-sample MIS) and
- * the strategy that produced it. */
+ * sample the BSDF. Writes the world direction with the mixture density (one-sample MIS), the
+ * strategy that produced it, and the mixture itself (for the host's MIS weights). */
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
 #include "shared/pmm.h"
@@ -16,6 +16,8 @@ __kernel void sample(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint width
   if ((f & PG_GBUF_SKY) != 0u) {
     direction_pdf[i] = (float4)(0.0f, 0.0f, 1.0f, 0.0f);
     strategy[i] = PG_STRATEGY_NONE;
+    mixture_a[i] = (float4)(0.0f);
+    mixture_b[i] = (float2)(0.0f);
     return;
   }
   float4 bcr = base_color_roughness[i];
@@ -36,4 +38,6 @@ __kernel void sample(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint width
   float3 w = pg_to_world(frame_x, s.wi);
   direction_pdf[i] = (float4)(w.x, w.y, w.z, s.pdf);
   strategy[i] = s.strategy;
+  mixture_a[i] = pg_pmm_mixture_a(model);
+  mixture_b[i] = pg_pmm_mixture_b(model);
 }

@@ -43,7 +43,7 @@ __kernel void train(
   uint f = flags[i];
   float4 bcr = base_color_roughness[i];
   uchar changed = 0;
-  if (pg_guiding_applies(f, bcr.w, settings)) {
+  if (pg_guiding_applies(f, bcr.w, settings) && pg_train_this_frame(s1.w, x, y, frame, settings)) {
     pg_pmm_state state;
     state.s0 = s0;
     state.s1 = s1;
@@ -64,13 +64,13 @@ __kernel void train(
 #if PG_TRAIN_LOCAL_TILE
       int t = ((int)get_local_id(1) + apron + dy) * tw + (int)get_local_id(0) + apron + dx;
       kept += pg_train_sample_from_vpl(px, tile_position[t], tile_normal[t], tile_radiance[t],
-                                       &samples[kept]);
+                                       settings, &samples[kept]);
 #else
       int sx = x + dx, sy = y + dy;
       if (sx < 0 || sy < 0 || sx >= (int)width || sy >= (int)height) continue;
       int j = sy * (int)width + sx;
       kept += pg_train_sample_from_vpl(px, vpl_position[j], vpl_normal[j], vpl_radiance_info[j],
-                                       &samples[kept]);
+                                       settings, &samples[kept]);
 #endif
     }
     int updated = 0;

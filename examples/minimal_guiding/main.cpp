@@ -109,7 +109,8 @@ double run(rtpg::ClRuntime& rt, int size, int frames, bool guided) {
   rtpg::enqueue_upload(rt.queue(), g, gbuffer);
   rt.queue().finish();
 
-  HostSamples s{std::vector<host::float4>(n), std::vector<host::uint>(n)};
+  HostSamples s{std::vector<host::float4>(n), std::vector<host::uint>(n),
+                std::vector<host::float4>(n), std::vector<host::float2>(n)};
   HostVpls v{std::vector<host::float4>(n), std::vector<host::float4>(n),
              std::vector<host::float4>(n)};
   double error_sum = 0.0;

@@ -8,8 +8,8 @@
 namespace rtpg {
 namespace {
 
-static_assert(sizeof(pg_kernel_settings) == 19 * 4,
-              "pg_kernel_settings: 19 plain 4-byte fields, no padding");
+static_assert(sizeof(pg_kernel_settings) == 21 * 4,
+              "pg_kernel_settings: 21 plain 4-byte fields, no padding");
 static_assert(sizeof(shared::pg_pmm_state) == 4 * PG_STATE_FLOATS_PER_PIXEL,
               "the state's floats per pixel");
 
@@ -173,8 +173,9 @@ void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previo
 void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint32_t frame,
                     std::uint32_t sample_index, const GuiderSamples& out) {
   check_gbuffer(current, "current");
-  check_buffer(out.direction_pdf, 16, "samples.direction_pdf");
-  check_buffer(out.strategy, 4, "samples.strategy");
+#define RTPG_CHECK(name, type, bytes) check_buffer(out.name, bytes, "samples." #name);
+  PG_SAMPLE_CHANNELS(RTPG_CHECK)
+#undef RTPG_CHECK
   const State& state = state_[current_];
   translate_cl_errors([&] {
     KernelArgs(sample_) << current << state.state0 << state.state1 << out

@@ -30,18 +30,39 @@ GuidingDistribution::GuidingDistribution(const pg_kernel_settings& settings) : s
   RTPG_PIXEL(pixel_).model.valid = 0;
 }
 
+namespace {
+
+sh::float4 load4(const float* v) {
+  return sh::float4(v[0], v[1], v[2], v[3]);
+}
+
+// Frame, view direction and lobes of a pixel from its G-buffer entries.
+void init_surface(Pixel& px, const float* shading_normal, const float* view_dir,
+                  const sh::float4& bcr, const float* metallic_specular) {
+  px.frame =
+      sh::pg_frame_from_normal(sh::float3(shading_normal[0], shading_normal[1], shading_normal[2]));
+  px.wo = sh::pg_to_local(px.frame, sh::float3(view_dir[0], view_dir[1], view_dir[2]));
+  px.lobes = sh::pg_make_lobes(sh::pg_material_from_gbuffer(bcr, load4(metallic_specular)), px.wo);
+}
+
+}  // namespace
+
+void GuidingDistribution::init_mixture(const float* mixture_a, const float* mixture_b,
+                                       const float* shading_normal, const float* view_dir,
+                                       const float* base_color_roughness,
+                                       const float* metallic_specular) {
+  Pixel& px = RTPG_PIXEL(pixel_);
+  init_surface(px, shading_normal, view_dir, load4(base_color_roughness), metallic_specular);
+  px.model =
+      sh::pg_pmm_model_from_mixture(load4(mixture_a), sh::float2(mixture_b[0], mixture_b[1]));
+}
+
 void GuidingDistribution::init(const float* state, const float* shading_normal,
                                const float* view_dir, const float* base_color_roughness,
                                const float* metallic_specular, std::uint32_t flags) {
   Pixel& px = RTPG_PIXEL(pixel_);
-  px.frame =
-      sh::pg_frame_from_normal(sh::float3(shading_normal[0], shading_normal[1], shading_normal[2]));
-  px.wo = sh::pg_to_local(px.frame, sh::float3(view_dir[0], view_dir[1], view_dir[2]));
-  const sh::float4 bcr(base_color_roughness[0], base_color_roughness[1], base_color_roughness[2],
-                       base_color_roughness[3]);
-  const sh::float4 ms(metallic_specular[0], metallic_specular[1], metallic_specular[2],
-                      metallic_specular[3]);
-  px.lobes = sh::pg_make_lobes(sh::pg_material_from_gbuffer(bcr, ms), px.wo);
+  const sh::float4 bcr = load4(base_color_roughness);
+  init_surface(px, shading_normal, view_dir, bcr, metallic_specular);
   sh::pg_pmm_state st = sh::pg_pmm_initial_state();
   if (sh::pg_guiding_applies(flags, bcr.w, settings_)) {
     st.s0 = sh::float4(state[0], state[1], state[2], state[3]);

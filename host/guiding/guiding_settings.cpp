@@ -72,6 +72,10 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
            "Position change, relative to the depth, that rejects history"),
       real("reproject_normal", &S::reproject_normal, -1, 1, false, false,
            "Normal cosine below which history is rejected"),
+      integer("train_interval", &S::train_interval, 1, 64,
+              "A mature pixel (k >= k_max/4) trains every this many frames"),
+      integer("train_all_samples", &S::train_all_samples, 0, 1,
+              "1: train on every VPL at its mixture density; 0: BSDF samples only"),
       integer("local_x", &S::local_x, 1, 65536, "Work-group (VPL tile) width"),
       integer("local_y", &S::local_y, 1, 65536, "Work-group (VPL tile) height"),
   };
@@ -157,6 +161,8 @@ pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {
   p.em_passes = c.em_passes;
   p.apron = c.apron;
   p.stride = window_stride(c.apron);
+  p.train_interval = c.train_interval;
+  p.train_all_samples = c.train_all_samples;
   return p;
 }
 

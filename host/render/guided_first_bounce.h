@@ -46,8 +46,11 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   struct HostSamples {  // PG_SAMPLE_CHANNELS on the host
     std::vector<glm::vec4> direction_pdf;
     std::vector<std::uint32_t> strategy;
+    std::vector<glm::vec4> mixture_a;  // what pdf() evaluates
+    std::vector<glm::vec2> mixture_b;
   } host_samples_;
-  std::vector<float> state_;  // after reprojection: what sample() and pdf() use
+  std::size_t pixels_ = 0, surfaces_ = 0;
+  std::size_t bytes_ = 0;  // copied between host and device this frame
   double upload_ms_ = 0.0, readback_ms_ = 0.0, sample_ms_ = 0.0;
   double guided_fraction_ = 0.0, trained_fraction_ = 0.0, mean_pi_ = 0.0;
 };

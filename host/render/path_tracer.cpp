@@ -155,10 +155,12 @@ void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSamp
             const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
             p.throughput = f / fs.pdf;
             if (vpls) {
-              // The VPL keeps the density of the strategy that made it: trained samples are BSDF
-              // samples, distributed by the BSDF alone (paper 3.2). Area measure comes later.
+              // The VPL keeps the density of the strategy that made it (BSDF samples are
+              // distributed by the BSDF alone: paper 3.2) and the whole sampler's density D
+              // (include/rtpg/guiding_layout.h). Area measure comes later.
               const float bsdf_pdf = shared::pg_bsdf_pdf(lobes, wo, wi);
               vpls->position[i].w = fs.strategy == kStrategyBsdf ? bsdf_pdf : fs.pdf;
+              vpls->normal[i].w = fs.pdf;
               vpls->info[i] = fs.strategy << PG_VPL_STRATEGY_SHIFT;
             }
             if (!is_black(p.throughput) && is_finite(p.throughput)) {
@@ -224,7 +226,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls) {
         const float d2 = glm::dot(to, to);
         const float cos_y = std::fabs(glm::dot(sp.geometric_normal, dir));
         vpls->position[i] = glm::vec4(sp.position, vpls->position[i].w * cos_y / d2);
-        vpls->normal[i] = glm::vec4(sp.geometric_normal, 0.0f);
+        vpls->normal[i] = glm::vec4(sp.geometric_normal, vpls->normal[i].w * cos_y / d2);
         vpls->info[i] |= PG_VPL_VALID;
       }
       if (depth == settings_.max_bounces) continue;

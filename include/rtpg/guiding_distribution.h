@@ -2,7 +2,8 @@
 // in Shirley-Chiu square space, weight pi, plus the BSDF) exactly as the sample kernel draws
 // from it. A CPU renderer needs its density for the MIS weight of next-event estimation at
 // the guided vertex, and may sample it without a device. Built from a pixel's state
-// (Guider::read_state) and its G-buffer entries (include/rtpg/guiding_layout.h).
+// (Guider::read_state) or the mixture the sample kernel wrote, and its G-buffer entries
+// (include/rtpg/guiding_layout.h).
 //
 // A value type without allocation: make one per thread and init() it per pixel.
 #pragma once
@@ -29,6 +30,13 @@ class GuidingDistribution {
   // trained model gets the BSDF alone.
   void init(const float* state, const float* shading_normal, const float* view_dir,
             const float* base_color_roughness, const float* metallic_specular, std::uint32_t flags);
+
+  // The same from the mixture the sample kernel wrote for the pixel (mixture_a, mixture_b of
+  // include/rtpg/guiding_layout.h): no state read-back, no regularisation on the host. The
+  // kernel has already applied pg_guiding_applies (a skipped pixel's mixture is zero).
+  void init_mixture(const float* mixture_a, const float* mixture_b, const float* shading_normal,
+                    const float* view_dir, const float* base_color_roughness,
+                    const float* metallic_specular);
 
   bool guided() const;          // a trained Gaussian takes part
   float mixing_weight() const;  // its pi (0 when not guided)

@@ -38,10 +38,13 @@
 
 /* ---- VPLs: the first-bounce hit y of every pixel's path, the trainer's input -------------
  * (paper, section 3.1: the texture Pi)
- * position       xyz hit point y (or the unit direction of an escaped ray); w the density
- *                that generated y, in area measure at y (solid angle for an escaped ray), so
- *                that a neighbouring pixel can convert it to its own solid angle
- * normal         xyz geometric normal at y (facing the pixel's point), w 0
+ * position       xyz hit point y (or the unit direction of an escaped ray); w the density of
+ *                the strategy that generated y (the BSDF's for a BSDF sample, else D), in
+ *                area measure at y (solid angle for an escaped ray), so that a neighbouring
+ *                pixel can convert it to its own solid angle
+ * normal         xyz geometric normal at y (facing the pixel's point), w the full mixture
+ *                density D of the direction (whatever the strategy), in area measure at y
+ *                (solid angle for an escaped ray)
  * radiance_info  rgb radiance leaving y towards the pixel's point; w the info word as a float
  *                (exact: small integers): PG_VPL_* bits, the strategy in bits 8..15 */
 #define PG_VPL_CHANNELS(X) \
@@ -57,10 +60,18 @@
 /* ---- Samples: what the sample kernel writes ---------------------------------------------
  * direction_pdf  xyz unit world direction of the first bounce, w the mixture's density in
  *                solid angle (0 = no sample)
- * strategy       PG_STRATEGY_* that produced it */
+ * strategy       PG_STRATEGY_* that produced it
+ * mixture_a      the mixture the pixel sampled, in the form the density needs (paper eq. 2):
+ *                x pi, yz the Gaussian's mean in the square, w the Cholesky factor's l11
+ *                (0: no Gaussian, the pixel samples its BSDF alone)
+ * mixture_b      x l21, y l22: the rest of the Cholesky factor of Sigma
+ * With the mixture a host renderer evaluates the density for its MIS weights
+ * (include/rtpg/guiding_distribution.h) without the state or its regularisation. */
 #define PG_SAMPLE_CHANNELS(X)  \
   X(direction_pdf, float4, 16) \
-  X(strategy, uint, 4)
+  X(strategy, uint, 4)         \
+  X(mixture_a, float4, 16)     \
+  X(mixture_b, float2, 8)
 
 #define PG_STRATEGY_NONE 0u  /* no surface, or no sample */
 #define PG_STRATEGY_BSDF 1u  /* the BSDF component: the only samples that train (paper 3.2) */
@@ -115,6 +126,9 @@ typedef struct pg_kernel_settings {
   int em_passes;            /* E-step passes over a frame's samples (pg_pmm_train) */
   int apron;                /* neighbourhood radius in pixels (window 2*apron+1 squared) */
   int stride;               /* step through the window, coprime with its size */
+  int train_interval;    /* a mature pixel (k >= k_max / 4) trains every train_interval-th frame */
+  int train_all_samples; /* 1: train on every VPL at its full mixture density (normal.w);
+                            0: BSDF-strategy VPLs only (paper 3.2) */
 } pg_kernel_settings;
 
 #ifdef __cplusplus

@@ -85,6 +85,28 @@ PG_FN pg_pmm_model pg_pmm_model_from_state(pg_pmm_state s, pg_kernel_settings p)
   return m;
 }
 
+/* The model as the sample kernel hands it to the host (mixture_a, mixture_b of
+ * include/rtpg/guiding_layout.h) and back: an invalid model is all zeros. */
+PG_FN float4 pg_pmm_mixture_a(pg_pmm_model m) {
+  return m.valid ? pg_make_float4(m.pi, m.mx, m.my, m.l11) : pg_make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+}
+
+PG_FN float2 pg_pmm_mixture_b(pg_pmm_model m) {
+  return m.valid ? pg_make_float2(m.l21, m.l22) : pg_make_float2(0.0f, 0.0f);
+}
+
+PG_FN pg_pmm_model pg_pmm_model_from_mixture(float4 a, float2 b) {
+  pg_pmm_model m;
+  m.valid = a.w > 0.0f && b.y > 0.0f;
+  m.pi = a.x;
+  m.mx = a.y;
+  m.my = a.z;
+  m.l11 = a.w;
+  m.l21 = b.x;
+  m.l22 = b.y;
+  return m;
+}
+
 /* Squared Mahalanobis distance of u from the Gaussian's mean. */
 PG_FN float pg_pmm_mahalanobis2(pg_pmm_model m, float2 u) {
   float z1 = (u.x - m.mx) / m.l11;

@@ -24,16 +24,21 @@ typedef struct {
 
 /* One VPL (position_pdf, normal, radiance with the info bits in w) as a training sample of
  * this pixel: x = weight a = lum(L f_r cos) / r, (y, z) = square point, w = BSDF density.
- * Returns 0 when the VPL says nothing about this pixel's hemisphere. */
+ * Returns 0 when the VPL says nothing about this pixel's hemisphere. With train_all_samples
+ * every VPL counts at the density its pixel really sampled with (the whole mixture D, in
+ * normal.w); otherwise BSDF-strategy VPLs only, at the BSDF's density (paper 3.2). */
 PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float4 normal,
-                                   float4 radiance_info, PG_PRIVATE float4* sample) {
+                                   float4 radiance_info, pg_kernel_settings p,
+                                   PG_PRIVATE float4* sample) {
   uint info = (uint)radiance_info.w;
-  if ((info & PG_VPL_VALID) == 0u || PG_VPL_STRATEGY(info) != PG_STRATEGY_BSDF) return 0;
+  if ((info & PG_VPL_VALID) == 0u) return 0;
+  if (!p.train_all_samples && PG_VPL_STRATEGY(info) != PG_STRATEGY_BSDF) return 0;
+  float density = p.train_all_samples ? normal.w : position_pdf.w;
   float3 w;
   float r; /* density of w as seen from this pixel */
   if ((info & PG_VPL_DISTANT) != 0u) {
     w = pg_float4_xyz(position_pdf);
-    r = position_pdf.w;
+    r = density;
   } else {
     float3 to = pg_float4_xyz(position_pdf) - px.x;
     float d2 = dot(to, to);
@@ -42,7 +47,7 @@ PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float
     /* The VPL's density is in area measure at y: to this pixel's solid angle. */
     float cos_y = -dot(pg_float4_xyz(normal), w);
     if (cos_y <= 1e-4f) return 0; /* y faces away from x */
-    r = position_pdf.w * d2 / cos_y;
+    r = density * d2 / cos_y;
   }
   if (!(r > 0.0f) || !isfinite(r)) return 0;
   float3 wl = pg_to_local(px.frame, w);
@@ -57,6 +62,14 @@ PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float
   float2 u = pg_hemisphere_to_square(wl);
   *sample = pg_make_float4(a, u.x, u.y, pg_bsdf_pdf(px.lobes, px.wo, wl));
   return 1;
+}
+
+/* Amortised training (docs/guiding.md, "Cost"): a mature pixel's lobe (k at least a quarter
+ * of k_max, where the step size is small) trains on every train_interval-th frame only, in a
+ * pattern that rotates over the image; the other frames keep its state. */
+PG_FN int pg_train_this_frame(float k, int x, int y, uint frame, pg_kernel_settings p) {
+  if (p.train_interval <= 1 || k < 0.25f * p.k_max) return 1;
+  return ((uint)x + 3u * (uint)y + frame) % (uint)p.train_interval == 0u;
 }
 
 /* The window offset of the s-th neighbour of this frame's walk through the window. */

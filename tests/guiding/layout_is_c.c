@@ -8,12 +8,13 @@
 
 int main(void) {
   int failed = 0;
-  if (sizeof(pg_kernel_settings) != 19 * 4) {
-    printf("pg_kernel_settings: %u bytes, expected 76\n", (unsigned)sizeof(pg_kernel_settings));
+  if (sizeof(pg_kernel_settings) != 21 * 4) {
+    printf("pg_kernel_settings: %u bytes, expected 84\n", (unsigned)sizeof(pg_kernel_settings));
     failed = 1;
   }
   if (0 PG_GBUFFER_CHANNELS(PG_SUM_BYTES) != 5 * 16 + 4 + 4 + 8 ||
-      0 PG_VPL_CHANNELS(PG_SUM_BYTES) != 3 * 16 || 0 PG_SAMPLE_CHANNELS(PG_SUM_BYTES) != 20 ||
+      0 PG_VPL_CHANNELS(PG_SUM_BYTES) != 3 * 16 ||
+      0 PG_SAMPLE_CHANNELS(PG_SUM_BYTES) != 16 + 4 + 16 + 8 ||
       0 PG_STATE_CHANNELS(PG_SUM_BYTES) != 4 * PG_STATE_FLOATS_PER_PIXEL) {
     printf("channel bytes differ from the documented layout\n");
     failed = 1;

@@ -131,15 +131,14 @@ TEST(GuiderApi, CreateResetReprojectSampleTrainAndStateRoundTrip) {
   // Sampling: sky pixels produce nothing; surface pixels a unit direction above the floor with a
   // positive pdf (or pdf 0 for a Gaussian sample that left the square), by the Gaussian with
   // probability pi = 0.6 (binomial: 5 standard deviations).
-  cl::Buffer dir(rt.context(), CL_MEM_READ_WRITE, n * 16);
-  cl::Buffer strategy(rt.context(), CL_MEM_READ_WRITE, n * 4);
+  const rtpg::GuiderSamples samples = rtpg::make_guider_samples(rt.context(), w, h);
   std::size_t guided = 0, surface = 0;
   for (std::uint32_t frame = 0; frame < 4; ++frame) {
-    guider.sample(g, 42u, frame, 0u, {dir, strategy});
+    guider.sample(g, 42u, frame, 0u, samples);
     std::vector<float> d(4 * n);
     std::vector<std::uint32_t> st(n);
-    rt.queue().enqueueReadBuffer(dir, CL_TRUE, 0, n * 16, d.data());
-    rt.queue().enqueueReadBuffer(strategy, CL_TRUE, 0, n * 4, st.data());
+    rt.queue().enqueueReadBuffer(samples.direction_pdf, CL_TRUE, 0, n * 16, d.data());
+    rt.queue().enqueueReadBuffer(samples.strategy, CL_TRUE, 0, n * 4, st.data());
     for (std::size_t i = 0; i < n; ++i) {
       if (i < static_cast<std::size_t>(w)) {
         EXPECT_EQ(st[i], kNone);
@@ -244,7 +243,7 @@ TEST(GuiderApi, HostDistributionHasTheSampleKernelsDensity) {
 TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
   EXPECT_NO_THROW(rtpg::validate(rtpg::GuidingSettings{}));
   const auto& table = rtpg::guiding_settings_table();
-  EXPECT_EQ(table.size(), 20u);
+  EXPECT_EQ(table.size(), 22u);
   for (const rtpg::GuidingSettingInfo& row : table) {
     ASSERT_TRUE((row.float_field != nullptr) != (row.int_field != nullptr)) << row.name;
     EXPECT_TRUE(row.in_range(row.get(rtpg::GuidingSettings{}))) << row.name;

@@ -153,8 +153,8 @@ HostGBuffer random_gbuffer(Random& r, int w, int h) {
 }
 
 // VPLs above the floor: invalid ones, distant ones (a direction and a solid-angle density),
-// ones produced by the guide strategy (which must not train), facing away, zero density,
-// zero and very bright radiance.
+// ones produced by the guide strategy (which train only with train_all_samples), facing away,
+// zero density, zero and very bright radiance; the mixture density in normal.w.
 HostVpls random_vpls(Random& r, std::size_t n) {
   HostVpls v;
   for (std::size_t i = 0; i < n; ++i) {
@@ -173,7 +173,10 @@ HostVpls random_vpls(Random& r, std::size_t n) {
           float4(r.uniform(-1.0f, 3.0f), r.uniform(-1.0f, 3.0f), r.uniform(0.3f, 2.0f), pdf));
     }
     const float3 nrm = r.uniform() < 0.8f ? r.tilt(float3(0, 0, -1), 0.0f, 80.0f) : r.unit();
-    v.normal.push_back(float4(nrm.x, nrm.y, nrm.z, 0.0f));
+    const float mixture_pdf = strategy == PG_STRATEGY_GUIDE
+                                  ? v.position.back().w
+                                  : v.position.back().w * r.uniform(0.5f, 2.0f);
+    v.normal.push_back(float4(nrm.x, nrm.y, nrm.z, mixture_pdf));
     const float l = r.uniform();
     const float scale = l < 0.1f ? 0.0f : (l < 0.15f ? 1000.0f : 5.0f);
     v.radiance_info.push_back(float4(scale * r.uniform(), scale * r.uniform(), scale * r.uniform(),
@@ -307,8 +310,10 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
     for (int x = 0; x < w; ++x) {
       const int i = y * w + x;
       const float4 bcr = g.base_color_roughness[i];
-      if (!sh::pg_guiding_applies(g.flags[i], bcr.w, p)) continue;
       sh::pg_pmm_state s = state_at(state, i);
+      if (!sh::pg_guiding_applies(g.flags[i], bcr.w, p) ||
+          !sh::pg_train_this_frame(s.s1.w, x, y, frame, p))
+        continue;
       sh::pg_train_pixel px;
       px.x = sh::pg_float4_xyz(g.position_depth[i]);
       px.frame = sh::pg_frame_from_normal(sh::pg_float4_xyz(g.shading_normal[i]));
@@ -329,7 +334,7 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
         const int sx = x + c % side - p.apron, sy = y + c / side - p.apron;
         if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
         const int j = sy * w + sx;
-        kept += sh::pg_train_sample_from_vpl(px, v.position[j], v.normal[j], v.radiance_info[j],
+        kept += sh::pg_train_sample_from_vpl(px, v.position[j], v.normal[j], v.radiance_info[j], p,
                                              &samples[kept]);
       }
       int updated = 0;
@@ -517,16 +522,18 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
     const GuiderGBuffer dg = upload(rt, g);
     const std::vector<float> state = random_states(r, g.n(), p.k_max, false);
     guider.write_state(state);
-    cl::Buffer dir(rt.context(), CL_MEM_READ_WRITE, g.n() * 16);
-    cl::Buffer strat(rt.context(), CL_MEM_READ_WRITE, g.n() * 4);
+    const GuiderSamples samples = make_guider_samples(rt.context(), kc.width, kc.height);
     for (std::uint32_t frame = 0; frame < 3; ++frame) {
       const std::uint32_t seed = 7u + frame * 13u;
-      guider.sample(dg, seed, frame, frame % 2u, {dir, strat});
-      std::vector<float4> got_dir(g.n()), want_dir;
+      guider.sample(dg, seed, frame, frame % 2u, samples);
+      std::vector<float4> got_dir(g.n()), want_dir, got_mixture_a(g.n());
+      std::vector<float2> got_mixture_b(g.n());
       std::vector<std::uint32_t> got_strategy(g.n()), want_strategy;
       std::vector<PixelMixture> mixture;
-      rt.queue().enqueueReadBuffer(dir, CL_TRUE, 0, g.n() * 16, got_dir.data());
-      rt.queue().enqueueReadBuffer(strat, CL_TRUE, 0, g.n() * 4, got_strategy.data());
+      rt.queue().enqueueReadBuffer(samples.direction_pdf, CL_TRUE, 0, g.n() * 16, got_dir.data());
+      rt.queue().enqueueReadBuffer(samples.strategy, CL_TRUE, 0, g.n() * 4, got_strategy.data());
+      rt.queue().enqueueReadBuffer(samples.mixture_a, CL_TRUE, 0, g.n() * 16, got_mixture_a.data());
+      rt.queue().enqueueReadBuffer(samples.mixture_b, CL_TRUE, 0, g.n() * 8, got_mixture_b.data());
       host_sample(state, g, seed, frame, frame % 2u, p, want_dir, want_strategy, mixture);
       for (std::size_t i = 0; i < g.n(); ++i) {
         const float4 a = want_dir[i], b = got_dir[i];
@@ -542,14 +549,22 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
         const double ggx = ggx_relative_error(mixture[i], local);
         const double pdf_tolerance = (1e-4 + ggx) * reference + 2.0 * spread;
         ill_conditioned += 2.0 * spread > 1e-3 * reference || ggx > 1e-3;
+        // The mixture the kernel hands to the host gives, evaluated on the host, the density
+        // the kernel sampled with (within the float allowance above): what next-event MIS at
+        // the primary hit needs.
+        PixelMixture handed = mixture[i];
+        handed.model = sh::pg_pmm_model_from_mixture(got_mixture_a[i], got_mixture_b[i]);
+        const float host_side = handed.pdf(local);
         const bool ok = std::fabs(b.x - a.x) <= 1e-4f && std::fabs(b.y - a.y) <= 1e-4f &&
                         std::fabs(b.z - a.z) <= 1e-4f && std::isfinite(b.w) &&
-                        std::fabs(double(b.w) - reference) <= pdf_tolerance;
+                        std::fabs(double(b.w) - reference) <= pdf_tolerance &&
+                        handed.model.valid == mixture[i].model.valid &&
+                        std::fabs(double(host_side) - b.w) <= pdf_tolerance;
         if (!ok && ++mismatched <= 5)
           ADD_FAILURE() << name(kc) << " frame " << frame << " pixel " << i << ": host (" << a.x
                         << " " << a.y << " " << a.z << " pdf " << a.w << ") device (" << b.x << " "
                         << b.y << " " << b.z << " pdf " << b.w << "), host pdf there " << reference
-                        << " +- " << pdf_tolerance;
+                        << " +- " << pdf_tolerance << ", from the kernel's mixture " << host_side;
       }
       pixels += g.n();
     }
@@ -588,6 +603,10 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInBothMemoryVariants) {
     settings.local_x = kc.local_x;
     settings.local_y = kc.local_y;
     settings.apron = kc.apron;
+    // The training options vary with the case (every case has its own apron): every VPL at
+    // its mixture density with apron 2, amortised training of mature pixels with apron 1.
+    settings.train_all_samples = kc.apron == 2 ? 1 : 0;
+    settings.train_interval = kc.apron == 1 ? 3 : 1;
     const pg_kernel_settings p = to_kernel_settings(settings);
     std::vector<float> state = random_states(r, g.n(), p.k_max, false);
     std::vector<float> per_variant[2];
@@ -883,8 +902,7 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
   const HostGBuffer hg = random_gbuffer(r, w, h);
   const GuiderGBuffer good = upload(rt, hg);
   const GuiderVpls vpls = upload(rt, random_vpls(r, hg.n()), w, h);
-  cl::Buffer dir(rt.context(), CL_MEM_READ_WRITE, hg.n() * 16);
-  cl::Buffer strategy(rt.context(), CL_MEM_READ_WRITE, hg.n() * 4);
+  const GuiderSamples samples = make_guider_samples(rt.context(), w, h);
   Guider guider(rt, w, h);
   const std::vector<float> state = random_states(r, hg.n(), 32.0f, false);
   guider.write_state(state);
@@ -904,19 +922,30 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
     const std::string name(m.name);
     expect_guider_error([&] { guider.reproject(bad, good); }, "current." + name);
     expect_guider_error([&] { guider.reproject(good, bad); }, "previous." + name);
-    expect_guider_error([&] { guider.sample(bad, 1, 0, 0, {dir, strategy}); }, "current." + name);
+    expect_guider_error([&] { guider.sample(bad, 1, 0, 0, samples); }, "current." + name);
     expect_guider_error([&] { guider.train(bad, vpls, 1, 0); }, "current." + name);
     bad.*m.field = cl::Buffer();
-    expect_guider_error([&] { guider.sample(bad, 1, 0, 0, {dir, strategy}); }, "current." + name);
+    expect_guider_error([&] { guider.sample(bad, 1, 0, 0, samples); }, "current." + name);
   }
   cl::Buffer short16(rt.context(), CL_MEM_READ_WRITE, hg.n() * 16 - 16);
   cl::Buffer short4(rt.context(), CL_MEM_READ_WRITE, hg.n() * 4 - 4);
-  expect_guider_error(
-      [&] {
-        guider.sample(good, 1, 0, 0, {short16, strategy});
-      },
-      "samples.direction_pdf");
-  expect_guider_error([&] { guider.sample(good, 1, 0, 0, {dir, short4}); }, "samples.strategy");
+  cl::Buffer short8(rt.context(), CL_MEM_READ_WRITE, hg.n() * 8 - 8);
+  // Each sample channel one element short.
+  struct SampleMember {
+    const char* name;
+    cl::Buffer GuiderSamples::*field;
+    const cl::Buffer* too_short;
+  };
+#define RTPG_MEMBER(name, type, bytes) \
+  {#name, &GuiderSamples::name, bytes == 16 ? &short16 : bytes == 8 ? &short8 : &short4},
+  const SampleMember sample_members[] = {PG_SAMPLE_CHANNELS(RTPG_MEMBER)};
+#undef RTPG_MEMBER
+  for (const SampleMember& m : sample_members) {
+    GuiderSamples bad = samples;
+    bad.*m.field = *m.too_short;
+    expect_guider_error([&] { guider.sample(good, 1, 0, 0, bad); },
+                        std::string("samples.") + m.name);
+  }
   expect_guider_error(
       [&] {
         guider.train(good, {short16, vpls.normal, vpls.radiance_info}, 1, 0);
@@ -943,7 +972,7 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
   guider.read_state(after);
   ASSERT_EQ(after.size(), state.size());
   for (std::size_t c = 0; c < state.size(); ++c) ASSERT_TRUE(same_bits(after[c], state[c])) << c;
-  guider.sample(good, 1, 0, 0, {dir, strategy});
+  guider.sample(good, 1, 0, 0, samples);
   guider.train(good, vpls, 1, 0);
   guider.reproject(good, good);
   EXPECT_GT(guider.count_trained(), 0u);
