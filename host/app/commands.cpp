@@ -124,7 +124,8 @@ nlohmann::json guiding_settings_json(const GuidingSettings& s) {
 nlohmann::json path_tracer_settings_json(const PathTracerSettings& s) {
   return {{"max_bounces", s.max_bounces},
           {"roulette_start", s.roulette_start},
-          {"next_event", s.next_event}};
+          {"next_event", s.next_event},
+          {"guide_secondary", s.guide_secondary}};
 }
 
 // The flag wins, then the scene's integrator setting, then the renderer's default.
@@ -175,6 +176,10 @@ int run_render(const RenderCommand& command) {
   ClRuntime cl(command.common.device);
   RenderSettings settings = command.settings;
   settings.path_tracer.max_bounces = bounces_for(scene, command.max_bounces);
+  settings.path_tracer.guide_secondary =
+      command.guiding == "pmm" && command.guide_vertices == "all";
+  settings.path_tracer.guide_position = command.guiding_settings.reproject_position;
+  settings.path_tracer.guide_normal = command.guiding_settings.reproject_normal;
   Renderer renderer = with_flag_names([&] { return Renderer(scene, settings); });
   if (command.guiding == "pmm")
     renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(
@@ -239,7 +244,8 @@ int run_render(const RenderCommand& command) {
                             {"rays",
                              {{"primary", stats.primary_rays},
                               {"secondary", stats.secondary_rays},
-                              {"shadow", stats.shadow_rays}}}};
+                              {"shadow", stats.shadow_rays}}},
+                            {"guided_vertices", stats.guided_vertices}};
     for (const auto& [key, value] : stats.extra) frame[key] = value;
     if (flicker >= 0.0) frame["flicker_mse"] = flicker;
     if (!command.reference.empty()) {

@@ -39,6 +39,11 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
   cmd->add_option("--guiding", r.guiding, "First-bounce sampling: pmm (guided) or off (BSDF)")
       ->check(CLI::IsMember({"off", "pmm"}))
       ->capture_default_str();
+  cmd->add_option("--guide-vertices", r.guide_vertices,
+                  "With --guiding pmm: first (the first bounce only, as the paper) or all (later "
+                  "vertices seen by the camera borrow their pixel's mixture)")
+      ->check(CLI::IsMember({"first", "all"}))
+      ->capture_default_str();
   auto* grp = cmd->add_option_group("Guiding",
                                     "Settings of the PMM guider (include/rtpg/guiding_settings.h)");
   for (const rtpg::GuidingSettingInfo& row : rtpg::guiding_settings_table()) {

@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "render/gbuffer.h"
+#include "shared/pmm.h"
 
 namespace rtpg {
 
@@ -33,6 +34,13 @@ struct SampleCoordinates {
 
 struct VplBuffer;
 
+// Pixel i's guiding mixture as a later path vertex borrows it (guiding beyond the first
+// bounce, docs/guiding.md): the Gaussian lives in the square of pixel i's hemisphere frame.
+struct PixelGuide {
+  shared::pg_pmm_model model;  // model.valid == 0: the pixel has no trained Gaussian
+  shared::pg_frame frame;      // pixel i's shading frame
+};
+
 class FirstBounceSampler {
  public:
   virtual ~FirstBounceSampler() = default;
@@ -53,6 +61,11 @@ class FirstBounceSampler {
   // The density sample() uses at pixel i for direction wi (world): next-event estimation at
   // the primary hit needs it for its MIS weight.
   virtual float pdf(const GBuffer& gbuffer, std::size_t i, const glm::vec3& wi) const = 0;
+  // The mixture pixel i sampled this frame, for a secondary vertex on pixel i's surface;
+  // false when the sampler has none (BSDF sampling).
+  virtual bool pixel_guide(const GBuffer& gbuffer, std::size_t i, PixelGuide& out) const {
+    return false;
+  }
 };
 
 // BSDF importance sampling, on the host.

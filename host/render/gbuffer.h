@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "rtpg/guiding_layout.h"
+#include "scene/camera.h"
 #include "shared/bsdf.h"
 #include "shared/compat.h"
 
@@ -22,6 +23,7 @@ struct GBuffer {
 #undef RTPG_HOST_CHANNEL
   std::vector<glm::vec4> geometric_normal;  // xyz, facing the camera; w unused
   std::vector<glm::vec4> emission;          // rgb emitted towards the camera (or sky radiance)
+  CameraFrame camera;                       // the camera the primary rays came from
 
   void resize(int w, int h);  // every pixel sky
   std::size_t pixel_count() const {

@@ -125,6 +125,17 @@ float GuidedFirstBounce::pdf(const GBuffer& g, std::size_t i, const glm::vec3& w
   return d.pdf(&wi.x);
 }
 
+bool GuidedFirstBounce::pixel_guide(const GBuffer& g, std::size_t i, PixelGuide& out) const {
+  if (i >= host_samples_.mixture_a.size()) return false;
+  const glm::vec4 a = host_samples_.mixture_a[i];
+  const glm::vec2 b = host_samples_.mixture_b[i];
+  out.model = shared::pg_pmm_model_from_mixture(shared::float4(a.x, a.y, a.z, a.w),
+                                                shared::float2(b.x, b.y));
+  if (!out.model.valid) return false;
+  out.frame = gbuffer_frame(g, i);
+  return true;
+}
+
 void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
                                   const SampleCoordinates& at) {
   if (!training_) return;

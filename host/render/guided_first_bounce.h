@@ -24,6 +24,7 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
               std::vector<FirstBounceSample>& out) override;
   float pdf(const GBuffer& gbuffer, std::size_t i, const glm::vec3& wi) const override;
+  bool pixel_guide(const GBuffer& gbuffer, std::size_t i, PixelGuide& out) const override;
   void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls,
                  const SampleCoordinates& at) override;
   bool wants_vpls() const override { return true; }

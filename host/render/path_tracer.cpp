@@ -1,6 +1,7 @@
 #include "render/path_tracer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -9,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include "render/surface.h"
+#include "shared/guiding_pixel.h"
 #include "shared/rng.h"
 #include "rtpg/guiding_layout.h"
 
@@ -36,6 +38,18 @@ bool is_finite(const glm::vec3& c) {
   return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
 }
 
+// Density of a borrowed guide's mixture at world direction w (wi its local form at the
+// vertex, bsdf_pdf the vertex's own BSDF density there): the Gaussian of the lending pixel in
+// that pixel's frame, mixed with the vertex's BSDF.
+float guide_density(const PixelGuide& guide, const glm::vec3& w, float bsdf_pdf) {
+  const glm::vec3 l = shared::pg_to_local(guide.frame, w);
+  float gaussian = 0.0f;
+  if (l.z > 0.0f)
+    gaussian = shared::pg_pmm_gaussian_pdf(guide.model, shared::pg_hemisphere_to_square(l)) *
+               PG_INV_TWO_PI;
+  return guide.model.pi * gaussian + (1.0f - guide.model.pi) * bsdf_pdf;
+}
+
 Ray inactive_ray() {
   Ray r;
   r.origin = glm::vec3(0.0f);
@@ -56,6 +70,8 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
                        std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite,
                        RayCounts& rays, PassTimes& times) {
   const std::size_t n = g.pixel_count();
+  gbuffer_ = &g;
+  sampler_ = &sampler;
   prepare(n, vpls);
   auto start = Clock::now();
   start_paths(g, first, sampler, at, vpls);
@@ -72,7 +88,7 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
     rays.secondary += m;
 
     start = Clock::now();
-    shade_bounce(depth, m, vpls);
+    shade_bounce(depth, m, vpls, rays);
     times.shade_ms += ms_since(start);
     run_shadow_rays(m, rays, times);
     apply_shadow_rays(m, &active_);
@@ -178,9 +194,17 @@ void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSamp
       });
 }
 
-void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls) {
+void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays) {
   const bool nee = next_event_on_;
+  std::atomic<std::uint64_t> guided_vertices{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
+    std::uint64_t guided_here = 0;
+    // Counted once per range, whatever way the loop leaves a path.
+    struct AddOnExit {
+      std::atomic<std::uint64_t>& total;
+      std::uint64_t& count;
+      ~AddOnExit() { total += count; }
+    } add_on_exit{guided_vertices, guided_here};
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
       const std::uint32_t i = active_[j];
       PathState& p = paths_[i];
@@ -241,14 +265,23 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls) {
 
       const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
                   u2 = shared::pg_rng_next(&rng);
-      // Beyond the first bounce the BSDF sampler competes with the light.
-      const auto bsdf_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
-        return shared::pg_bsdf_pdf(lobes, wo, wi);
+      PixelGuide guide;
+      // A borrowed lobe is the lending pixel's product of incident light and its BSDF for its
+      // own view direction: it carries over to a vertex whose reflection is mostly diffuse
+      // (view-independent), not to a glossy one seen from elsewhere.
+      const bool guided =
+          settings_.guide_secondary && lobes.p_specular <= 0.5f && borrow_guide(sp, guide);
+      guided_here += guided;
+      // Beyond the first bounce the vertex's sampler competes with the light: its BSDF, or
+      // the borrowed guide's mixture.
+      const auto vertex_pdf = [&](const glm::vec3& w, const glm::vec3& wi) {
+        const float bsdf = shared::pg_bsdf_pdf(lobes, wo, wi);
+        return guided ? guide_density(guide, w, bsdf) : bsdf;
       };
       glm::vec3 c;
       Ray shadow;
       if (nee && next_event(sp.position, sp.geometric_normal, frame, wo, lobes, origin, u_sel, u1,
-                            u2, bsdf_pdf, c, shadow)) {
+                            u2, vertex_pdf, c, shadow)) {
         shadow_work_[j].contribution = p.throughput * c;
         shadow_work_[j].vpl_contribution = vpl_throughput * c;
         shadow_rays_[j] = shadow;
@@ -257,9 +290,37 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls) {
       const float u_lobe = shared::pg_rng_next(&rng), v1 = shared::pg_rng_next(&rng),
                   v2 = shared::pg_rng_next(&rng), u_rr = shared::pg_rng_next(&rng);
       p.rng = rng.state;
-      const shared::pg_bsdf_sample_t bs = shared::pg_bsdf_sample(lobes, wo, u_lobe, v1, v2);
-      if (bs.pdf <= 0.0f) continue;
-      const glm::vec3 wi_world = shared::pg_to_world(frame, bs.wi);
+      shared::pg_bsdf_sample_t bs;
+      glm::vec3 wi_world;
+      if (!guided) {
+        bs = shared::pg_bsdf_sample(lobes, wo, u_lobe, v1, v2);
+        if (bs.pdf <= 0.0f) continue;
+        wi_world = shared::pg_to_world(frame, bs.wi);
+      } else {
+        // One-sample MIS over the borrowed mixture, as the sample kernel does (pmm.h): the
+        // Gaussian with probability pi (in the lending pixel's square and frame), else the
+        // BSDF; the weight uses the whole mixture's density.
+        const float pi = guide.model.pi;
+        if (u_lobe < pi) {
+          const float r = std::sqrt(-2.0f * std::log(std::max(1.0f - v1, 1e-30f)));
+          const float phi = 2.0f * PG_PI * v2;
+          const float z1 = r * std::cos(phi), z2 = r * std::sin(phi);
+          const float ux = guide.model.mx + guide.model.l11 * z1;
+          const float uy = guide.model.my + guide.model.l21 * z1 + guide.model.l22 * z2;
+          if (!(ux >= 0.0f && ux <= 1.0f && uy >= 0.0f && uy <= 1.0f)) continue;
+          wi_world = shared::pg_to_world(guide.frame,
+                                         shared::pg_square_to_hemisphere(shared::float2(ux, uy)));
+          bs.wi = shared::pg_to_local(frame, wi_world);
+        } else {
+          const float u = std::min((u_lobe - pi) / (1.0f - pi), 0.99999994f);
+          bs = shared::pg_bsdf_sample(lobes, wo, u, v1, v2);
+          if (bs.pdf <= 0.0f) continue;
+          wi_world = shared::pg_to_world(frame, bs.wi);
+        }
+        if (bs.wi.z <= 0.0f) continue;
+        bs.pdf = guide_density(guide, wi_world, shared::pg_bsdf_pdf(lobes, wo, bs.wi));
+        if (!(bs.pdf > 0.0f)) continue;
+      }
       if (glm::dot(wi_world, sp.geometric_normal) <= 0.0f) continue;
       const glm::vec3 weight = shared::pg_bsdf_eval(lobes, wo, bs.wi) * (bs.wi.z / bs.pdf);
       p.throughput *= weight;
@@ -281,6 +342,29 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls) {
       alive_[j] = 1;
     }
   });
+  rays.guided_vertices += guided_vertices.load();
+}
+
+bool PathTracer::borrow_guide(const SurfacePoint& sp, PixelGuide& guide) const {
+  const GBuffer& g = *gbuffer_;
+  float sx = 0.0f, sy = 0.0f;
+  if (!g.camera.project(sp.position, sx, sy)) return false;
+  const float fx = std::floor(sx * static_cast<float>(g.width));
+  const float fy = std::floor(sy * static_cast<float>(g.height));
+  if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.width) &&
+        fy < static_cast<float>(g.height)))
+    return false;
+  const std::size_t i = static_cast<std::size_t>(fy) * static_cast<std::size_t>(g.width) +
+                        static_cast<std::size_t>(fx);
+  if (!g.has_surface(i)) return false;
+  const float depth = glm::dot(sp.position - g.camera.position, g.camera.forward);
+  const shared::float4 here(sp.position.x, sp.position.y, sp.position.z, depth);
+  // The pixel must show this very surface (an occluder in front fails the position test).
+  if (!shared::pg_same_surface(g.position_depth[i], shared::pg_float4_xyz(g.shading_normal[i]),
+                               g.material[i], here, sp.shading_normal, sp.material_id,
+                               settings_.guide_position, settings_.guide_normal))
+    return false;
+  return sampler_->pixel_guide(g, i, guide);
 }
 
 void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times) {

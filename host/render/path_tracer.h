@@ -18,14 +18,23 @@
 
 namespace rtpg {
 
+struct SurfacePoint;
+
 struct PathTracerSettings {
   int max_bounces = 8;     // path vertices after the primary hit
   int roulette_start = 3;  // first bounce at which Russian roulette may end a path
   bool next_event = true;  // false: BSDF sampling only (emitters found by chance)
+  // Guiding beyond the first bounce (docs/guiding.md): a later vertex that the camera sees
+  // in some pixel (the same surface by the tests of reprojection, these thresholds) samples
+  // that pixel's guiding mixture instead of its BSDF alone.
+  bool guide_secondary = false;
+  float guide_position = 0.05f;  // relative distance to the pixel's depth
+  float guide_normal = 0.9f;     // normal cosine
 };
 
 struct RayCounts {
   std::uint64_t secondary = 0, shadow = 0;
+  std::uint64_t guided_vertices = 0;  // later vertices that sampled a borrowed guide
 };
 
 struct PassTimes {
@@ -69,7 +78,7 @@ class PathTracer {
                    const FirstBounceSampler& sampler, const SampleCoordinates& at, VplBuffer* vpls);
   // The hits of the m live paths at path vertex `depth`: emission found by the bounce (MIS),
   // the VPL at depth 1, next-event estimation, BSDF sampling and Russian roulette.
-  void shade_bounce(int depth, std::size_t m, VplBuffer* vpls);
+  void shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays);
   // Next-event estimation at a surface point, once for every vertex: samples a light and,
   // where the BSDF sees it, returns true with the contribution an unoccluded shadow ray adds
   // (BSDF x cosine x radiance x MIS weight / pdf; competing_pdf(world_dir, local_dir) is the
@@ -84,6 +93,8 @@ class PathTracer {
   // Keeps the rays of the paths still alive at the front of rays_; active_ becomes their
   // pixels (owners[j] of slot j, or j itself when owners is null).
   void compact(std::size_t count, const std::vector<std::uint32_t>* owners);
+  // The guide of the pixel that shows surface point sp, if any (guide_secondary).
+  bool borrow_guide(const SurfacePoint& sp, PixelGuide& guide) const;
   // Pixel estimates (non-finite ones dropped and counted) and the VPLs' radiance.
   void gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite) const;
 
@@ -91,6 +102,10 @@ class PathTracer {
   const EmbreeScene& tracer_;
   const Lights& lights_;
   PathTracerSettings settings_;
+
+  // This frame's G-buffer and first-bounce sampler (set by trace()).
+  const GBuffer* gbuffer_ = nullptr;
+  const FirstBounceSampler* sampler_ = nullptr;
 
   // Scratch, reused across frames.
   std::vector<PathState> paths_;

@@ -69,6 +69,7 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
   const CameraFrame camera = make_camera_frame(camera_at(frame), aspect);
   const CameraFrame previous = make_camera_frame(camera_at(frame > 0 ? frame - 1 : 0), aspect);
   const std::size_t n = gbuffer_.pixel_count();
+  gbuffer_.camera = camera;
   camera_rays_.resize(n);
   camera_hits_.resize(n);
 
@@ -178,6 +179,7 @@ FrameStats Renderer::render_frame(int index) {
   stats.time_ms["shade"] = times.shade_ms;
   stats.secondary_rays = rays.secondary;
   stats.shadow_rays = rays.shadow;
+  stats.guided_vertices = rays.guided_vertices;
   sampler_->report(stats.time_ms, stats.extra);
   stats.time_ms["total"] = ms_since(start);
   return stats;

@@ -37,6 +37,7 @@ struct FrameStats {
       time_ms;  // "total", "primary", "gbuffer", "sample", "trace", "shade", kernels
   std::uint64_t nonfinite_samples = 0;
   std::uint64_t primary_rays = 0, secondary_rays = 0, shadow_rays = 0;
+  std::uint64_t guided_vertices = 0;    // later path vertices that sampled a borrowed guide
   std::map<std::string, double> extra;  // sampler-specific figures (e.g. guided fraction)
 };
 

@@ -108,7 +108,7 @@ namespace rtpg {
 
 typedef struct pg_kernel_settings {
   float pi_min;          /* clamp of the mixing weight (paper: 0.05) */
-  float pi_max;          /* (paper: 0.95) */
+  float pi_max;          /* (paper: 0.95; rtpg: 0.5, docs/guiding.md) */
   float pi_init;         /* weight of a new model (paper: 0.05) */
   float k_max;           /* epochs after which the step size stops shrinking */
   float step_alpha;      /* eta_k = max((k+1)^-alpha, 1/(k_max+1)) */

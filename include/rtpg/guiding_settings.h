@@ -12,12 +12,13 @@
 namespace rtpg {
 
 struct GuidingSettings {
-  float pi_min = 0.05f;  // clamp of the Gaussian's mixing weight (paper 3.2)
-  float pi_max = 0.95f;
-  float pi_init = 0.05f;       // weight of a new model (paper 3.1)
-  int k_max = 32;              // epochs; the step size stops shrinking after k_max updates
-  float step_alpha = 1.0f;     // eta_k = max((k+1)^-alpha, 1/(k_max+1)): 1 = plain mean until k_max
-  float sigma_eps = 1e-4f;     // regularisation of Sigma's diagonal (square units^2)
+  float pi_min = 0.05f;     // clamp of the Gaussian's mixing weight (paper 3.2)
+  float pi_max = 0.5f;      // the paper's 0.95 lets a lobe narrower than its target cost up to
+                            // 20x BSDF sampling's second moment (docs/guiding.md, "Mixing weight")
+  float pi_init = 0.05f;    // weight of a new model (paper 3.1)
+  int k_max = 32;           // epochs; the step size stops shrinking after k_max updates
+  float step_alpha = 1.0f;  // eta_k = max((k+1)^-alpha, 1/(k_max+1)): 1 = plain mean until k_max
+  float sigma_eps = 1e-4f;  // regularisation of Sigma's diagonal (square units^2)
   float sigma_prior = 5e-2f;   // prior variance, added as sigma_prior / (k + 1)
   float reseed_ratio = 10.0f;  // a sample with weight > ratio * W outside the lobe re-seeds it
   float weight_clamp = 0.0f;   // training weights clamped to weight_clamp * W (0 = no clamp)

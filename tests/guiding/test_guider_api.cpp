@@ -107,10 +107,10 @@ TEST(GuiderApi, CreateResetReprojectSampleTrainAndStateRoundTrip) {
   guider.read_state(state);
   for (float v : state) ASSERT_EQ(v, 0.0f);
 
-  // A lobe straight up at every pixel (mean (0.5, 0.5): the normal), pi = 0.6, k = 5.
+  // A lobe straight up at every pixel (mean (0.5, 0.5): the normal), pi = 0.4, k = 5.
   std::vector<float> lobe(8 * n);
   for (std::size_t i = 0; i < n; ++i) {
-    const float s0 = 1.0f, pi = 0.6f, var = 0.004f;
+    const float s0 = 1.0f, pi = 0.4f, var = 0.004f;
     const float v[8] = {
         s0 / pi,    s0,  0.5f * s0, 0.5f * s0, s0 * (var + 0.25f), s0 * (var + 0.25f),
         0.25f * s0, 5.0f};
@@ -130,7 +130,7 @@ TEST(GuiderApi, CreateResetReprojectSampleTrainAndStateRoundTrip) {
 
   // Sampling: sky pixels produce nothing; surface pixels a unit direction above the floor with a
   // positive pdf (or pdf 0 for a Gaussian sample that left the square), by the Gaussian with
-  // probability pi = 0.6 (binomial: 5 standard deviations).
+  // probability pi = 0.4 (binomial: 5 standard deviations).
   const rtpg::GuiderSamples samples = rtpg::make_guider_samples(rt.context(), w, h);
   std::size_t guided = 0, surface = 0;
   for (std::uint32_t frame = 0; frame < 4; ++frame) {
@@ -156,8 +156,8 @@ TEST(GuiderApi, CreateResetReprojectSampleTrainAndStateRoundTrip) {
       EXPECT_GT(d[4 * i + 2], 0.0f);
     }
   }
-  const double sd = std::sqrt(0.6 * 0.4 * surface);
-  EXPECT_NEAR(static_cast<double>(guided), 0.6 * surface, 5.0 * sd);
+  const double sd = std::sqrt(0.4 * 0.6 * surface);
+  EXPECT_NEAR(static_cast<double>(guided), 0.4 * surface, 5.0 * sd);
   EXPECT_GE(guider.last_times().sample_ms, 0.0);
 
   // Training from bright VPLs 2 units above every pixel (valid, BSDF strategy): every surface
