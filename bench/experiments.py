@@ -29,8 +29,8 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ALL_SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza", "sponza-glossy",
-              "sponza-sky"]
+ALL_SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "slit-room", "corridor", "sunlit-room",
+              "veach-ajar", "sponza", "sponza-glossy", "sponza-sky"]
 METHODS = ("off", "pmm")
 LABEL = {"off": "PT", "pmm": "PG"}
 
