@@ -38,9 +38,9 @@ bool is_finite(const glm::vec3& c) {
   return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
 }
 
-// Density of a borrowed guide's mixture at world direction w (wi its local form at the
-// vertex, bsdf_pdf the vertex's own BSDF density there): the Gaussian of the lending pixel in
-// that pixel's frame, mixed with the vertex's BSDF.
+// Density of a borrowed guide's mixture at world direction w (bsdf_pdf: the vertex's own BSDF
+// density there): the Gaussian of the lending pixel in that pixel's frame, mixed with the
+// vertex's BSDF.
 float guide_density(const PixelGuide& guide, const glm::vec3& w, float bsdf_pdf) {
   const glm::vec3 l = shared::pg_to_local(guide.frame, w);
   float gaussian = 0.0f;
@@ -302,14 +302,10 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         // BSDF; the weight uses the whole mixture's density.
         const float pi = guide.model.pi;
         if (u_lobe < pi) {
-          const float r = std::sqrt(-2.0f * std::log(std::max(1.0f - v1, 1e-30f)));
-          const float phi = 2.0f * PG_PI * v2;
-          const float z1 = r * std::cos(phi), z2 = r * std::sin(phi);
-          const float ux = guide.model.mx + guide.model.l11 * z1;
-          const float uy = guide.model.my + guide.model.l21 * z1 + guide.model.l22 * z2;
-          if (!(ux >= 0.0f && ux <= 1.0f && uy >= 0.0f && uy <= 1.0f)) continue;
-          wi_world = shared::pg_to_world(guide.frame,
-                                         shared::pg_square_to_hemisphere(shared::float2(ux, uy)));
+          int inside = 0;
+          const shared::float2 u = shared::pg_pmm_sample_square(guide.model, v1, v2, &inside);
+          if (!inside) continue;
+          wi_world = shared::pg_to_world(guide.frame, shared::pg_square_to_hemisphere(u));
           bs.wi = shared::pg_to_local(frame, wi_world);
         } else {
           const float u = std::min((u_lobe - pi) / (1.0f - pi), 0.99999994f);

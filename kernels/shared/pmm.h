@@ -137,6 +137,19 @@ typedef struct {
   uint strategy; /* PG_STRATEGY_* (include/rtpg/guiding_layout.h) */
 } pg_pmm_sample_t;
 
+/* A point of the square drawn from the model's Gaussian (Box-Muller, then the Cholesky factor);
+ * *inside is 0 when it falls outside the square, where the mixture has no Gaussian mass: the
+ * sample is lost (pdf 0), never moved. */
+PG_FN float2 pg_pmm_sample_square(pg_pmm_model m, float u1, float u2, PG_PRIVATE int* inside) {
+  float r = sqrt(-2.0f * log(fmax(1.0f - u1, 1e-30f)));
+  float phi = PG_TWO_PI * u2;
+  float z1 = r * cos(phi), z2 = r * sin(phi);
+  float ux = m.mx + m.l11 * z1;
+  float uy = m.my + m.l21 * z1 + m.l22 * z2;
+  *inside = ux >= 0.0f && ux <= 1.0f && uy >= 0.0f && uy <= 1.0f;
+  return pg_make_float2(ux, uy);
+}
+
 /* One-sample MIS over the two components (paper 3.1): xi < pi picks the Gaussian (Box-Muller
  * then the Cholesky factor, then M), else the BSDF. Either way the sample's weight is
  * f cos / D(w) with the full mixture density. */
@@ -148,13 +161,10 @@ PG_FN pg_pmm_sample_t pg_pmm_sample(pg_pmm_model m, pg_lobes lobes, float3 wo, f
   s.strategy = PG_STRATEGY_NONE;
   if (m.valid && xi < m.pi) {
     s.strategy = PG_STRATEGY_GUIDE;
-    float r = sqrt(-2.0f * log(fmax(1.0f - u1, 1e-30f)));
-    float phi = PG_TWO_PI * u2;
-    float z1 = r * cos(phi), z2 = r * sin(phi);
-    float ux = m.mx + m.l11 * z1;
-    float uy = m.my + m.l21 * z1 + m.l22 * z2;
-    if (!(ux >= 0.0f && ux <= 1.0f && uy >= 0.0f && uy <= 1.0f)) return s; /* left the square */
-    s.wi = pg_square_to_hemisphere(pg_make_float2(ux, uy));
+    int inside = 0;
+    float2 u = pg_pmm_sample_square(m, u1, u2, &inside);
+    if (!inside) return s; /* left the square */
+    s.wi = pg_square_to_hemisphere(u);
     if (s.wi.z <= 0.0f) return s;
   } else {
     s.strategy = PG_STRATEGY_BSDF;
