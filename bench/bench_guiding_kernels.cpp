@@ -17,6 +17,8 @@
 //   copy_bw              what copy_float4 (kernels/copy_float4.cl, 64 MiB each way) reaches,
 //                        launched in the same iteration as the kernel
 //   copy_fraction        bytes_per_second / copy_bw
+//   gflops               (FmaPeak/floatW) multiply-add rate of kernels/fma_peak.cl at vector
+//                        width W: 1 is the scalar rate, 8 and 16 what vector code can reach
 //   vs_16x16_global      kernel time / the same kernel's time at 16x16 with VPLs read from
 //                        global memory, launched in the same iterations (1 for that one):
 //                        the local-size sweep and Local vs Global as ratios that host drift
@@ -330,6 +332,47 @@ Copy& copy() {
   return c;
 }
 
+// ---- the arithmetic yardstick ----------------------------------------------------------------
+
+// kernels/fma_peak.cl at one vector width: the device's multiply-add rate, the compute side of
+// the roofline the guiding kernels are compared with.
+struct FmaPeak {
+  static constexpr std::size_t kItems = 1u << 16;
+  static constexpr cl_uint kRounds = 1024;
+  static constexpr int kChains = 8;  // PG_FMA_CHAINS
+  int width;
+  cl::Kernel kernel;
+  cl::Buffer out;
+  explicit FmaPeak(int w) : width(w) {
+    kernel = runtime().kernel("fma_peak.cl", "fma_peak", "-DPG_FMA_WIDTH=" + std::to_string(w));
+    out = cl::Buffer(runtime().context(), CL_MEM_WRITE_ONLY, kItems * 4);
+    kernel.setArg(0, out);
+    kernel.setArg(1, kRounds);
+    kernel.setArg(2, 0.999f);
+    kernel.setArg(3, 0.001f);
+    run();  // first launch: compile the work-group function
+  }
+  double flops() const { return 2.0 * kItems * kRounds * kChains * width; }
+  double run() {  // ms
+    cl::Event done;
+    runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(kItems),
+                                           cl::NullRange, nullptr, &done);
+    done.wait();
+    return ClRuntime::event_ms(done);
+  }
+};
+
+void BM_FmaPeak(benchmark::State& state, int width) {
+  FmaPeak f(width);
+  double ms = 0.0;
+  for (auto _ : state) {
+    const double t = f.run();
+    state.SetIterationTime(t * 1e-3);
+    ms += t;
+  }
+  state.counters["gflops"] = f.flops() * static_cast<double>(state.iterations()) / (ms * 1e6);
+}
+
 void BM_CopyFloat4(benchmark::State& state) {
   Copy& c = copy();
   for (auto _ : state) state.SetIterationTime(c.run() * 1e-3);
@@ -545,6 +588,11 @@ void register_all(bool full) {
   benchmark::RegisterBenchmark("CopyFloat4/64MiB", BM_CopyFloat4)
       ->UseManualTime()
       ->Unit(benchmark::kMillisecond);
+  for (int width : {1, 8, 16})
+    benchmark::RegisterBenchmark(("FmaPeak/float" + std::to_string(width)).c_str(), BM_FmaPeak,
+                                 width)
+        ->UseManualTime()
+        ->Unit(benchmark::kMillisecond);
   using M = GuidingSettings::TrainMemory;
   struct Local {
     int x, y;
