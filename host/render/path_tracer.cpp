@@ -199,12 +199,6 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
   std::atomic<std::uint64_t> guided_vertices{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
     std::uint64_t guided_here = 0;
-    // Counted once per range, whatever way the loop leaves a path.
-    struct AddOnExit {
-      std::atomic<std::uint64_t>& total;
-      std::uint64_t& count;
-      ~AddOnExit() { total += count; }
-    } add_on_exit{guided_vertices, guided_here};
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
       const std::uint32_t i = active_[j];
       PathState& p = paths_[i];
@@ -337,6 +331,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       rays_[j] = next;
       alive_[j] = 1;
     }
+    guided_vertices += guided_here;
   });
   rays.guided_vertices += guided_vertices.load();
 }
