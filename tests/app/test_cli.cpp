@@ -278,6 +278,15 @@ TEST_F(Cli, RejectsUnknownGuidingMode) {
                   {"out.exr"});
 }
 
+TEST_F(Cli, RejectsUnknownGuideVertices) {
+  expect_rejected("render --res 16x16 --spp 1 --guide-vertices some -o out.exr", "--guide-vertices",
+                  {"out.exr"});
+}
+
+TEST_F(Cli, RejectsUnknownDevice) {
+  expect_rejected(render("--res 16x16 --device nosuch"), "nosuch");
+}
+
 TEST_F(Cli, RejectsResolutionTooLargeForMemory) {
   expect_rejected(render("--res 100000x100000"), "--res");
 }
