@@ -299,6 +299,15 @@ Inputs& inputs_for(int w, int h) {
   return in;
 }
 
+// A 1D launch of `items` work-items, driver-chosen work-groups: its profiled time in ms.
+double run_1d(cl::Kernel& kernel, std::size_t items) {
+  cl::Event done;
+  runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(items), cl::NullRange,
+                                         nullptr, &done);
+  done.wait();
+  return ClRuntime::event_ms(done);
+}
+
 // ---- the copy yardstick ----------------------------------------------------------------------
 
 struct Copy {
@@ -318,13 +327,7 @@ struct Copy {
     run();  // first launch: compile the work-group function
   }
   static double bytes() { return 2.0 * kElements * 16; }
-  double run() {  // ms
-    cl::Event done;
-    runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(kElements),
-                                           cl::NullRange, nullptr, &done);
-    done.wait();
-    return ClRuntime::event_ms(done);
-  }
+  double run() { return run_1d(kernel, kElements); }
 };
 
 Copy& copy() {
@@ -353,13 +356,7 @@ struct FmaPeak {
     run();  // first launch: compile the work-group function
   }
   double flops() const { return 2.0 * kItems * kRounds * kChains * width; }
-  double run() {  // ms
-    cl::Event done;
-    runtime().queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(kItems),
-                                           cl::NullRange, nullptr, &done);
-    done.wait();
-    return ClRuntime::event_ms(done);
-  }
+  double run() { return run_1d(kernel, kItems); }
 };
 
 void BM_FmaPeak(benchmark::State& state, int width) {

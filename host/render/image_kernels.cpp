@@ -20,15 +20,19 @@ std::size_t pixel_count(int width, int height) {
 
 // 1D launch over count items: local size clamped to what the device allows, global rounded
 // up to a multiple of it.
-struct Launch {
-  cl::NDRange global;
-  cl::NDRange local;
-};
-
-Launch launch_1d(const ClRuntime& runtime, std::size_t count, std::size_t local_size) {
-  if (local_size == 0) return {cl::NDRange(count), cl::NullRange};
-  const std::size_t local = std::min(local_size, runtime.info().max_work_group_size);
-  return {cl::NDRange((count + local - 1) / local * local), cl::NDRange(local)};
+// One work-item per pixel; local_size 0 lets the driver choose, else the global size is
+// rounded up to a multiple of it (the kernels bounds-check).
+cl::Event enqueue_1d(ClRuntime& runtime, cl::Kernel& kernel, std::size_t count,
+                     std::size_t local_size) {
+  cl::NDRange global(count), local = cl::NullRange;
+  if (local_size != 0) {
+    const std::size_t l = std::min(local_size, runtime.info().max_work_group_size);
+    global = cl::NDRange((count + l - 1) / l * l);
+    local = cl::NDRange(l);
+  }
+  cl::Event event;
+  runtime.queue().enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &event);
+  return event;
 }
 
 }  // namespace
@@ -43,11 +47,7 @@ cl::Event enqueue_tonemap(ClRuntime& runtime, const cl::Buffer& radiance, const 
     kernel.setArg(2, static_cast<cl_uint>(width));
     kernel.setArg(3, static_cast<cl_uint>(height));
     kernel.setArg(4, exposure);
-    const Launch launch = launch_1d(runtime, count, local_size);
-    cl::Event event;
-    runtime.queue().enqueueNDRangeKernel(kernel, cl::NullRange, launch.global, launch.local,
-                                         nullptr, &event);
-    return event;
+    return enqueue_1d(runtime, kernel, count, local_size);
   });
 }
 
@@ -94,11 +94,7 @@ cl::Event Accumulator::add(const cl::Buffer& frame) {
     kernel_.setArg(2, static_cast<cl_uint>(width_));
     kernel_.setArg(3, static_cast<cl_uint>(height_));
     kernel_.setArg(4, weight_new);
-    const Launch launch = launch_1d(runtime_, count, local_size_);
-    cl::Event e;
-    runtime_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, launch.global, launch.local,
-                                          nullptr, &e);
-    return e;
+    return enqueue_1d(runtime_, kernel_, count, local_size_);
   });
   ++frames_;
   return event;
