@@ -33,11 +33,9 @@ void BsdfFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
   });
 }
 
-float BsdfFirstBounce::pdf(const GBuffer& g, std::size_t i, const glm::vec3& wi) const {
-  const shared::pg_frame frame = gbuffer_frame(g, i);
-  const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
-  const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
-  return shared::pg_bsdf_pdf(lobes, wo, shared::pg_to_local(frame, wi));
+float BsdfFirstBounce::pdf(const GBuffer&, std::size_t, const shared::pg_lobes& lobes,
+                           const glm::vec3& wo, const glm::vec3& wi) const {
+  return shared::pg_bsdf_pdf(lobes, wo, wi);
 }
 
 }  // namespace rtpg

@@ -58,9 +58,11 @@ class FirstBounceSampler {
   // One direction for every surface pixel of the G-buffer (others get pdf 0).
   virtual void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
                       std::vector<FirstBounceSample>& out) = 0;
-  // The density sample() uses at pixel i for direction wi (world): next-event estimation at
-  // the primary hit needs it for its MIS weight.
-  virtual float pdf(const GBuffer& gbuffer, std::size_t i, const glm::vec3& wi) const = 0;
+  // The density sample() uses at pixel i for direction wi: next-event estimation at the
+  // primary hit needs it for its MIS weight. The caller passes what it already has of the
+  // pixel: its lobes, and wo and wi in its shading frame (gbuffer_frame).
+  virtual float pdf(const GBuffer& gbuffer, std::size_t i, const shared::pg_lobes& lobes,
+                    const glm::vec3& wo, const glm::vec3& wi) const = 0;
   // The mixture pixel i sampled this frame, for a secondary vertex on pixel i's surface;
   // false when the sampler has none (BSDF sampling).
   virtual bool pixel_guide(const GBuffer& gbuffer, std::size_t i, PixelGuide& out) const {
@@ -73,6 +75,7 @@ class BsdfFirstBounce final : public FirstBounceSampler {
  public:
   void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
               std::vector<FirstBounceSample>& out) override;
-  float pdf(const GBuffer& gbuffer, std::size_t i, const glm::vec3& wi) const override;
+  float pdf(const GBuffer& gbuffer, std::size_t i, const shared::pg_lobes& lobes,
+            const glm::vec3& wo, const glm::vec3& wi) const override;
 };
 }  // namespace rtpg

@@ -18,14 +18,6 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-// Pixel i's guiding distribution from the mixture the sample kernel wrote for it.
-template <class Samples>
-void init_distribution(GuidingDistribution& d, const GBuffer& g, const Samples& samples,
-                       std::size_t i) {
-  d.init_mixture(&samples.mixture_a[i].x, &samples.mixture_b[i].x, &g.shading_normal[i].x,
-                 &g.view_dir[i].x, &g.base_color_roughness[i].x, &g.metallic_specular[i].x);
-}
-
 // Bytes of one pixel's entries in a channel list (include/rtpg/guiding_layout.h).
 #define RTPG_ADD_BYTES(name, type, bytes) +(bytes)
 constexpr std::size_t kGBufferBytes = 0 PG_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
@@ -119,18 +111,21 @@ void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
   mean_pi_ = counts.guided ? counts.pi_sum / static_cast<double>(counts.guided) : 0.0;
 }
 
-float GuidedFirstBounce::pdf(const GBuffer& g, std::size_t i, const glm::vec3& wi) const {
-  GuidingDistribution d(guider_->kernel_settings());
-  init_distribution(d, g, host_samples_, i);
-  return d.pdf(&wi.x);
+shared::pg_pmm_model GuidedFirstBounce::model_at(std::size_t i) const {
+  const glm::vec4 a = host_samples_.mixture_a[i];
+  const glm::vec2 b = host_samples_.mixture_b[i];
+  return shared::pg_pmm_model_from_mixture(shared::float4(a.x, a.y, a.z, a.w),
+                                           shared::float2(b.x, b.y));
+}
+
+float GuidedFirstBounce::pdf(const GBuffer&, std::size_t i, const shared::pg_lobes& lobes,
+                             const glm::vec3& wo, const glm::vec3& wi) const {
+  return shared::pg_pmm_pdf(model_at(i), lobes, wo, wi);
 }
 
 bool GuidedFirstBounce::pixel_guide(const GBuffer& g, std::size_t i, PixelGuide& out) const {
   if (i >= host_samples_.mixture_a.size()) return false;
-  const glm::vec4 a = host_samples_.mixture_a[i];
-  const glm::vec2 b = host_samples_.mixture_b[i];
-  out.model = shared::pg_pmm_model_from_mixture(shared::float4(a.x, a.y, a.z, a.w),
-                                                shared::float2(b.x, b.y));
+  out.model = model_at(i);
   if (!out.model.valid) return false;
   out.frame = gbuffer_frame(g, i);
   return true;

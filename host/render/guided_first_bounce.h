@@ -9,7 +9,6 @@
 #include "render/first_bounce.h"
 #include "render/vpl_buffer.h"
 #include "rtpg/guider.h"
-#include "rtpg/guiding_distribution.h"
 
 namespace rtpg {
 
@@ -23,7 +22,8 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) override;
   void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
               std::vector<FirstBounceSample>& out) override;
-  float pdf(const GBuffer& gbuffer, std::size_t i, const glm::vec3& wi) const override;
+  float pdf(const GBuffer& gbuffer, std::size_t i, const shared::pg_lobes& lobes,
+            const glm::vec3& wo, const glm::vec3& wi) const override;
   bool pixel_guide(const GBuffer& gbuffer, std::size_t i, PixelGuide& out) const override;
   void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls,
                  const SampleCoordinates& at) override;
@@ -36,6 +36,9 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void set_training(bool on) { training_ = on; }
 
  private:
+  // The model pixel i sampled this frame (from the mixture the sample kernel wrote).
+  shared::pg_pmm_model model_at(std::size_t i) const;
+
   ClRuntime& runtime_;
   std::unique_ptr<Guider> guider_;
   GuiderGBuffer gbuffers_[2];

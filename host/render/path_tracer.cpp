@@ -153,8 +153,8 @@ void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSamp
           const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
                       u2 = shared::pg_rng_next(&rng);
           // The first bounce's own sampler competes with the light here (the guided mixture).
-          const auto first_bounce_pdf = [&](const glm::vec3& direction, const glm::vec3&) {
-            return sampler.pdf(g, i, direction);
+          const auto first_bounce_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
+            return sampler.pdf(g, i, lobes, wo, wi);
           };
           glm::vec3 c;
           Ray shadow;

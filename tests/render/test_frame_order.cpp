@@ -34,8 +34,9 @@ class RecordingSampler final : public FirstBounceSampler {
     log_.push_back("sample " + std::to_string(at.frame) + "." + std::to_string(at.sample));
     bsdf_.sample(g, at, out);
   }
-  float pdf(const GBuffer& g, std::size_t i, const glm::vec3& wi) const override {
-    return bsdf_.pdf(g, i, wi);
+  float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
+            const glm::vec3& wi) const override {
+    return bsdf_.pdf(g, i, lobes, wo, wi);
   }
 
  private:
