@@ -147,7 +147,8 @@ inline RaySets make_ray_sets(const Scene& scene, const EmbreeScene& tracer, int 
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       if (!hits[i].valid()) continue;
       const SurfacePoint sp = make_surface_point(scene, s.primary[i], hits[i]);
-      const glm::vec3 origin = offset_ray_origin(sp.position, sp.geometric_normal);
+      const glm::vec3 origin =
+          offset_ray_origin(sp.position, sp.geometric_normal, sp.offset_distance);
       shared::pg_rng rng = shared::pg_rng_make(seed, static_cast<shared::uint>(i), 0u, 0u, 9u);
       const float u1 = shared::pg_rng_next(&rng), u2 = shared::pg_rng_next(&rng);
       const float r = std::sqrt(u1), phi = 2.0f * PG_PI * u2;

@@ -21,7 +21,8 @@ struct GBuffer {
 #define RTPG_HOST_CHANNEL(name, type, bytes) std::vector<shared::type> name;
   PG_GBUFFER_CHANNELS(RTPG_HOST_CHANNEL)
 #undef RTPG_HOST_CHANNEL
-  std::vector<glm::vec4> geometric_normal;  // xyz, facing the camera; w unused
+  std::vector<glm::vec4> geometric_normal;  // xyz, facing the camera; w the offset distance
+                                            // (SurfacePoint::offset_distance)
   std::vector<glm::vec4> emission;          // rgb emitted towards the camera (or sky radiance)
   CameraFrame camera;                       // the camera the primary rays came from
 

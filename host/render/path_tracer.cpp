@@ -148,7 +148,7 @@ void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSamp
           const shared::pg_frame frame = gbuffer_frame(g, i);
           const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
           const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
-          const glm::vec3 origin = offset_ray_origin(x0, ng);
+          const glm::vec3 origin = offset_ray_origin(x0, ng, g.geometric_normal[i].w);
 
           const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
                       u2 = shared::pg_rng_next(&rng);
@@ -254,7 +254,8 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       const shared::pg_frame frame = shared::pg_frame_from_normal(sp.shading_normal);
       const glm::vec3 wo = shared::pg_to_local(frame, -dir);
       const shared::pg_lobes lobes = shared::pg_make_lobes(sp.material, wo);
-      const glm::vec3 origin = offset_ray_origin(sp.position, sp.geometric_normal);
+      const glm::vec3 origin =
+          offset_ray_origin(sp.position, sp.geometric_normal, sp.offset_distance);
       const glm::vec3 vpl_throughput = depth == 1 ? glm::vec3(1.0f) : p.vpl_throughput;
 
       const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),

@@ -115,7 +115,7 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
       const float depth = glm::dot(sp.position - camera.position, camera.forward);
       g.position_depth[i] = glm::vec4(sp.position, depth);
       g.shading_normal[i] = glm::vec4(sp.shading_normal, 0.0f);
-      g.geometric_normal[i] = glm::vec4(sp.geometric_normal, 0.0f);
+      g.geometric_normal[i] = glm::vec4(sp.geometric_normal, sp.offset_distance);
       g.view_dir[i] = glm::vec4(-dir, 0.0f);
       g.base_color_roughness[i] = glm::vec4(sp.material.base_color.x, sp.material.base_color.y,
                                             sp.material.base_color.z, sp.material.roughness);

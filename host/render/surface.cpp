@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace rtpg {
 namespace {
@@ -53,17 +54,14 @@ float texture_channel(const glm::vec4& texel, int channel) {
 
 }  // namespace
 
-glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n) {
-  constexpr float kOrigin = 1.0f / 32.0f, kFloatScale = 1.0f / 65536.0f, kIntScale = 256.0f;
-  glm::vec3 out;
+glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n, float offset_distance) {
+  const glm::vec3 offset = n * offset_distance;
+  glm::vec3 out = p + offset;
   for (int i = 0; i < 3; ++i) {
-    const int offset = static_cast<int>(kIntScale * n[i]);
-    std::int32_t bits;
-    std::memcpy(&bits, &p[i], sizeof(bits));
-    bits += p[i] < 0.0f ? -offset : offset;
-    float moved;
-    std::memcpy(&moved, &bits, sizeof(moved));
-    out[i] = std::fabs(p[i]) < kOrigin ? p[i] + kFloatScale * n[i] : moved;
+    if (offset[i] > 0.0f)
+      out[i] = std::nextafter(out[i], std::numeric_limits<float>::infinity());
+    else if (offset[i] < 0.0f)
+      out[i] = std::nextafter(out[i], -std::numeric_limits<float>::infinity());
   }
   return out;
 }
@@ -74,9 +72,16 @@ SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& h
   const Material& mat = scene.materials[mesh.material];
   SurfacePoint sp;
   sp.material_id = mesh.material;
-  sp.position = ray.origin + ray.direction * hit.t;
   const glm::vec3 p0 = mesh.positions[tri.x], p1 = mesh.positions[tri.y],
                   p2 = mesh.positions[tri.z];
+  // The hit from its barycentrics, not from origin + t * direction: its rounding error then
+  // depends on the triangle's coordinates only, not on how far the ray came (pbrt-v4, 6.8).
+  // The bound gamma(7) * max|p_i| per coordinate covers the sum and the barycentrics'
+  // own rounding (b0 = 1 - u - v); the offset distance is its projection on the normal.
+  sp.position = (1.0f - hit.u - hit.v) * p0 + hit.u * p1 + hit.v * p2;
+  constexpr float kEps = std::numeric_limits<float>::epsilon() * 0.5f;
+  constexpr float kGamma7 = 7.0f * kEps / (1.0f - 7.0f * kEps);
+  const glm::vec3 error = kGamma7 * glm::max(glm::max(glm::abs(p0), glm::abs(p1)), glm::abs(p2));
   glm::vec3 ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
   const bool front = glm::dot(ng, ray.direction) < 0.0f;
   if (!front) ng = -ng;
@@ -126,6 +131,7 @@ SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& h
     }
   }
   sp.geometric_normal = ng;
+  sp.offset_distance = glm::dot(glm::abs(ng), error);
   sp.shading_normal = ns;
   sp.material.base_color = shared::float3(base.x, base.y, base.z);
   sp.material.roughness = roughness;
