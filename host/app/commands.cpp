@@ -62,7 +62,10 @@ Scene load(const CommonArguments& common) {
   const std::string path = common.scene.empty() ? default_scene_path() : common.scene;
   SceneLoadSettings settings;
   settings.asset_root = common.asset_root;
-  return load_quietly([&] { return load_scene(path, settings); });
+  Scene scene = load_quietly([&] { return load_scene(path, settings); });
+  for (const std::string& warning : scene.warnings)
+    std::fprintf(stderr, "rtpg: warning: %s\n", warning.c_str());
+  return scene;
 }
 
 double median(std::vector<double> v) {
@@ -371,6 +374,7 @@ int run_info(const CommonArguments& command) {
               scene.environment.kind == Environment::Kind::None       ? "none"
               : scene.environment.kind == Environment::Kind::Constant ? "constant"
                                                                       : "map");
+  std::printf("degenerate triangles dropped: %zu\n", scene.degenerate_triangles);
   std::printf("bounds: [%g %g %g] - [%g %g %g]\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
   std::printf("camera paths: %zu", scene.camera.paths.size());
   for (const auto& [name, path] : scene.camera.paths) std::printf(" %s", name.c_str());

@@ -1,6 +1,7 @@
 // Image decoding with OpenImageIO: channel expansion, sRGB decoding, errors as InputError.
 #include "scene/image_loader.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -57,6 +58,19 @@ Texture read_opened(OIIO::ImageInput& in, const std::string& name, ImageDecode d
     ok = in.read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, values.data());
   }
   if (!ok) throw InputError(name, reason(in.geterror(), "could not read the pixels"));
+  // Float images (EXR, HDR) can hold NaN and infinities; OIIO passes them on and one such texel
+  // would make every path that sees it NaN. Negative values are clamped to 0: filtering leaves
+  // tiny ones in real maps (hotel_room_1k_blender_interior.exr holds -2e-6).
+  if (!eight_bit)
+    for (std::size_t i = 0; i < count; ++i) {
+      if (!std::isfinite(values[i])) {
+        const std::size_t pixel = i / static_cast<std::size_t>(nch);
+        throw InputError(name, "pixel (" + std::to_string(pixel % spec.width) + ", " +
+                                   std::to_string(pixel / spec.width) + ") channel " +
+                                   std::to_string(i % nch) + " is not finite");
+      }
+      values[i] = std::max(values[i], 0.0f);
+    }
 
   // Which input channel holds alpha: OIIO knows for most formats; a 2- or 4-channel image
   // without that metadata is grey+alpha or RGBA by convention.

@@ -5,7 +5,6 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 
 #include <assimp/Importer.hpp>
@@ -14,6 +13,8 @@
 #include <assimp/scene.h>
 
 #include "scene/assimp_material.h"
+#include "scene/mesh_check.h"
+#include "scene/obj_check.h"
 #include "scene/ply_check.h"
 #include "rtpg/errors.h"
 
@@ -26,26 +27,6 @@ std::string lower_extension(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
-}
-
-// assimp ignores a missing .mtl and silently gives every surface its default grey, which
-// would render a wrong scene without a word: check the mtllib lines ourselves.
-void check_mtllibs(const std::string& obj_path, const std::string& context) {
-  std::ifstream in(obj_path);
-  std::string line;
-  while (std::getline(in, line)) {
-    const std::size_t start = line.find_first_not_of(" \t");
-    if (start == std::string::npos || line.compare(start, 7, "mtllib ") != 0) continue;
-    std::string name = line.substr(start + 7);
-    while (!name.empty() && std::isspace(static_cast<unsigned char>(name.back()))) name.pop_back();
-    name.erase(0, name.find_first_not_of(" \t"));
-    if (name.empty()) continue;
-    const std::filesystem::path mtl = std::filesystem::path(obj_path).parent_path() / name;
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(mtl, ec))
-      throw InputError(mtl.lexically_normal().string(),
-                       "file not found (mtllib of " + obj_path + ", " + context + ")");
-  }
 }
 
 bool finite(const glm::vec3& v) {
@@ -90,7 +71,8 @@ glm::vec3 perpendicular(const glm::vec3& n) {
   return glm::normalize(glm::cross(a, n));
 }
 
-Mesh convert_mesh(const aiMesh& in, const std::string& fallback_name) {
+Mesh convert_mesh(const aiMesh& in, const std::string& fallback_name, const std::string& path,
+                  const std::string& context, std::size_t& degenerate) {
   Mesh mesh;
   mesh.name = in.mName.length > 0 ? in.mName.C_Str() : fallback_name;
   mesh.positions.reserve(in.mNumVertices);
@@ -111,6 +93,8 @@ Mesh convert_mesh(const aiMesh& in, const std::string& fallback_name) {
     if (face.mNumIndices != 3) continue;  // points and lines left over after triangulation
     mesh.triangles.emplace_back(face.mIndices[0], face.mIndices[1], face.mIndices[2]);
   }
+  check_mesh_values(mesh, path, context);
+  degenerate += drop_degenerate_triangles(mesh);
   sanitise_normals(mesh);
 
   // Tangent frames for normal and bump mapping: xyz tangent, w = handedness of the
@@ -141,7 +125,7 @@ MeshFile load_mesh_file(const std::string& path, TextureCache* textures,
   if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found" + where);
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "not a file" + where);
   const std::string ext = lower_extension(path);
-  if (ext == ".obj" && textures) check_mtllibs(path, context);
+  if (ext == ".obj") check_obj(path, context, textures != nullptr);
   if (ext == ".ply") check_ply(path, context);
 
   Assimp::Importer importer;
@@ -169,7 +153,8 @@ MeshFile load_mesh_file(const std::string& path, TextureCache* textures,
   std::map<unsigned, std::uint32_t> material_index;  // assimp index -> out.materials index
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh& in = *scene->mMeshes[m];
-    Mesh mesh = convert_mesh(in, stem + "#" + std::to_string(m));
+    Mesh mesh =
+        convert_mesh(in, stem + "#" + std::to_string(m), path, context, out.degenerate_triangles);
     if (mesh.triangles.empty()) continue;
     if (textures && in.mMaterialIndex < scene->mNumMaterials) {
       auto found = material_index.find(in.mMaterialIndex);
@@ -182,6 +167,7 @@ MeshFile load_mesh_file(const std::string& path, TextureCache* textures,
         } else {
           out.materials.push_back(convert_material(*scene, *scene->mMaterials[in.mMaterialIndex],
                                                    convention, path, *textures, context));
+          check_material_values(out.materials.back(), path, context);
         }
         found =
             material_index
@@ -195,7 +181,12 @@ MeshFile load_mesh_file(const std::string& path, TextureCache* textures,
     }
     out.meshes.push_back(std::move(mesh));
   }
-  if (out.meshes.empty()) throw InputError(path, "the file holds no triangles" + where);
+  if (out.meshes.empty())
+    throw InputError(
+        path, (out.degenerate_triangles > 0
+                   ? "all " + std::to_string(out.degenerate_triangles) + " triangles have zero area"
+                   : std::string("the file holds no triangles")) +
+                  where);
   return out;
 }
 

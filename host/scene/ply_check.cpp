@@ -1,7 +1,10 @@
 // A minimal PLY reader that only walks the file's structure.
 #include "scene/ply_check.h"
 
+#include <cfloat>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
@@ -124,6 +127,7 @@ class PlyChecker {
         } else {
           words >> p.name;
           p.size = type_size(type);
+          p.is_float = is_float_type(type);
           if (p.size == 0) fail("unknown property type '" + type + "'");
         }
         elements_.back().properties.push_back(p);
@@ -143,6 +147,31 @@ class PlyChecker {
   void check_index(double index, std::uint64_t vertices) const {
     if (!(index >= 0.0) || index >= static_cast<double>(vertices))
       fail("a face index is outside the vertex range");
+  }
+
+  // assimp takes NaN, infinities and doubles beyond the float range as they are (and its
+  // vertex joining then merges a NaN vertex into another one, without a word).
+  void check_value(double v, const Element& e, std::uint64_t index, const Property& p) const {
+    if (!std::isfinite(v) || std::fabs(v) > FLT_MAX) {
+      std::ostringstream text;
+      text << "element '" << e.name << "' " << index << ", property '" << p.name << "': " << v
+           << " is not a finite float";
+      throw InputError(path_, text.str() + " (" + context_ + ")");
+    }
+  }
+
+  // A float or double at pos_, in the file's byte order.
+  double read_float(int size) {
+    const auto bits = static_cast<std::uint64_t>(read_integer(size, false));
+    if (size == 4) {
+      float f;
+      const auto b32 = static_cast<std::uint32_t>(bits);
+      std::memcpy(&f, &b32, sizeof(f));
+      return f;
+    }
+    double d;
+    std::memcpy(&d, &bits, sizeof(d));
+    return d;
   }
 
   // assimp's triangulation aborts the process (an assert) on faces of 0 to 2 vertices.
@@ -165,7 +194,8 @@ class PlyChecker {
       for (std::uint64_t i = 0; i < e.count; ++i)
         for (const Property& p : e.properties) {
           if (p.count_size == 0) {
-            next(e);
+            const double v = next(e);
+            if (p.is_float) check_value(v, e, i, p);
             continue;
           }
           const double n = next(e);
@@ -175,6 +205,7 @@ class PlyChecker {
           for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k) {
             const double v = next(e);
             if (is_face_index(e, p)) check_index(v, vertices);
+            if (p.is_float) check_value(v, e, i, p);
           }
         }
   }
@@ -207,17 +238,24 @@ class PlyChecker {
         fixed += static_cast<std::uint64_t>(p.size);
         has_list = has_list || p.count_size > 0;
       }
+      bool has_float = false;
+      for (const Property& p : e.properties) has_float = has_float || p.is_float;
       if (!has_list) {
         if (fixed != 0 && e.count > (data_.size() - pos_) / fixed)
           fail("the file ends inside element '" + e.name + "'");
-        pos_ += static_cast<std::size_t>(fixed * e.count);
-        continue;
+        if (!has_float) {
+          pos_ += static_cast<std::size_t>(fixed * e.count);
+          continue;
+        }
       }
       for (std::uint64_t i = 0; i < e.count; ++i)
         for (const Property& p : e.properties) {
           if (p.count_size == 0) {
             need(static_cast<std::uint64_t>(p.size), e);
-            pos_ += static_cast<std::size_t>(p.size);
+            if (p.is_float)
+              check_value(read_float(p.size), e, i, p);
+            else
+              pos_ += static_cast<std::size_t>(p.size);
             continue;
           }
           need(static_cast<std::uint64_t>(p.count_size), e);
@@ -225,7 +263,12 @@ class PlyChecker {
           const double n = read_integer(p.count_size, false);
           if (is_face_index(e, p)) check_face_size(n);
           need(static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(p.size), e);
-          if (!is_face_index(e, p) || p.is_float) {
+          if (p.is_float) {
+            for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k)
+              check_value(read_float(p.size), e, i, p);
+            continue;
+          }
+          if (!is_face_index(e, p)) {
             pos_ += static_cast<std::size_t>(n) * static_cast<std::size_t>(p.size);
             continue;
           }

@@ -7,7 +7,8 @@
 namespace rtpg {
 
 // Throws InputError(path, problem (context)) unless the header is well formed and the body
-// holds every element the header announces, with face indices inside the vertex range.
+// holds every element the header announces, with face indices inside the vertex range and
+// every float or double value finite and inside the float range.
 void check_ply(const std::string& path, const std::string& context);
 
 }  // namespace rtpg

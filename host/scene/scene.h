@@ -3,6 +3,7 @@
 // the lights (light sampling) and the renderer. Knows nothing of Embree or OpenCL.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -80,6 +81,8 @@ struct Scene {
   Environment environment;
   CameraSetup camera;
   int max_bounces = 0;  // the scene's "integrator.max_bounces"; 0 = the renderer's default
+  std::size_t degenerate_triangles = 0;  // zero-area triangles the loader dropped
+  std::vector<std::string> warnings;     // what the loader accepted but the user should know
 
   std::size_t triangle_count() const;
   glm::vec3 bounds_min() const;

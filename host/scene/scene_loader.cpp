@@ -2,6 +2,7 @@
 // assembly of the Scene and the checks that make a scene renderable.
 #include "scene/scene_loader.h"
 
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -203,7 +204,14 @@ class SceneBuilder {
   }
 
   void add_mesh(Mesh mesh, const JsonNode& entry) {
-    if (entry.has("transform")) transform_mesh(mesh, read_transform(entry.child("transform")));
+    if (entry.has("transform")) {
+      const JsonNode transform = entry.child("transform");
+      transform_mesh(mesh, read_transform(transform));
+      // A large scale can carry finite coordinates past the float range.
+      for (const glm::vec3& p : mesh.positions)
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+          transform.fail("moves a vertex of mesh '" + mesh.name + "' outside the float range");
+    }
     scene_.meshes.push_back(std::move(mesh));
   }
 
@@ -215,6 +223,12 @@ class SceneBuilder {
     const bool replace = entry.has("material");
     const std::uint32_t replacement = replace ? named_material(entry.child("material")) : 0;
     MeshFile loaded = load_mesh_file(mesh_path, replace ? nullptr : &cache_, context(file));
+    if (loaded.degenerate_triangles > 0) {
+      scene_.degenerate_triangles += loaded.degenerate_triangles;
+      scene_.warnings.push_back(mesh_path + ": dropped " +
+                                std::to_string(loaded.degenerate_triangles) +
+                                " triangles of zero area (" + context(file) + ")");
+    }
     const auto offset = static_cast<std::uint32_t>(scene_.materials.size());
     if (!replace)
       scene_.materials.insert(scene_.materials.end(), loaded.materials.begin(),

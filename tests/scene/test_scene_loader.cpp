@@ -11,6 +11,7 @@
 #include <functional>
 #include <initializer_list>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -24,43 +25,18 @@
 #include "scene/scene_loader.h"
 #include "scene/texture.h"
 #include "rtpg/errors.h"
+#include "support/scene_files.h"
 
 namespace fs = std::filesystem;
 
 namespace rtpg {
 namespace {
 
+using test::expect_input_error;
+using test::TempDir;
+using test::write_file;
+
 // ---- helpers -------------------------------------------------------------------------------
-
-// A fresh folder per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ =
-        fs::temp_directory_path() / ("rtpg_scene_" + std::string(info ? info->name() : "x") + "_" +
-                                     std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string operator/(const std::string& name) const { return (path_ / name).string(); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-void write_file(const std::string& path, const std::string& content) {
-  fs::create_directories(fs::path(path).parent_path());
-  std::ofstream out(path, std::ios::binary);
-  out << content;
-  ASSERT_TRUE(out.good()) << path;
-}
 
 // An 8-bit image with `channels` channels; pixel(x, y, c) gives the byte values.
 void write_png(const std::string& path, int w, int h, int channels,
@@ -88,19 +64,6 @@ void write_float_image(const std::string& path, int w, int h, float value) {
   ASSERT_TRUE(out->open(path, spec)) << out->geterror();
   ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, data.data())) << out->geterror();
   out->close();
-}
-
-// Runs `f`, expects an InputError whose message contains every one of `parts`.
-void expect_input_error(const std::function<void()>& f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError thrown";
-  } catch (const InputError& e) {
-    const std::string message = e.what();
-    for (const std::string& part : parts)
-      EXPECT_NE(message.find(part), std::string::npos)
-          << "message \"" << message << "\" lacks \"" << part << "\"";
-  }
 }
 
 void expect_vec3_near(const glm::vec3& a, const glm::vec3& b, float eps = 1e-5f) {
@@ -737,6 +700,25 @@ TEST(SceneLoaderErrors, MissingEnvironmentMap) {
     "shapes": [{"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "m"}]})");
   expect_input_error([&] { load_scene(dir / "s.json"); },
                      {"s.json", "environment.file", "envmaps/none.hdr", "not found"});
+}
+
+// OIIO hands float images over as stored: a NaN or infinite texel must be refused, a tiny
+// negative one (filtering leftovers in real EXRs) clamped to 0.
+TEST(SceneLoaderErrors, NonFiniteEnvironmentMapTexel) {
+  for (const float bad :
+       {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    TempDir dir;
+    write_float_image(dir / "sky.exr", 4, 2, bad);
+    write_file(dir / "s.json", std::string("{") + kCamera + R"(,
+      "environment": {"file": "sky.exr"}, "materials": {"m": {}},
+      "shapes": [{"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "m"}]})");
+    expect_input_error([&] { load_scene(dir / "s.json"); },
+                       {"sky.exr", "pixel (0, 0) channel 0 is not finite"});
+  }
+  TempDir dir;
+  write_float_image(dir / "sky.exr", 4, 2, -1e-6f);
+  const Texture t = load_image(dir / "sky.exr", ImageDecode{false, false});
+  for (const glm::vec4& texel : t.texels) EXPECT_EQ(texel.x, 0.0f);
 }
 
 }  // namespace

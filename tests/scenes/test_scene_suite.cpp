@@ -21,28 +21,29 @@
 namespace rtpg {
 namespace {
 
-// What `rtpg info` prints for each scene file (triangles, materials, textures, lights). The
+// What `rtpg info` prints for each scene file (triangles, the zero-area triangles the loader
+// dropped, materials, textures, lights). The
 // texture count is that of distinct (file, decoding) pairs: each is decoded once (Sponza's 25
 // materials name 37 distinct maps; sponza-sky adds its environment map).
 struct Expected {
   const char* file;
-  std::size_t triangles, materials, textures, emissive_triangles;
+  std::size_t triangles, degenerate, materials, textures, emissive_triangles;
   bool sun;
   Environment::Kind environment;
   const char* camera_path;
 };
 
 const Expected kScenes[] = {
-    {"cornell-box.json", 36, 4, 0, 2, false, Environment::Kind::None, "pan"},
-    {"cornell-indirect.json", 38, 4, 0, 2, false, Environment::Kind::None, "pan"},
-    {"cornell-glossy.json", 1112, 8, 0, 2, false, Environment::Kind::None, "pan"},
-    {"slit-room.json", 62, 3, 0, 2, false, Environment::Kind::None, "pan"},
-    {"corridor.json", 22, 3, 0, 2, false, Environment::Kind::None, "pan"},
-    {"sunlit-room.json", 42, 2, 0, 0, true, Environment::Kind::Constant, "pan"},
-    {"sponza.json", 262267, 25, 37, 0, true, Environment::Kind::Constant, "walk"},
-    {"sponza-glossy.json", 262267, 25, 37, 0, true, Environment::Kind::Constant, "walk"},
-    {"sponza-sky.json", 262267, 25, 38, 0, false, Environment::Kind::Map, "walk"},
-    {"veach-ajar.json", 382690, 13, 3, 2, false, Environment::Kind::None, "pan"},
+    {"cornell-box.json", 36, 0, 4, 0, 2, false, Environment::Kind::None, "pan"},
+    {"cornell-indirect.json", 38, 0, 4, 0, 2, false, Environment::Kind::None, "pan"},
+    {"cornell-glossy.json", 1112, 0, 8, 0, 2, false, Environment::Kind::None, "pan"},
+    {"slit-room.json", 62, 0, 3, 0, 2, false, Environment::Kind::None, "pan"},
+    {"corridor.json", 22, 0, 3, 0, 2, false, Environment::Kind::None, "pan"},
+    {"sunlit-room.json", 42, 0, 2, 0, 0, true, Environment::Kind::Constant, "pan"},
+    {"sponza.json", 262035, 232, 25, 37, 0, true, Environment::Kind::Constant, "walk"},
+    {"sponza-glossy.json", 262035, 232, 25, 37, 0, true, Environment::Kind::Constant, "walk"},
+    {"sponza-sky.json", 262035, 232, 25, 38, 0, false, Environment::Kind::Map, "walk"},
+    {"veach-ajar.json", 382628, 62, 13, 3, 2, false, Environment::Kind::None, "pan"},
 };
 
 // gtest prints a parameter in test listings: the file name, not its bytes.
@@ -134,6 +135,7 @@ TEST_P(SceneSuite, LoadsAndRenders) {
   for (const Mesh& m : scene.meshes)
     if (scene.materials[m.material].is_emissive()) emissive += m.triangles.size();
   EXPECT_EQ(scene.triangle_count(), e.triangles) << e.file;
+  EXPECT_EQ(scene.degenerate_triangles, e.degenerate) << e.file;
   EXPECT_EQ(scene.materials.size(), e.materials) << e.file;
   EXPECT_EQ(scene.textures.size(), e.textures) << e.file;
   EXPECT_EQ(emissive, e.emissive_triangles) << e.file;
