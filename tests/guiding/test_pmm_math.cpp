@@ -17,6 +17,7 @@
 #include "shared/pmm.h"
 #include "shared/rng.h"
 #include "support/chi_square.h"
+#include "support/pmm_checks.h"
 
 using namespace rtpg::shared;
 
@@ -50,20 +51,7 @@ Cov model_covariance(const pg_pmm_model& m) {
           double(m.l11) * m.l21};
 }
 
-// The model's properties every state must give: a usable Cholesky factor, pi within its
-// clamps and the mean inside the square.
-::testing::AssertionResult model_is_sane(const pg_pmm_model& m, const pg_kernel_settings& p) {
-  if (!m.valid) return ::testing::AssertionSuccess();
-  if (!(m.l11 > 0.0f) || !(m.l22 > 0.0f) || !std::isfinite(m.l11) || !std::isfinite(m.l22) ||
-      !std::isfinite(m.l21))
-    return ::testing::AssertionFailure()
-           << "Cholesky factor l11=" << m.l11 << " l21=" << m.l21 << " l22=" << m.l22;
-  if (!(m.pi >= p.pi_min && m.pi <= p.pi_max))
-    return ::testing::AssertionFailure() << "pi=" << m.pi;
-  if (!(m.mx >= 0.0f && m.mx <= 1.0f && m.my >= 0.0f && m.my <= 1.0f))
-    return ::testing::AssertionFailure() << "mean " << m.mx << "," << m.my;
-  return ::testing::AssertionSuccess();
-}
+using rtpg::test::model_is_sane;
 
 // ---- sampler against density -------------------------------------------------------------
 
