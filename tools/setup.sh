@@ -15,6 +15,10 @@ DEBIAN_PACKAGES=(
   python3 python3-pip python3-venv
 )
 
+# More for one job (tools/fuzz.sh: clang and libFuzzer), space-separated.
+read -r -a EXTRA <<< "${RTPG_EXTRA_PACKAGES:-}"
+DEBIAN_PACKAGES+=("${EXTRA[@]}")
+
 missing=()
 for p in "${DEBIAN_PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -112,8 +112,8 @@ void expect_density_integrates_to_valid_fraction(const char* name, const pg_pmm_
   }
   const double f = static_cast<double>(produced) / attempts;
   const double sd = std::sqrt(std::max(f * (1.0 - f), 1e-12) / attempts);
-  std::printf("%s: density integral %.5f, valid fraction %.5f (sd %.1e), pi %.3f\n", name,
-              integral, f, sd, m.pi);
+  std::printf("%s: density integral %.5f, valid fraction %.5f (sd %.1e), pi %.3f\n", name, integral,
+              f, sd, m.pi);
   EXPECT_NEAR(integral, f, 5.0 * sd + 1e-3)
       << name << ": model pi " << m.pi << " mean (" << m.mx << ", " << m.my << ") L (" << m.l11
       << ", " << m.l21 << ", " << m.l22 << ")";

@@ -11,6 +11,8 @@ endif()
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples/minimal_guiding
                         -B ${WORK_DIR}/build -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
                         -DCMAKE_BUILD_TYPE=Release
+                        # A sanitized rtpg (RTPG_SANITIZE) needs its runtime in the example too.
+                        -DCMAKE_CXX_FLAGS=${EXAMPLE_FLAGS} -DCMAKE_EXE_LINKER_FLAGS=${EXAMPLE_FLAGS}
                 RESULT_VARIABLE rc)
 if(rc)
   message(FATAL_ERROR "configuring the example against the install tree failed (${rc})")
