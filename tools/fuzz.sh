@@ -11,5 +11,7 @@ RTPG_EXTRA_PACKAGES="clang libclang-rt-14-dev" bash tools/setup.sh
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRTPG_FUZZ=ON \
   -DRTPG_BUILD_BENCH=OFF -DRTPG_FUZZ_SECONDS="$SECONDS_EACH" >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target fuzz_scene_json fuzz_obj fuzz_mtl fuzz_ply
+export LSAN_OPTIONS="suppressions=$PWD/tools/lsan.supp:print_suppressions=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 cd build-fuzz
 ctest --output-on-failure -j"$(nproc)" -L fuzz --timeout $((SECONDS_EACH * 2 + 120))

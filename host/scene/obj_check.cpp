@@ -143,13 +143,20 @@ void for_each_statement(const std::string& path, const std::string& context, Vis
 
 void check_mtl(const std::string& path, const std::string& context) {
   std::string material;
+  bool in_material = false;
   for_each_statement(path, context, [&](std::size_t line, const std::string& text) {
     const std::vector<std::string> t = split(text);
+    if (t.empty()) return;  // whitespace before a comment
     if (t[0] == "newmtl") {
       material = t.size() > 1 ? t[1] : "";
+      in_material = true;
       return;
     }
     Place at{path, context, line, material};
+    // assimp 5.2.5 writes through a null material for a texture statement before the first
+    // newmtl (a crash found by fuzzing: tests/fuzz/corpus/mtl/texture-before-newmtl.mtl), and
+    // a statement that belongs to no material means nothing anyway.
+    if (!in_material) at.fail("'" + t[0].substr(0, 24) + "' before the first newmtl");
     check_mtl_statement(t, at);
   });
 }

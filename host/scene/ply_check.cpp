@@ -124,6 +124,9 @@ class PlyChecker {
           p.is_signed = is_signed_type(item_type);
           p.is_float = is_float_type(item_type);
           if (p.count_size == 0 || p.size == 0) fail("bad list property '" + p.name + "'");
+          // A length typed float or double could exceed every integer (found by fuzzing).
+          if (is_float_type(count_type) || p.count_size > 4)
+            fail("list property '" + p.name + "' has a length of type " + count_type);
         } else {
           words >> p.name;
           p.size = type_size(type);
@@ -162,7 +165,7 @@ class PlyChecker {
 
   // A float or double at pos_, in the file's byte order.
   double read_float(int size) {
-    const auto bits = static_cast<std::uint64_t>(read_integer(size, false));
+    const std::uint64_t bits = read_bits(size);
     if (size == 4) {
       float f;
       const auto b32 = static_cast<std::uint32_t>(bits);
@@ -199,7 +202,7 @@ class PlyChecker {
             continue;
           }
           const double n = next(e);
-          if (!(n >= 0.0) || n != static_cast<double>(static_cast<std::uint64_t>(n)))
+          if (!(n >= 0.0 && n < 4294967296.0) || n != std::floor(n))
             fail("a bad list length in element '" + e.name + "'");
           if (is_face_index(e, p)) check_face_size(n);
           for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k) {
@@ -211,7 +214,8 @@ class PlyChecker {
   }
 
   // An unsigned or signed integer of `size` bytes at pos_, in the file's byte order.
-  double read_integer(int size, bool is_signed) {
+  // The `size` bytes at pos_ as an unsigned integer, in the file's byte order.
+  std::uint64_t read_bits(int size) {
     std::uint64_t bits = 0;
     for (int b = 0; b < size; ++b) {
       const auto byte = static_cast<unsigned char>(data_[pos_ + static_cast<std::size_t>(b)]);
@@ -219,6 +223,11 @@ class PlyChecker {
       bits |= static_cast<std::uint64_t>(byte) << shift;
     }
     pos_ += static_cast<std::size_t>(size);
+    return bits;
+  }
+
+  double read_integer(int size, bool is_signed) {
+    const std::uint64_t bits = read_bits(size);
     if (is_signed && size < 8 && (bits >> (8 * size - 1)) & 1u)
       return static_cast<double>(static_cast<std::int64_t>(bits) - (std::int64_t{1} << (8 * size)));
     return static_cast<double>(bits);

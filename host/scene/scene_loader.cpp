@@ -97,9 +97,10 @@ nlohmann::json parse_file(const std::string& path) {
   try {
     DuplicateKeyCheck check(path);
     return nlohmann::json::parse(text.str(), std::ref(check));
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
     // e.what() is "[json.exception.parse_error.101] parse error at line 3, column 7: ...":
-    // keep the part a user needs.
+    // keep the part a user needs. Not only parse errors: a number beyond the double range is
+    // out_of_range.406 (found by fuzzing, tests/fuzz/corpus/scene_json/number-overflow.json).
     std::string message = e.what();
     const std::size_t bracket = message.find("] ");
     if (message.rfind("[json.exception", 0) == 0 && bracket != std::string::npos)

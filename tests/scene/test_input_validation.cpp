@@ -113,6 +113,27 @@ TEST(InputValidation, BadMtlValuesNameTheMaterialAndLine) {
   }
 }
 
+// assimp 5.2.5 crashes (a write through a null material) on a texture statement before the
+// first newmtl; found by fuzzing. The check refuses every statement there.
+TEST(InputValidation, MtlStatementBeforeTheFirstNewmtl) {
+  for (const char* mtl : {"map_Kd t.png\nnewmtl grey\n", "map_d9\n\n", "Kd 1 1 1\n"}) {
+    SCOPED_TRACE(mtl);
+    expect_obj_refused("v 0 0 0\n", mtl, {"m.mtl", "line 1", "before the first newmtl"});
+  }
+}
+
+// A PLY list whose length is typed double could claim more items than any integer holds
+// (undefined behaviour in the check itself, found by fuzzing).
+TEST(InputValidation, PlyListLengthOfAFloatType) {
+  TempDir dir;
+  write_file(dir / "d.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+             "property float z\nelement face 1\nproperty list double int vertex_indices\n"
+             "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const std::string scene = write_scene(dir, "d.ply");
+  expect_input_error([&] { load_scene(scene); }, {"d.ply", "has a length of type double"});
+}
+
 TEST(InputValidation, TrailingCommentsAndOtherForms) {
   TempDir dir;
   write_file(dir / "m.obj", std::string("mtllib m.mtl\n") + "v 0 0 0 # origin\n" +

@@ -563,6 +563,15 @@ TEST(SceneLoaderErrors, MalformedJsonGivesLineAndColumn) {
   expect_input_error([&] { load_scene(dir / "bad.json"); }, {"bad.json", "line 3", "column"});
 }
 
+// nlohmann reports a number beyond the double range as out_of_range, not parse_error (found by
+// fuzzing): still a one-line InputError, not an escaped exception.
+TEST(SceneLoaderErrors, NumberBeyondTheDoubleRange) {
+  TempDir dir;
+  write_file(dir / "huge.json", "{\"camera\": {\"fov\": 5E5555}}");
+  expect_input_error([&] { load_scene(dir / "huge.json"); },
+                     {"huge.json", "invalid JSON", "number overflow"});
+}
+
 TEST(SceneLoaderErrors, UnknownKeyIsNamed) {
   TempDir dir;
   write_file(dir / "unknown.json", simple_scene(R"("meshes": [{"fiel": "x.obj"}],)"));
