@@ -83,6 +83,11 @@ class PlyChecker {
     std::string line = data_.substr(pos_, end - pos_);
     pos_ = end + 1;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    // The header is printable ASCII. We split words at any whitespace, assimp at spaces and
+    // tabs only: a vertical tab before "property" hid the property from assimp, which then
+    // read a misaligned body and aborted (found by fuzzing).
+    for (const char c : line)
+      if ((c < 0x20 || c > 0x7e) && c != '\t') fail("a control or non-ASCII byte in the header");
     return line;
   }
 
@@ -133,12 +138,31 @@ class PlyChecker {
           p.is_float = is_float_type(type);
           if (p.size == 0) fail("unknown property type '" + type + "'");
         }
+        // assimp 5.2.5 misreads a body whose properties have no name and then aborts in its
+        // triangulation (an assert; found by fuzzing).
+        if (p.name.empty()) fail("a property without a name");
         elements_.back().properties.push_back(p);
       } else {
         fail("unknown header keyword '" + keyword + "'");
       }
     }
     if (!have_format) fail("the header has no format line");
+    // assimp 5.2.5 builds faces without indices from a face element whose list has another
+    // name, and then aborts in its triangulation (an assert; found by fuzzing): faces need
+    // their index list, vertices their position.
+    for (const Element& e : elements_) {
+      if (e.name == "face" && e.count > 0) {
+        bool indexed = false;
+        for (const Property& p : e.properties) indexed = indexed || is_face_index(e, p);
+        if (!indexed) fail("element 'face' has no vertex_indices list");
+      }
+      if (e.name == "vertex" && e.count > 0)
+        for (const char* axis : {"x", "y", "z"}) {
+          bool found = false;
+          for (const Property& p : e.properties) found = found || p.name == axis;
+          if (!found) fail(std::string("element 'vertex' has no property '") + axis + "'");
+        }
+    }
   }
 
   std::uint64_t vertex_count() const {
@@ -182,38 +206,51 @@ class PlyChecker {
     if (n < 3.0) fail("a face with fewer than 3 vertices");
   }
 
+  // ASCII bodies hold one element per line (assimp reads them line by line: an element split
+  // over two lines shifted every later one, and a face read from a vertex line had no
+  // indices, which aborts assimp's triangulation; found by fuzzing).
   void walk_ascii() {
     std::istringstream body(data_.substr(pos_));
     const std::uint64_t vertices = vertex_count();
+    std::string line_text;
+    std::istringstream line;
     std::string token;
-    auto next = [&](const Element& e) {
-      if (!(body >> token)) fail("the file ends inside element '" + e.name + "'");
-      char* end = nullptr;
-      const double v = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0') fail("'" + token + "' is not a number");
-      return v;
-    };
     for (const Element& e : elements_)
-      for (std::uint64_t i = 0; i < e.count; ++i)
+      for (std::uint64_t i = 0; i < e.count; ++i) {
+        do {
+          if (!std::getline(body, line_text)) fail("the file ends inside element '" + e.name + "'");
+        } while (line_text.find_first_not_of(" \t\r") == std::string::npos);
+        line.clear();
+        line.str(line_text);
+        auto next = [&]() {
+          if (!(line >> token))
+            fail("element '" + e.name + "' " + std::to_string(i) + " has too few values");
+          char* end = nullptr;
+          const double v = std::strtod(token.c_str(), &end);
+          if (end == token.c_str() || *end != '\0') fail("'" + token + "' is not a number");
+          return v;
+        };
         for (const Property& p : e.properties) {
           if (p.count_size == 0) {
-            const double v = next(e);
+            const double v = next();
             if (p.is_float) check_value(v, e, i, p);
             continue;
           }
-          const double n = next(e);
+          const double n = next();
           if (!(n >= 0.0 && n < 4294967296.0) || n != std::floor(n))
             fail("a bad list length in element '" + e.name + "'");
           if (is_face_index(e, p)) check_face_size(n);
           for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k) {
-            const double v = next(e);
+            const double v = next();
             if (is_face_index(e, p)) check_index(v, vertices);
             if (p.is_float) check_value(v, e, i, p);
           }
         }
+        if (line >> token)
+          fail("element '" + e.name + "' " + std::to_string(i) + " has too many values");
+      }
   }
 
-  // An unsigned or signed integer of `size` bytes at pos_, in the file's byte order.
   // The `size` bytes at pos_ as an unsigned integer, in the file's byte order.
   std::uint64_t read_bits(int size) {
     std::uint64_t bits = 0;
