@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 namespace rtpg {
@@ -75,9 +74,10 @@ SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& h
   const glm::vec3 p0 = mesh.positions[tri.x], p1 = mesh.positions[tri.y],
                   p2 = mesh.positions[tri.z];
   // The hit from its barycentrics, not from origin + t * direction: its rounding error then
-  // depends on the triangle's coordinates only, not on how far the ray came (pbrt-v4, 6.8).
+  // depends on the triangle's coordinates only, not on how far the ray came.
   // The bound gamma(7) * max|p_i| per coordinate covers the sum and the barycentrics'
-  // own rounding (b0 = 1 - u - v); the offset distance is its projection on the normal.
+  // own rounding (b0 = 1 - u - v); the offset distance is its projection on the normal
+  // (docs/robustness.md, "Scale invariance").
   sp.position = (1.0f - hit.u - hit.v) * p0 + hit.u * p1 + hit.v * p2;
   constexpr float kEps = std::numeric_limits<float>::epsilon() * 0.5f;
   constexpr float kGamma7 = 7.0f * kEps / (1.0f - 7.0f * kEps);
