@@ -9,10 +9,6 @@
 namespace rtpg {
 namespace {
 
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
 std::string vec_text(const glm::vec3& v) {
   char text[96];
   std::snprintf(text, sizeof(text), "(%g %g %g)", v.x, v.y, v.z);
@@ -21,12 +17,16 @@ std::string vec_text(const glm::vec3& v) {
 
 }  // namespace
 
+bool all_finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
 std::size_t drop_degenerate_triangles(Mesh& mesh) {
   std::size_t kept = 0;
   for (const glm::uvec3& t : mesh.triangles) {
     const glm::vec3 c = glm::cross(mesh.positions[t.y] - mesh.positions[t.x],
                                    mesh.positions[t.z] - mesh.positions[t.x]);
-    if (finite(c) && glm::dot(c, c) > 0.0f) mesh.triangles[kept++] = t;
+    if (all_finite(c) && glm::dot(c, c) > 0.0f) mesh.triangles[kept++] = t;
   }
   const std::size_t dropped = mesh.triangles.size() - kept;
   mesh.triangles.resize(kept);
@@ -38,7 +38,7 @@ void check_mesh_values(const Mesh& mesh, const std::string& file, const std::str
     throw InputError(file, "mesh '" + mesh.name + "': " + problem + " (" + context + ")");
   };
   for (std::size_t i = 0; i < mesh.positions.size(); ++i)
-    if (!finite(mesh.positions[i]))
+    if (!all_finite(mesh.positions[i]))
       fail("vertex " + std::to_string(i) + " at " + vec_text(mesh.positions[i]) + " is not finite");
   for (std::size_t i = 0; i < mesh.uvs.size(); ++i)
     if (!std::isfinite(mesh.uvs[i].x) || !std::isfinite(mesh.uvs[i].y))

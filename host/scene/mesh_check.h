@@ -10,6 +10,9 @@
 
 namespace rtpg {
 
+// Every component finite (no NaN, no infinity).
+bool all_finite(const glm::vec3& v);
+
 // Drops the triangles whose edge cross product is zero or not finite (repeated or collinear
 // vertices); returns how many it dropped.
 std::size_t drop_degenerate_triangles(Mesh& mesh);

@@ -29,10 +29,6 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-bool finite(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
 // Normals from files can be unnormalised, zero or NaN (assimp writes NaN/zero for degenerate
 // faces); shading would turn those into NaN radiance. Unusable ones take the geometric
 // normal of a triangle that uses the vertex.
@@ -43,7 +39,7 @@ void sanitise_normals(Mesh& mesh) {
   for (std::size_t i = 0; i < mesh.normals.size(); ++i) {
     glm::vec3& n = mesh.normals[i];
     const float len2 = glm::dot(n, n);
-    if (!finite(n) || !(len2 > 1e-20f)) {
+    if (!all_finite(n) || !(len2 > 1e-20f)) {
       bad[i] = any_bad = true;
     } else {
       n /= std::sqrt(len2);
@@ -54,7 +50,7 @@ void sanitise_normals(Mesh& mesh) {
     const glm::vec3 g = glm::cross(mesh.positions[t.y] - mesh.positions[t.x],
                                    mesh.positions[t.z] - mesh.positions[t.x]);
     const float len2 = glm::dot(g, g);
-    if (!finite(g) || !(len2 > 0.0f)) continue;
+    if (!all_finite(g) || !(len2 > 0.0f)) continue;
     for (int k = 0; k < 3; ++k)
       if (bad[t[k]]) {
         mesh.normals[t[k]] = g / std::sqrt(len2);
@@ -108,8 +104,8 @@ Mesh convert_mesh(const aiMesh& in, const std::string& fallback_name, const std:
       const glm::vec3 b(in.mBitangents[i].x, in.mBitangents[i].y, in.mBitangents[i].z);
       t -= n * glm::dot(n, t);  // Gram-Schmidt against the (sanitised) normal
       const float len2 = glm::dot(t, t);
-      t = finite(t) && len2 > 1e-20f ? t / std::sqrt(len2) : perpendicular(n);
-      const float w = finite(b) && glm::dot(glm::cross(n, t), b) < 0.0f ? -1.0f : 1.0f;
+      t = all_finite(t) && len2 > 1e-20f ? t / std::sqrt(len2) : perpendicular(n);
+      const float w = all_finite(b) && glm::dot(glm::cross(n, t), b) < 0.0f ? -1.0f : 1.0f;
       mesh.tangents.emplace_back(t, w);
     }
   }

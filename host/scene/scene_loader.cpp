@@ -2,7 +2,6 @@
 // assembly of the Scene and the checks that make a scene renderable.
 #include "scene/scene_loader.h"
 
-#include <cmath>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -17,6 +16,7 @@
 #include "scene/camera_json.h"
 #include "scene/json_reader.h"
 #include "scene/material_json.h"
+#include "scene/mesh_check.h"
 #include "scene/mesh_loader.h"
 #include "scene/mesh_transform.h"
 #include "scene/shapes.h"
@@ -210,7 +210,7 @@ class SceneBuilder {
       transform_mesh(mesh, read_transform(transform));
       // A large scale can carry finite coordinates past the float range.
       for (const glm::vec3& p : mesh.positions)
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        if (!all_finite(p))
           transform.fail("moves a vertex of mesh '" + mesh.name + "' outside the float range");
     }
     scene_.meshes.push_back(std::move(mesh));

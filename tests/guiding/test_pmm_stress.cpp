@@ -136,6 +136,13 @@ float4 sample_at(float a, float2 u) {
   return float4(a, u.x, u.y, bsdf_pdf_at(u));
 }
 
+// A point drawn around c by `spread`, clamped into the square (x drawn before y: the order of
+// a call's arguments is unspecified).
+float2 clamped_around(float2 c, std::normal_distribution<float>& spread, std::mt19937& gen) {
+  const float dx = spread(gen), dy = spread(gen);
+  return float2(std::clamp(c.x + dx, 0.0f, 1.0f), std::clamp(c.y + dy, 0.0f, 1.0f));
+}
+
 }  // namespace
 
 TEST(PmmStress, WeightsOverSixtyDecades) {
@@ -187,9 +194,7 @@ TEST(PmmStress, AlternatingFarApartSources) {
         const float2 c = step % 2 ? float2(0.05f, 0.05f) : float2(0.95f, 0.95f);
         const float a = step % 2 ? 1e4f : 1e-2f;
         for (float4& x : out) {
-          const float2 v(std::clamp(c.x + n(gen), 0.0f, 1.0f),
-                         std::clamp(c.y + n(gen), 0.0f, 1.0f));
-          x = sample_at(a, v);
+          x = sample_at(a, clamped_around(c, n, gen));
         }
       },
       1000000, pg_pmm_initial_state(), 999000);
@@ -227,9 +232,7 @@ TEST(PmmStress, AtKMaxForAHundredThousandFrames) {
         const float angle = 2.0f * PG_PI * static_cast<float>(step) / 5000.0f;
         std::normal_distribution<float> n(0.0f, 0.03f);
         const float2 c(0.5f + 0.35f * std::cos(angle), 0.5f + 0.35f * std::sin(angle));
-        for (float4& x : out)
-          x = sample_at(1.0f, float2(std::clamp(c.x + n(gen), 0.0f, 1.0f),
-                                     std::clamp(c.y + n(gen), 0.0f, 1.0f)));
+        for (float4& x : out) x = sample_at(1.0f, clamped_around(c, n, gen));
       },
       100000, mature, 100000);
 }
