@@ -101,8 +101,12 @@ class PlyChecker {
       if (keyword == "end_header") break;
       if (keyword == "comment" || keyword == "obj_info" || keyword.empty()) continue;
       if (keyword == "format") {
+        // Two format lines make assimp 5.2.5 read the body in one format and triangulate it as
+        // the other, ending in an assert (found by fuzzing); the PLY header has exactly one.
+        if (have_format) fail("a second format line");
         std::string format, version;
         words >> format >> version;
+        if (version != "1.0") fail("format version '" + version + "' (only 1.0 exists)");
         if (format == "ascii")
           format_ = Format::Ascii;
         else if (format == "binary_little_endian")
@@ -220,6 +224,11 @@ class PlyChecker {
         do {
           if (!std::getline(body, line_text)) fail("the file ends inside element '" + e.name + "'");
         } while (line_text.find_first_not_of(" \t\r") == std::string::npos);
+        // assimp reads the line as a C string: a NUL ends it early, and the rest of the element
+        // shifts into the next one (a triangulation assert; found by fuzzing). Text only.
+        for (const char c : line_text)
+          if ((c < 0x20 || c > 0x7e) && c != '\t' && c != '\r')
+            fail("a control or non-ASCII byte in element '" + e.name + "' " + std::to_string(i));
         line.clear();
         line.str(line_text);
         auto next = [&]() {
@@ -227,7 +236,8 @@ class PlyChecker {
             fail("element '" + e.name + "' " + std::to_string(i) + " has too few values");
           char* end = nullptr;
           const double v = std::strtod(token.c_str(), &end);
-          if (end == token.c_str() || *end != '\0') fail("'" + token + "' is not a number");
+          if (end != token.c_str() + token.size() || token.empty())
+            fail("'" + token + "' is not a number");
           return v;
         };
         for (const Property& p : e.properties) {

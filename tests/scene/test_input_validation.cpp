@@ -134,6 +134,38 @@ TEST(InputValidation, PlyListLengthOfAFloatType) {
   expect_input_error([&] { load_scene(scene); }, {"d.ply", "has a length of type double"});
 }
 
+// A PLY header has exactly one format line, of version 1.0; with two, assimp 5.2.5 reads the
+// body in one format and asserts while triangulating it (found by fuzzing).
+TEST(InputValidation, PlyFormatLineOnceAndVersionOne) {
+  TempDir dir;
+  const std::string body =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  write_file(dir / "two.ply", "ply\nformat ascii 1.0\nformat binary_little_endian 1.0\n" + body);
+  expect_input_error([&] { load_scene(write_scene(dir, "two.ply")); },
+                     {"two.ply", "a second format line"});
+  write_file(dir / "v2.ply", "ply\nformat ascii 2.0\n" + body);
+  expect_input_error([&] { load_scene(write_scene(dir, "v2.ply")); },
+                     {"v2.ply", "format version '2.0'"});
+  write_file(dir / "good.ply", "ply\nformat ascii 1.0\n" + body);
+  EXPECT_NO_THROW(load_scene(write_scene(dir, "good.ply")));
+}
+
+// An ASCII PLY body is text: assimp 5.2.5 stops reading a line at a NUL byte, shifts the rest
+// of the element into the next and asserts while triangulating (found by fuzzing).
+TEST(InputValidation, PlyAsciiBodyWithANulByte) {
+  TempDir dir;
+  std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0";
+  ply += std::string("\0\x01 1\n3 0 1 2\n", 13);
+  write_file(dir / "nul.ply", ply);
+  expect_input_error([&] { load_scene(write_scene(dir, "nul.ply")); },
+                     {"nul.ply", "a control or non-ASCII byte in element 'vertex' 2"});
+}
+
 TEST(InputValidation, TrailingCommentsAndOtherForms) {
   TempDir dir;
   write_file(dir / "m.obj", std::string("mtllib m.mtl\n") + "v 0 0 0 # origin\n" +
