@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <string>
@@ -135,6 +136,15 @@ void for_each_statement(const std::string& path, const std::string& context, Vis
   std::size_t number = 0;
   while (std::getline(in, line)) {
     ++number;
+    // OBJ and MTL are text. assimp 5.2.5 reads a NUL as the end of its buffer and then reads
+    // past the MTL's end (a crash, found by fuzzing), even inside a comment.
+    for (const char c : line)
+      if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\r') {
+        char code[8];
+        std::snprintf(code, sizeof code, "0x%02x", static_cast<unsigned>(c));
+        throw InputError(path, "line " + std::to_string(number) + ": a control byte (" + code +
+                                   ") in a text file (" + context + ")");
+      }
     const std::size_t start = line.find_first_not_of(" \t\r");
     if (start == std::string::npos || line[start] == '#') continue;
     visit(number, line);

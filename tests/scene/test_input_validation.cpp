@@ -122,6 +122,15 @@ TEST(InputValidation, MtlStatementBeforeTheFirstNewmtl) {
   }
 }
 
+// OBJ and MTL are text: a NUL byte, even in a comment, makes assimp 5.2.5 read past the end of
+// an MTL (a crash, found by fuzzing); every control byte but tab and CR is refused.
+TEST(InputValidation, ControlBytesInObjAndMtl) {
+  expect_obj_refused(std::string("v 0 0 0\n# a\0b\n", 14), "newmtl grey\nKd 0.5 0.5 0.5\n",
+                     {"m.obj", "line 3", "a control byte (0x00)"});
+  expect_obj_refused("v 0 0 0\n", "newmtl grey\nKd 0.5 0.5 0.5\x01\n",
+                     {"m.mtl", "line 2", "a control byte (0x01)"});
+}
+
 // A PLY list whose length is typed double could claim more items than any integer holds
 // (undefined behaviour in the check itself, found by fuzzing).
 TEST(InputValidation, PlyListLengthOfAFloatType) {

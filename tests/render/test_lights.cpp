@@ -1,0 +1,267 @@
+// Light sampling for next-event estimation against its own densities (host/render/lights.h):
+// the directions Lights::sample produces are binned over the sphere and compared with the
+// density MIS uses for them (chi-square, tests/support/chi_square.h), for emissive triangles,
+// the sun's cone, a constant sky and an environment map. Each test also shows its power: the
+// same samples against a density that is 5% off, or that lacks the environment map's sin(theta)
+// Jacobian, are rejected.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "render/distribution.h"
+#include "render/lights.h"
+#include "scene/scene.h"
+#include "scene/shapes.h"
+#include "shared/rng.h"
+#include "support/chi_square.h"
+
+namespace rtpg {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr std::size_t kSamples = 1000000;
+
+// Every chi-square test of this file at an overall level of 0.01.
+const double kAlpha = test::sidak_alpha(0.01, 3);
+
+// A grey floor, so that the scene has bounds (they size the sun's and sky's share).
+Scene floor_scene() {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  scene.meshes.push_back(make_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2}));
+  return scene;
+}
+
+// The directions Lights::sample produces from p, with the pdf each sample reports.
+struct LightSampler {
+  const Lights& lights;
+  glm::vec3 p;
+  bool operator()(std::size_t i, glm::vec3& d) const {
+    shared::pg_rng rng = shared::pg_rng_make(7u, static_cast<shared::uint>(i), 0u, 0u, 3u);
+    const float a = shared::pg_rng_next(&rng), b = shared::pg_rng_next(&rng),
+                c = shared::pg_rng_next(&rng);
+    LightSample s;
+    if (!lights.sample(p, a, b, c, s) || !(s.pdf > 0.0f)) return false;
+    d = s.direction;
+    return true;
+  }
+};
+
+// Sun (a cone of 0.25 rad) and a constant sky: the density of a direction is what pdf_escaped
+// says, which MIS uses when a BSDF-sampled ray escapes.
+TEST(Lights, SunConeAndConstantSkyMatchTheirDensity) {
+  Scene scene = floor_scene();
+  scene.sun.enabled = true;
+  scene.sun.direction = glm::normalize(glm::vec3(0.3f, 0.8f, 0.2f));
+  scene.sun.irradiance = glm::vec3(3.0f);
+  scene.sun.angular_radius = 0.25f;
+  scene.environment.kind = Environment::Kind::Constant;
+  scene.environment.color = glm::vec3(0.5f, 0.6f, 0.7f);
+  const Lights lights(scene);
+  const LightSampler sampler{lights, glm::vec3(0.0f, 0.5f, 0.0f)};
+  // Each sample reports the density of its direction.
+  for (std::size_t i = 0; i < 10000; ++i) {
+    std::mt19937 gen(static_cast<unsigned>(i));
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    LightSample s;
+    ASSERT_TRUE(lights.sample(sampler.p, u(gen), u(gen), u(gen), s));
+    ASSERT_FALSE(s.delta);
+    ASSERT_EQ(s.pdf, lights.pdf_escaped(s.direction));
+  }
+  const auto pdf = [&](const glm::vec3& d) { return double(lights.pdf_escaped(d)); };
+  const auto right = test::chi_square_test(sampler, pdf, kSamples, 40, 80, 24);
+  EXPECT_GT(right.p_value, kAlpha) << right.describe();
+  EXPECT_NEAR(right.pdf_integral, 1.0, 2e-3) << right.describe();
+  EXPECT_EQ(right.sample_fraction, 1.0);
+  // Power: 5% more density inside the sun's cone is rejected.
+  const glm::vec3 axis = scene.sun.direction;
+  const auto wrong = test::chi_square_test(
+      sampler,
+      [&](const glm::vec3& d) {
+        return pdf(d) * (glm::dot(d, axis) >= std::cos(0.25f) ? 1.05 : 1.0);
+      },
+      kSamples, 40, 80, 24);
+  EXPECT_LT(wrong.p_value, 1e-6) << wrong.describe();
+}
+
+// An equirectangular map of random texels with one bright spot, rotated about +y, and a sun:
+// sampled by luminance times sin(theta) (pbrt's infinite area light).
+TEST(Lights, EnvironmentMapMatchesItsDensity) {
+  Scene scene = floor_scene();
+  Texture map;
+  map.path = "random";
+  map.width = 32;
+  map.height = 16;
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> u(0.05f, 1.0f);
+  for (int i = 0; i < map.width * map.height; ++i)
+    map.texels.push_back(glm::vec4(u(gen), u(gen), u(gen), 1.0f));
+  map.texels[5 * map.width + 20] = glm::vec4(40.0f, 30.0f, 20.0f, 1.0f);
+  scene.textures.push_back(map);
+  scene.environment.kind = Environment::Kind::Map;
+  scene.environment.map_texture = 0;
+  scene.environment.color = glm::vec3(1.0f);
+  scene.environment.rotation = 0.7f;
+  scene.sun.enabled = true;
+  scene.sun.direction = glm::normalize(glm::vec3(-0.5f, 0.6f, 0.3f));
+  scene.sun.irradiance = glm::vec3(1.0f);
+  scene.sun.angular_radius = 0.3f;
+  const Lights lights(scene);
+  const LightSampler sampler{lights, glm::vec3(0.0f, 0.5f, 0.0f)};
+  const auto pdf = [&](const glm::vec3& d) { return double(lights.pdf_escaped(d)); };
+  const auto right = test::chi_square_test(sampler, pdf, kSamples, 40, 80, 24);
+  EXPECT_GT(right.p_value, kAlpha) << right.describe();
+  EXPECT_NEAR(right.pdf_integral, 1.0, 2e-3) << right.describe();
+  // Power: the density without the 1 / sin(theta) of the equirectangular map (theta from +y),
+  // renormalised over the sphere, is rejected.
+  double integral = 0.0;
+  const int n = 512;
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < 2 * n; ++b) {
+      const double z = 1.0 - 2.0 * (a + 0.5) / n, phi = 2.0 * kPi * (b + 0.5) / (2 * n);
+      const double r = std::sqrt(1.0 - z * z);
+      const glm::vec3 d(r * std::cos(phi), r * std::sin(phi), z);
+      integral += pdf(d) * std::sqrt(std::max(0.0, 1.0 - double(d.y) * d.y));
+    }
+  integral *= (2.0 / n) * (2.0 * kPi / (2 * n));
+  const auto wrong = test::chi_square_test(
+      sampler,
+      [&](const glm::vec3& d) {
+        return pdf(d) * std::sqrt(std::max(0.0, 1.0 - double(d.y) * d.y)) / integral;
+      },
+      kSamples, 40, 80, 24);
+  EXPECT_LT(wrong.p_value, 1e-6) << wrong.describe();
+}
+
+// The emissive triangle a ray from p along d hits first, with its hit point and mesh indices.
+struct TriangleHit {
+  bool hit = false;
+  std::uint32_t mesh = 0, triangle = 0;
+  glm::vec3 point{0.0f};
+};
+
+// Moller-Trumbore over every triangle of the scene (the test's own intersector).
+TriangleHit first_hit(const Scene& scene, const glm::vec3& p, const glm::vec3& d) {
+  TriangleHit best;
+  double best_t = 1e30;
+  for (std::uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::dvec3 a = mesh.positions[mesh.triangles[t].x];
+      const glm::dvec3 e1 = glm::dvec3(mesh.positions[mesh.triangles[t].y]) - a;
+      const glm::dvec3 e2 = glm::dvec3(mesh.positions[mesh.triangles[t].z]) - a;
+      const glm::dvec3 dd(d), pv = glm::cross(dd, e2);
+      const double det = glm::dot(e1, pv);
+      if (std::fabs(det) < 1e-12) continue;
+      const glm::dvec3 tv = glm::dvec3(p) - a;
+      const double u = glm::dot(tv, pv) / det;
+      if (u < 0.0 || u > 1.0) continue;
+      const glm::dvec3 qv = glm::cross(tv, e1);
+      const double v = glm::dot(dd, qv) / det;
+      if (v < 0.0 || u + v > 1.0) continue;
+      const double dist = glm::dot(e2, qv) / det;
+      if (dist <= 1e-6 || dist >= best_t) continue;
+      best_t = dist;
+      best = {true, m, t, glm::vec3(glm::dvec3(p) + dd * dist)};
+    }
+  }
+  return best;
+}
+
+// Two emissive quads of different size, radiance and distance (chosen by power, then uniformly
+// by area) and one facing away from p (one-sided: never sampled from p). The density of a
+// direction is pdf_triangle of the emitter it reaches, if that emitter faces p.
+TEST(Lights, EmissiveTrianglesMatchTheirDensity) {
+  Scene scene = floor_scene();
+  Material lamp;
+  lamp.emission = glm::vec3(4.0f, 3.0f, 2.0f);
+  scene.materials.push_back(lamp);
+  lamp.emission = glm::vec3(1.0f);
+  scene.materials.push_back(lamp);
+  Mesh big = make_quad({-0.8f, 1.5f, -0.4f}, {0.9f, 0, 0}, {0, 0, 0.6f});  // faces down
+  big.material = 1;
+  Mesh small = make_quad({1.2f, 0.4f, 0.2f}, {0, 0, 0.2f}, {0, 0.3f, 0});  // faces -x, p
+  small.material = 2;
+  Mesh away = make_quad({-1.5f, 0.4f, 0.2f}, {0, 0, 0.4f}, {0, 0.3f, 0});  // faces -x, away
+  away.material = 2;
+  scene.meshes.push_back(big);
+  scene.meshes.push_back(small);
+  scene.meshes.push_back(away);
+  const Lights lights(scene);
+  ASSERT_EQ(lights.emissive_triangle_count(), 6u);
+  const glm::vec3 p(0.1f, 0.3f, 0.1f);
+  // Which way each emitter faces, from the test's own geometry.
+  auto facing_p = [&](const TriangleHit& h) {
+    const Mesh& mesh = scene.meshes[h.mesh];
+    const glm::uvec3 t = mesh.triangles[h.triangle];
+    const glm::vec3 n = glm::cross(mesh.positions[t.y] - mesh.positions[t.x],
+                                   mesh.positions[t.z] - mesh.positions[t.x]);
+    return glm::dot(n, p - h.point) > 0.0f;
+  };
+  ASSERT_TRUE(facing_p(first_hit(scene, p, glm::normalize(glm::vec3(-0.3f, 1.5f, -0.1f)))));
+  ASSERT_FALSE(facing_p(first_hit(scene, p, glm::normalize(glm::vec3(-1.6f, 0.25f, 0.3f)))));
+  const auto pdf = [&](const glm::vec3& d) {
+    const TriangleHit h = first_hit(scene, p, d);
+    if (!h.hit || !scene.materials[scene.meshes[h.mesh].material].is_emissive() || !facing_p(h))
+      return 0.0;
+    return double(lights.pdf_triangle(h.mesh, h.triangle, p, h.point, glm::vec3(0.0f)));
+  };
+  const LightSampler sampler{lights, p};
+  // Each sample's pdf is the density pdf_triangle gives its direction.
+  for (std::size_t i = 0; i < 2000; ++i) {
+    std::mt19937 gen(static_cast<unsigned>(i));
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    LightSample s;
+    if (!lights.sample(p, u(gen), u(gen), u(gen), s)) continue;
+    const TriangleHit h = first_hit(scene, p, s.direction);
+    ASSERT_TRUE(h.hit);
+    EXPECT_NEAR(s.distance, glm::length(h.point - p), 1e-4f * s.distance);
+    EXPECT_NEAR(s.pdf, pdf(s.direction), 1e-3 * s.pdf);
+  }
+  const auto right = test::chi_square_test(sampler, pdf, kSamples / 4, 40, 80, 32);
+  EXPECT_GT(right.p_value, kAlpha) << right.describe();
+  // The one facing away takes its power's share of the attempts and never yields a sample.
+  EXPECT_NEAR(right.pdf_integral, right.sample_fraction, 5e-3) << right.describe();
+  EXPECT_LT(right.sample_fraction, 0.95) << right.describe();
+  const auto wrong = test::chi_square_test(
+      sampler, [&](const glm::vec3& d) { return pdf(d) * 1.05; }, kSamples / 4, 40, 80, 12);
+  EXPECT_LT(wrong.p_value, 1e-6) << wrong.describe();
+}
+
+// Distribution2D: samples fall in cells in proportion to their weights, and the density it
+// reports integrates to one and equals weight / mean weight.
+TEST(Distribution2D, SamplesInProportionToTheWeights) {
+  const int w = 7, h = 5;
+  std::vector<float> weights(w * h);
+  std::mt19937 gen(9);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  double total = 0.0;
+  for (float& x : weights) total += x = u(gen) < 0.2f ? 0.0f : u(gen);
+  const Distribution2D dist(weights, w, h);
+  std::vector<double> counts(w * h, 0.0);
+  const int n = 1000000;
+  for (int i = 0; i < n; ++i) {
+    float x = 0, y = 0, pdf = 0;
+    dist.sample(u(gen), u(gen), x, y, pdf);
+    const int cx = std::min(w - 1, int(x * w)), cy = std::min(h - 1, int(y * h));
+    ASSERT_GT(weights[cy * w + cx], 0.0f) << "sampled a cell of weight 0";
+    ASSERT_NEAR(pdf, weights[cy * w + cx] / (total / (w * h)), 1e-4 * pdf);
+    ASSERT_EQ(pdf, dist.pdf(x, y));
+    counts[cy * w + cx] += 1.0;
+  }
+  double chi2 = 0.0;
+  int cells = 0;
+  for (int i = 0; i < w * h; ++i) {
+    if (weights[i] == 0.0f) continue;
+    const double expected = n * weights[i] / total;
+    chi2 += (counts[i] - expected) * (counts[i] - expected) / expected;
+    ++cells;
+  }
+  const double p_value = test::incomplete_gamma_q(0.5 * (cells - 1), 0.5 * chi2);
+  EXPECT_GT(p_value, 0.01) << "chi2 " << chi2 << " over " << cells << " cells";
+}
+
+}  // namespace
+}  // namespace rtpg

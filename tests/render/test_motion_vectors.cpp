@@ -1,0 +1,99 @@
+// The renderer's motion vectors (host/render/renderer.cpp, G-buffer `motion`): for every pixel
+// that sees a surface, the offset in pixels from the pixel's centre to where that surface point
+// was on the previous frame's film, which the reprojection of guiding states follows
+// (docs/guiding.md). Checked against an independent projection: GLM's lookAt and perspective
+// matrices of the previous frame's camera view, not the renderer's CameraFrame.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "render/renderer.h"
+#include "scene/scene_loader.h"
+
+namespace rtpg {
+namespace {
+
+Scene cornell_box() {
+  return load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
+}
+
+// Film position of p in the view, (0,0) = top-left corner, (1,1) = bottom-right; false if
+// behind the camera.
+bool project_with_glm(const CameraView& view, float aspect, const glm::vec3& p, glm::dvec2& out) {
+  const glm::dmat4 clip_from_world =
+      glm::perspective(double(view.fov_y), double(aspect), 1e-3, 1e3) *
+      glm::lookAt(glm::dvec3(view.position), glm::dvec3(view.look_at), glm::dvec3(view.up));
+  const glm::dvec4 c = clip_from_world * glm::dvec4(glm::dvec3(p), 1.0);
+  if (!(c.w > 0.0)) return false;
+  out = glm::dvec2(0.5 * (c.x / c.w + 1.0), 0.5 * (1.0 - c.y / c.w));
+  return true;
+}
+
+// An odd, non-square size with jitter on, along the scene's camera path: the motion of pixel
+// (x, y) is the previous frame's film position of its surface point times the image size,
+// minus the pixel's centre (x + 0.5, y + 0.5), whatever the jitter of its ray.
+TEST(MotionVectors, EqualTheProjectionIntoThePreviousFrame) {
+  const Scene scene = cornell_box();
+  RenderSettings settings;
+  settings.width = 37;
+  settings.height = 23;
+  settings.camera_path = "pan";
+  settings.path_tracer.max_bounces = 1;
+  Renderer renderer(scene, settings);
+  const CameraPath& path = scene.camera.paths.at("pan");
+  const float aspect = float(settings.width) / float(settings.height);
+  double largest_motion = 0.0, largest_error = 0.0;
+  int checked = 0;
+  for (int f = 0; f < 6; ++f) {
+    renderer.render_frame(f);
+    const GBuffer& g = renderer.gbuffer();
+    const CameraView previous = path.at(float(f > 0 ? f - 1 : 0) / path.fps);
+    for (int y = 0; y < g.height; ++y)
+      for (int x = 0; x < g.width; ++x) {
+        const std::size_t i = std::size_t(y) * g.width + x;
+        if (!g.has_surface(i)) {
+          EXPECT_EQ(g.motion[i], glm::vec2(0.0f)) << "sky pixel " << x << "," << y;
+          continue;
+        }
+        if (f == 0) {
+          EXPECT_EQ(g.motion[i], glm::vec2(0.0f)) << "frame 0 has no previous frame";
+          continue;
+        }
+        glm::dvec2 film;
+        ASSERT_TRUE(project_with_glm(previous, aspect, glm::vec3(g.position_depth[i]), film));
+        const glm::dvec2 expected(film.x * g.width - (x + 0.5), film.y * g.height - (y + 0.5));
+        const glm::dvec2 error = glm::dvec2(g.motion[i]) - expected;
+        largest_error = std::max(largest_error, std::max(std::fabs(error.x), std::fabs(error.y)));
+        largest_motion = std::max(largest_motion, glm::length(expected));
+        ASSERT_NEAR(g.motion[i].x, expected.x, 2e-3) << "frame " << f << " pixel " << x << "," << y;
+        ASSERT_NEAR(g.motion[i].y, expected.y, 2e-3) << "frame " << f << " pixel " << x << "," << y;
+        ++checked;
+      }
+  }
+  // The path moves the camera by more than a pixel per frame here, so a sign or axis error
+  // could not hide in the tolerance.
+  EXPECT_GT(largest_motion, 0.5);
+  EXPECT_GT(checked, 5 * 37 * 23 / 2);
+  std::printf("motion vectors: %d pixels, largest motion %.3f px, largest error %.2e px\n", checked,
+              largest_motion, largest_error);
+}
+
+// A static camera has zero motion on every frame, jitter or not.
+TEST(MotionVectors, ZeroForAStaticCamera) {
+  const Scene scene = cornell_box();
+  RenderSettings settings;
+  settings.width = 19;
+  settings.height = 31;
+  settings.path_tracer.max_bounces = 1;
+  Renderer renderer(scene, settings);
+  for (int f = 0; f < 3; ++f) {
+    renderer.render_frame(f);
+    for (const glm::vec2& m : renderer.gbuffer().motion) ASSERT_EQ(m, glm::vec2(0.0f));
+  }
+}
+
+}  // namespace
+}  // namespace rtpg
