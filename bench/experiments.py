@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from suite import metrics, runner  # noqa: E402
+from suite import equal_time as equal_time_figures, metrics, runner  # noqa: E402
 
 import matplotlib  # noqa: E402
 matplotlib.use("Agg")
@@ -166,8 +166,9 @@ def equal_frame(ctx, scene):
 
 
 def equal_time(ctx, scene):
-    """Error of the accumulated image against cumulative wall time, both methods, same run,
-    medians over repeats with different seeds."""
+    """Error of the accumulated image against cumulative wall time, both methods, repeats with
+    different seeds. Every figure is read off each run's own curve, then the median over the runs
+    (suite/equal_time.py); the plot shows every run."""
     m = ctx.mode
     ref_path = ctx.reference(scene, m["res"])
     out = ctx.out / "equal_time" / scene
@@ -181,29 +182,26 @@ def equal_time(ctx, scene):
             # Frame 0 also builds the OpenCL programs (from the disk cache) and compiles
             # work-group functions: a one-time start-up cost, replaced by a typical frame.
             ms[0] = statistics.median(ms[1:]) if len(ms) > 1 else ms[0]
-            runs.append((np.cumsum(ms), [f["relmse_accumulated"] for f in stats["frames"]]))
-        curves[method] = {"time_ms": np.median([r[0] for r in runs], axis=0).tolist(),
-                          "relmse": np.median([r[1] for r in runs], axis=0).tolist(),
-                          "final_relmse_runs": [r[1][-1] for r in runs]}
+            runs.append({"time_ms": np.cumsum(ms).tolist(),
+                         "relmse": [f["relmse_accumulated"] for f in stats["frames"]]})
+        curves[method] = {"runs": runs}
     fig, ax = plt.subplots(figsize=(5, 4))
-    for method, c in curves.items():
-        ax.loglog(c["time_ms"], c["relmse"], label=LABEL[method])
+    for i, (method, c) in enumerate(curves.items()):
+        for j, run in enumerate(c["runs"]):
+            ax.loglog(run["time_ms"], run["relmse"], color=f"C{i}", alpha=0.7,
+                      label=LABEL[method] if j == 0 else None)
     ax.set_xlabel("wall time (ms, cumulative)")
     ax.set_ylabel("relMSE of the accumulated image")
-    ax.set_title(f"{scene}: equal time ({m['res']})")
+    ax.set_title(f"{scene}: equal time ({m['res']}, {m['repeats']} runs each)")
     ax.legend()
     fig.tight_layout()
     fig.savefig(out / "equal_time.png", dpi=100)
     plt.close(fig)
-    # The error each method reaches within PT's time for all its frames, and the time each
-    # needs to reach the error PT ends with (ratio PG/PT: below 1, guiding pays for itself).
-    budget = curves["off"]["time_ms"][-1]
-    at_budget = {k: float(np.interp(budget, c["time_ms"], c["relmse"])) for k, c in curves.items()}
-    target = curves["off"]["relmse"][-1]
-    pg_time = metrics.time_to_reach(curves["pmm"]["time_ms"], curves["pmm"]["relmse"], target)
-    return {"scene": scene, "curves": curves, "relmse_at_pt_budget": at_budget,
-            "pt_time_ms": budget, "pg_time_to_pt_error_ms": pg_time,
-            "time_ratio_pg_pt": (pg_time / budget) if pg_time else None, "figure": str(out / "equal_time.png")}
+    # The error each method reaches within PT's time for all its frames, and the time PG needs to
+    # reach the error PT ends with (ratio PG/PT: below 1, guiding pays for itself).
+    result = equal_time_figures.figures([(r["time_ms"], r["relmse"]) for r in curves["off"]["runs"]],
+                                        [(r["time_ms"], r["relmse"]) for r in curves["pmm"]["runs"]])
+    return {"scene": scene, "curves": curves, **result, "figure": str(out / "equal_time.png")}
 
 
 def flicker(ctx, scene):

@@ -66,17 +66,3 @@ def downsample_box(image, factor):
         raise ValueError(f"{image.shape[1]}x{image.shape[0]} is not a multiple of {factor}")
     return image.reshape(h, factor, w, factor, -1).mean(axis=(1, 3)).astype(np.float32)
 
-
-def time_to_reach(times, errors, target):
-    """First time at which a decreasing error curve reaches `target`, interpolated linearly in
-    log-log between samples; None when the curve never gets there."""
-    times = np.asarray(times, dtype=np.float64)
-    errors = np.asarray(errors, dtype=np.float64)
-    if errors[0] <= target:
-        return float(times[0])
-    for i in range(1, len(errors)):
-        if errors[i] <= target:
-            lt0, lt1 = np.log(times[i - 1]), np.log(times[i])
-            le0, le1, lt = np.log(errors[i - 1]), np.log(errors[i]), np.log(target)
-            return float(np.exp(lt0 + (lt - le0) * (lt1 - lt0) / (le1 - le0)))
-    return None

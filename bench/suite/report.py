@@ -75,20 +75,37 @@ def _equal_frame(ex, report_dir):
     return lines + [""]
 
 
+def _figure(value, fmt):
+    """A number formatted, or what stands in its place ("not reached", suite/equal_time.py)."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return format(value, fmt)
+    return "not reached" if value is None else str(value)  # None: results.json from before equal_time.py
+
+
 def _equal_time(ex, report_dir, settings):
+    if all("runs" in c for r in ex.values() for c in r["curves"].values()):
+        method = ("Each figure is read off each run's own (time, error) curve, log-log between frames, then the "
+                  "median over the runs is taken (bench/suite/equal_time.py): PT's time is the median of its runs' "
+                  "times, PT's error the median of their final errors.")
+    else:  # results.json from before bench/suite/equal_time.py: its figures came from per-frame medians
+        method = ("The figures are read off per-frame medians of the runs' times and errors (the method before "
+                  "bench/suite/equal_time.py).")
     lines = ["## Equal time: error of the accumulated image against wall time", "",
-             f"{settings['time_frames']} accumulated frames per method, medians over {settings['repeats']} runs "
-             "(seeds 100, 101, ...) in the same process tree; frame 0's one-time program build is replaced by the "
-             "median frame time.", "",
+             f"{settings['time_frames']} accumulated frames per method, {settings['repeats']} runs each (seeds 100, "
+             "101, ...) in the same process tree; frame 0's one-time program build is replaced by the median frame "
+             f"time. {method}", "",
              "| scene | PT time | relMSE PT at PT's time | relMSE PG at the same time | PG time to PT's final error |",
              "|---|---|---|---|---|"]
     for scene, r in ex.items():
         b = r["relmse_at_pt_budget"]
         ratio = r.get("time_ratio_pg_pt")
-        lines.append(f"| {scene} | {_ms(r.get('pt_time_ms', float('nan')))} | {b['off']:.4g} | {b['pmm']:.4g} "
-                     f"| {f'{ratio:.2f}x PT time' if ratio else 'not reached'} |")
+        ratio = f"{ratio:.2f}x PT time" if isinstance(ratio, (int, float)) else _figure(ratio, "")
+        lines.append(f"| {scene} | {_ms(r.get('pt_time_ms', float('nan')))} | {_figure(b['off'], '.4g')} "
+                     f"| {_figure(b['pmm'], '.4g')} | {ratio} |")
     lines += ["", "Last column below 1x: guiding reaches PT's error sooner (it pays for its cost); above 1x or "
-              "'not reached' (within the frames rendered): PT is the better use of the time on this machine.", ""]
+              "'not reached' (the median PG run does not get there within the frames rendered): PT is the better "
+              "use of the time on this machine. 'not reached' for PG's error: the median PG run ended before PT's "
+              "time.", ""]
     return lines + _figures(ex, report_dir, "equal-time")
 
 

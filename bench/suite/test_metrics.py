@@ -55,13 +55,6 @@ class MetricTests(unittest.TestCase):
         with self.assertRaises(ValueError):
             metrics.downsample_box(img, 4)
 
-    def test_time_to_reach_interpolates_in_log_log(self):
-        # error = 1 / t: reaching 0.25 takes t = 4 exactly, between the samples 2 and 8.
-        t = [1.0, 2.0, 8.0]
-        self.assertAlmostEqual(metrics.time_to_reach(t, [1 / x for x in t], 0.25), 4.0, places=9)
-        self.assertEqual(metrics.time_to_reach(t, [1.0, 0.5, 0.2], 2.0), 1.0)
-        self.assertIsNone(metrics.time_to_reach(t, [1.0, 0.5, 0.2], 0.1))
-
     def test_tonemap_matches_documented_curve(self):
         # 0 -> 0, large -> 1, and the ACES fit at x = 1 (0.8038...) through the sRGB curve.
         t = metrics.tonemap_srgb(np.array([[[0.0, 1.0, 1e6]]], np.float32))[0, 0]
