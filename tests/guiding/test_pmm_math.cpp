@@ -15,6 +15,7 @@
 #include "shared/bsdf.h"
 #include "shared/mapping.h"
 #include "shared/pmm.h"
+#include "shared/pmm_train.h"
 #include "shared/rng.h"
 #include "support/chi_square.h"
 #include "support/pmm_checks.h"
@@ -52,6 +53,8 @@ Cov model_covariance(const pg_pmm_model& m) {
 }
 
 using rtpg::test::model_is_sane;
+
+constexpr double kPiD = 3.14159265358979323846;
 
 // ---- sampler against density -------------------------------------------------------------
 
@@ -175,7 +178,23 @@ TEST(PmmSampler, ReportsItsOwnPdfAndStrategy) {
       if (s.pdf > 0.0f) {
         ASSERT_NEAR(length(s.wi), 1.0f, 1e-5f) << c.name;
         ASSERT_GT(s.wi.z, 0.0f) << c.name;
+        // The density next-event MIS uses for the same direction.
         ASSERT_EQ(s.pdf, pg_pmm_pdf(model, lobes, c.wo, s.wi)) << c.name;
+        // And the mixture of eq. 2 computed here from Sigma = L L^T (its inverse and
+        // determinant, not pmm.h's triangular solve), in double: pi N(u; mu, Sigma) / (2 pi)
+        // (the equal-area map's Jacobian, Mapping.JacobianIsTwoPiEverywhere) + (1 - pi) f_pdf.
+        double mixture =
+            (1.0 - (model.valid ? model.pi : 0.0)) * double(pg_bsdf_pdf(lobes, c.wo, s.wi));
+        if (model.valid) {
+          const Cov cov = model_covariance(model);
+          const double det = cov.xx * cov.yy - cov.xy * cov.xy;
+          const float2 u = pg_hemisphere_to_square(s.wi);
+          const double dx = u.x - double(model.mx), dy = u.y - double(model.my);
+          const double q = (cov.yy * dx * dx - 2.0 * cov.xy * dx * dy + cov.xx * dy * dy) / det;
+          const double gaussian = std::exp(-0.5 * q) / (2.0 * kPiD * std::sqrt(det));
+          mixture += model.pi * gaussian / (2.0 * kPiD);
+        }
+        ASSERT_NEAR(s.pdf, mixture, 1e-4 * mixture) << c.name;
       }
     }
   }
@@ -652,4 +671,160 @@ TEST(PmmReframe, RotationKeepsTheMeansWorldDirection) {
   std::nth_element(det_change.begin(), det_change.begin() + det_change.size() / 2,
                    det_change.end());
   EXPECT_LT(det_change[det_change.size() / 2], 0.01);
+}
+
+// ---- training samples from VPLs, by hand ----------------------------------------------------
+
+// One VPL seen from a Lambertian pixel (albedo 0.5, normal +z, at the origin, viewed head-on):
+// the VPL at y = (0, 3, 4), 5 away along w = (0, 0.6, 0.8), facing straight down (cos at y
+// 0.8), with area density 0.2 and radiance 2. Computed here by hand: its solid-angle density
+// from the pixel is 0.2 * 25 / 0.8 = 6.25, f cos = (0.5 / pi) * 0.8, so the weight
+// lum(L f cos) / density = 0.8 / (6.25 pi) and the BSDF density 0.8 / pi (pmm_train.h).
+TEST(PmmTrainSample, VplWeightByHand) {
+  pg_kernel_settings p = default_params();
+  p.train_all_samples = 0;
+  const pg_material grey{float3(0.5f), 1.0f, 0.0f, 0.0f};
+  pg_train_pixel px;
+  px.x = float3(0.0f);
+  px.frame = pg_frame_from_normal(float3(0.0f, 0.0f, 1.0f));
+  px.wo = float3(0.0f, 0.0f, 1.0f);
+  px.lobes = pg_make_lobes(grey, px.wo);
+  const float bsdf_info = float(PG_VPL_VALID | (PG_STRATEGY_BSDF << PG_VPL_STRATEGY_SHIFT));
+  const float guide_info = float(PG_VPL_VALID | (PG_STRATEGY_GUIDE << PG_VPL_STRATEGY_SHIFT));
+  const float4 position_pdf(0.0f, 3.0f, 4.0f, 0.2f);
+  const float4 normal(0.0f, 0.0f, -1.0f, 0.3f);  // w: the whole mixture's area density
+  float4 sample;
+  ASSERT_EQ(
+      pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, bsdf_info), p, &sample),
+      1);
+  EXPECT_NEAR(sample.x, 0.8 / (6.25 * kPiD), 1e-6);
+  EXPECT_NEAR(sample.w, 0.8 / kPiD, 1e-6);
+  const float3 w = pg_square_to_hemisphere(float2(sample.y, sample.z));
+  EXPECT_NEAR(w.x, 0.0f, 1e-5f);
+  EXPECT_NEAR(w.y, 0.6f, 1e-5f);
+  EXPECT_NEAR(w.z, 0.8f, 1e-5f);
+  // A guide-strategy VPL trains only with train_all_samples (paper 3.2), and then every VPL
+  // counts at the whole mixture's density: 0.3 * 25 / 0.8 = 9.375.
+  EXPECT_EQ(
+      pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, guide_info), p, &sample),
+      0);
+  p.train_all_samples = 1;
+  ASSERT_EQ(
+      pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, guide_info), p, &sample),
+      1);
+  EXPECT_NEAR(sample.x, 0.8 / (9.375 * kPiD), 1e-6);
+  p.train_all_samples = 0;
+  // A distant VPL (an escaped ray) holds its direction and a solid-angle density already.
+  const float distant_info = bsdf_info + float(PG_VPL_DISTANT);
+  ASSERT_EQ(pg_train_sample_from_vpl(px, float4(0.0f, 0.6f, 0.8f, 0.2f), normal,
+                                     float4(2, 2, 2, distant_info), p, &sample),
+            1);
+  EXPECT_NEAR(sample.x, 0.8 / (0.2 * kPiD), 1e-5);
+  // A VPL whose surface faces away from the pixel, or one below the pixel's horizon, says
+  // nothing about its hemisphere.
+  EXPECT_EQ(pg_train_sample_from_vpl(px, position_pdf, float4(0, 0, 1, 0.3f),
+                                     float4(2, 2, 2, bsdf_info), p, &sample),
+            0);
+  EXPECT_EQ(pg_train_sample_from_vpl(px, float4(0, 3, -4, 0.2f), float4(0, 0, 1, 0.3f),
+                                     float4(2, 2, 2, bsdf_info), p, &sample),
+            0);
+}
+
+// ---- reframe against carried samples --------------------------------------------------------
+
+// Sigma' = J Sigma J^T, checked without any Jacobian: points drawn from the state's Gaussian in
+// the old frame are carried one by one through the change of frame (pg_pmm_reframe_point), and
+// their sample covariance must equal the reframed state's within its sampling error (5 standard
+// errors) plus 3% of the scale for the map's curvature over the Gaussian (sigma <= 0.012).
+// Power: the same criterion rejects J^T Sigma J or a flipped Sigma_xy in most cases.
+TEST(PmmReframe, CovarianceMatchesCarriedSamples) {
+  std::mt19937 gen(14);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const int n = 20000;
+  int checked = 0, transposed_rejected = 0, flipped_rejected = 0;
+  auto within = [&](const Cov& sample, const Cov& model) {
+    const double scale = std::sqrt(model.xx * model.yy);
+    const double se_xx = std::sqrt(2.0 / n) * model.xx, se_yy = std::sqrt(2.0 / n) * model.yy;
+    const double se_xy = std::sqrt((model.xx * model.yy + model.xy * model.xy) / n);
+    return std::fabs(sample.xx - model.xx) <= 5.0 * se_xx + 0.03 * scale &&
+           std::fabs(sample.yy - model.yy) <= 5.0 * se_yy + 0.03 * scale &&
+           std::fabs(sample.xy - model.xy) <= 5.0 * se_xy + 0.03 * scale;
+  };
+  for (int i = 0; i < 300; ++i) {
+    const float3 n1 = random_unit(gen);
+    const float3 t = normalize(cross(n1, random_unit(gen)));
+    const float tilt = 45.0f * PG_PI / 180.0f * u(gen);
+    const float3 n2 = normalize(n1 * std::cos(tilt) + t * std::sin(tilt));
+    const pg_frame f1 = pg_frame_from_normal(n1), f2 = pg_frame_from_normal(n2);
+    const double sx = 0.004 + 0.008 * u(gen), sy = 0.004 + 0.008 * u(gen);
+    const double rho = -0.8 + 1.6 * u(gen);
+    const float mx = 0.15f + 0.7f * u(gen), my = 0.15f + 0.7f * u(gen);
+    // The equal-area map has kinks on the square's diagonals: keep the Gaussian off them.
+    const double margin = 6.0 * std::max(sx, sy);
+    if (std::fabs(std::fabs(mx - 0.5) - std::fabs(my - 0.5)) < margin) continue;
+    const pg_pmm_state s =
+        make_state(mx, my, float(sx * sx), float(sy * sy), float(rho * sx * sy), 0.5f, 5.0f);
+    const pg_pmm_state r = pg_pmm_reframe(s, f1, f2);
+    if (same_state(r, pg_pmm_initial_state())) continue;  // the mean fell below the horizon
+    // The carried points' mean and covariance.
+    double sum_x = 0, sum_y = 0, sum_xx = 0, sum_yy = 0, sum_xy = 0;
+    int carried = 0;
+    for (int k = 0; k < n; ++k) {
+      const double z1 = normal(gen), z2 = normal(gen);
+      const float2 a(float(mx + sx * z1),
+                     float(my + sy * (rho * z1 + std::sqrt(1.0 - rho * rho) * z2)));
+      int ok = 1;
+      const float2 b = pg_pmm_reframe_point(a, f1, f2, &ok);
+      if (!ok) continue;
+      sum_x += b.x;
+      sum_y += b.y;
+      sum_xx += double(b.x) * b.x;
+      sum_yy += double(b.y) * b.y;
+      sum_xy += double(b.x) * b.y;
+      ++carried;
+    }
+    if (carried < n) continue;  // part of the Gaussian crosses the new horizon
+    const double ex = sum_x / n, ey = sum_y / n;
+    const Cov sample{sum_xx / n - ex * ex, sum_yy / n - ey * ey, sum_xy / n - ex * ey};
+    const Cov reframed = raw_covariance(r);
+    // And off the new square's diagonals (where the carried Gaussian lands).
+    const double mx2 = r.s0.z / r.s0.y, my2 = r.s0.w / r.s0.y;
+    const double margin2 = 6.0 * std::sqrt(std::max(reframed.xx, reframed.yy));
+    if (std::fabs(std::fabs(mx2 - 0.5) - std::fabs(my2 - 0.5)) < margin2) continue;
+    ++checked;
+    EXPECT_TRUE(within(sample, reframed))
+        << i << ": carried (" << sample.xx << ", " << sample.yy << ", " << sample.xy
+        << "), reframed (" << reframed.xx << ", " << reframed.yy << ", " << reframed.xy << ")";
+    // The wrong variants, built from the reframed covariance and the Jacobian's action on the
+    // original: J^T Sigma J differs from J Sigma J^T unless J is symmetric.
+    const Cov orig = raw_covariance(s);
+    const float h = 1e-3f;
+    int okx = 1, oky = 1, ok0 = 1;
+    const float2 m0 = pg_pmm_reframe_point(float2(mx, my), f1, f2, &ok0);
+    const float2 px = pg_pmm_reframe_point(float2(mx + h, my), f1, f2, &okx);
+    const float2 py = pg_pmm_reframe_point(float2(mx, my + h), f1, f2, &oky);
+    const double j11 = (px.x - m0.x) / h, j21 = (px.y - m0.y) / h;
+    const double j12 = (py.x - m0.x) / h, j22 = (py.y - m0.y) / h;
+    // J^T Sigma J: the transpose has j12 and j21 exchanged.
+    const double a11 = j11, a12 = j21, a21 = j12, a22 = j22;
+    const Cov transposed{
+        a11 * (a11 * orig.xx + a12 * orig.xy) + a12 * (a11 * orig.xy + a12 * orig.yy),
+        a21 * (a21 * orig.xx + a22 * orig.xy) + a22 * (a21 * orig.xy + a22 * orig.yy),
+        a21 * (a11 * orig.xx + a12 * orig.xy) + a22 * (a11 * orig.xy + a12 * orig.yy)};
+    if (!within(sample, transposed)) ++transposed_rejected;
+    const Cov flipped_input{orig.xx, orig.yy, -orig.xy};
+    const Cov flipped{j11 * (j11 * flipped_input.xx + j12 * flipped_input.xy) +
+                          j12 * (j11 * flipped_input.xy + j12 * flipped_input.yy),
+                      j21 * (j21 * flipped_input.xx + j22 * flipped_input.xy) +
+                          j22 * (j21 * flipped_input.xy + j22 * flipped_input.yy),
+                      j21 * (j11 * flipped_input.xx + j12 * flipped_input.xy) +
+                          j22 * (j11 * flipped_input.xy + j12 * flipped_input.yy)};
+    if (!within(sample, flipped)) ++flipped_rejected;
+  }
+  EXPECT_GT(checked, 150);
+  EXPECT_GT(transposed_rejected, checked / 2) << "J^T Sigma J passes too often";
+  EXPECT_GT(flipped_rejected, checked / 2) << "a flipped Sigma_xy passes too often";
+  std::printf("reframe: %d cases; J^T rejected in %d, flipped Sigma_xy in %d\n", checked,
+              transposed_rejected, flipped_rejected);
 }
