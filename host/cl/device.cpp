@@ -34,6 +34,14 @@ std::string type_name(cl_device_type type) {
   return "other";
 }
 
+// No platform is an OpenCL failure like any other (the CLI's exit code 3), with the advice a
+// user needs in place of the bare code.
+class NoPlatformError final : public ClError {
+ public:
+  NoPlatformError(cl_int code, const std::string& message)
+      : ClError("clGetPlatformIDs", code, message) {}
+};
+
 std::vector<cl::Platform> platforms_or_throw() {
   prepare_opencl_environment();
   std::vector<cl::Platform> platforms;
@@ -44,11 +52,13 @@ std::vector<cl::Platform> platforms_or_throw() {
     status = e.err();
   }
   if (platforms.empty()) {
-    throw std::runtime_error(
+    if (status == CL_SUCCESS) status = -1001;  // CL_PLATFORM_NOT_FOUND_KHR
+    throw NoPlatformError(
+        status,
         "no OpenCL platform found (clGetPlatformIDs: " + cl_error_name(status) +
-        "): install an OpenCL driver and its ICD file in /etc/OpenCL/vendors, e.g. PoCL's CPU "
-        "device (Debian: apt-get install ocl-icd-libopencl1 pocl-opencl-icd); `clinfo -l` "
-        "lists what the ICD loader finds");
+            "): install an OpenCL driver and its ICD file in /etc/OpenCL/vendors, e.g. PoCL's CPU "
+            "device (Debian: apt-get install ocl-icd-libopencl1 pocl-opencl-icd); `clinfo -l` "
+            "lists what the ICD loader finds");
   }
   return platforms;
 }

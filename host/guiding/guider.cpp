@@ -130,7 +130,8 @@ void Guider::check_buffer(const cl::Buffer& b, std::size_t element_size,
   const std::size_t need = element_size * static_cast<std::size_t>(width_) * height_;
   if (b() == nullptr) throw GuiderError(name + ": buffer is not set");
   const std::size_t have = translate_cl_errors([&] { return b.getInfo<CL_MEM_SIZE>(); });
-  if (have < need)
+  // Exactly: a larger buffer is another resolution's, whose rows this guider would misread.
+  if (have != need)
     throw GuiderError(name + ": buffer holds " + std::to_string(have) + " bytes, " +
                       std::to_string(width_) + "x" + std::to_string(height_) + " pixels need " +
                       std::to_string(need));

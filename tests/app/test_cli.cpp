@@ -70,13 +70,15 @@ struct RunResult {
 
 // Runs `rtpg ARGS` with `cwd` as working directory. stdout and stderr go to files in a
 // separate folder, so that the working directory holds only what rtpg itself writes.
-RunResult run_rtpg(const fs::path& cwd, const std::string& args) {
+// `env` (optional): arguments of env(1) put before rtpg, e.g. "-u NAME NAME2=value".
+RunResult run_rtpg(const fs::path& cwd, const std::string& args, const std::string& env = "") {
   test::TempDir capture;
   const fs::path out = capture.path() / "stdout", err = capture.path() / "stderr";
   // exec: the shell becomes rtpg, so a crash shows as a signal rather than as exit code 128+n.
   const std::string command = "cd " + shell_quote(cwd.string()) + " && exec " +
-                              shell_quote(rtpg_binary()) + " " + args + " >" +
-                              shell_quote(out.string()) + " 2>" + shell_quote(err.string());
+                              (env.empty() ? "" : "env " + env + " ") + shell_quote(rtpg_binary()) +
+                              " " + args + " >" + shell_quote(out.string()) + " 2>" +
+                              shell_quote(err.string());
   const int status = std::system(command.c_str());
   RunResult r;
   r.exited = WIFEXITED(status);
@@ -510,6 +512,46 @@ TEST_F(Cli, DevicesListsAtLeastOneDevice) {
   ASSERT_TRUE(r.exited) << describe(r);
   EXPECT_EQ(r.exit_code, 0) << describe(r);
   EXPECT_FALSE(r.out.empty());
+}
+
+// No OpenCL platform at all (the ICD loader finds no vendor file): exit code 3, the OpenCL
+// failure's one line, and nothing written, for every command that needs a device.
+TEST_F(Cli, NoOpenClPlatformIsExitThree) {
+  write("scene.json", scene_with(R"({"base_color": [0.5, 0.5, 0.5]})"));
+  test::TempDir no_vendors;
+  const std::string env = "OCL_ICD_VENDORS=" + shell_quote(no_vendors.path().string());
+  for (const std::string& args :
+       {std::string("devices"), render("scene.json --res 16x16"),
+        std::string("render scene.json --res 16x16 --spp 1 --guiding pmm -o out.exr")}) {
+    SCOPED_TRACE(args);
+    const auto before = snapshot(dir());
+    const RunResult r = run_rtpg(dir(), args, env);
+    ASSERT_TRUE(r.exited) << describe(r);
+    EXPECT_EQ(r.exit_code, 3) << describe(r);
+    EXPECT_EQ(r.err.rfind("rtpg: OpenCL: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "not one line:\n" << r.err;
+    EXPECT_EQ(snapshot(dir()), before) << "files written without a device";
+  }
+}
+
+// A cache folder that cannot be created only costs the caches: rendering works, with and
+// without guiding, and writes its image (docs/design.md: the program cache).
+TEST_F(Cli, UnwritableCacheFolderStillRenders) {
+  write("scene.json", scene_with(R"({"base_color": [0.5, 0.5, 0.5]})"));
+  const std::string env = "-u POCL_CACHE_DIR -u XDG_CACHE_HOME RTPG_CACHE_DIR=/proc/rtpg-cache";
+  for (const char* guiding : {"off", "pmm"}) {
+    SCOPED_TRACE(guiding);
+    fs::remove(dir() / "out.exr");
+    const RunResult r =
+        run_rtpg(dir(),
+                 std::string("render scene.json --res 16x16 --spp 1 --frames 2 --guiding ") +
+                     guiding + " -o out.exr",
+                 env);
+    ASSERT_TRUE(r.exited) << describe(r);
+    EXPECT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_TRUE(fs::exists(dir() / "out.exr")) << describe(r);
+  }
+  EXPECT_FALSE(fs::exists("/proc/rtpg-cache"));
 }
 
 }  // namespace

@@ -55,6 +55,7 @@ TEST(ClError, NamesEveryCodeAndFormatsTheMessage) {
   EXPECT_EQ(e.code(), CL_INVALID_VALUE);
   try {
     rethrow_cl_error(cl::Error(CL_OUT_OF_RESOURCES, "clBar"));
+    FAIL() << "rethrow_cl_error returned";
   } catch (const ClError& converted) {
     EXPECT_STREQ(converted.what(), "clBar: CL_OUT_OF_RESOURCES (-5)");
   }
@@ -266,7 +267,9 @@ TEST(ClRuntimeTiming, EventTimesAreNonNegative) {
   cl::Event event = acc.add(std::vector<glm::vec4>(32 * 32, glm::vec4(1.0f)));
   event.wait();
   const double ms = ClRuntime::event_ms(event);
-  EXPECT_GE(ms, 0.0);
+  // A kernel that ran took some time: a timer that returns 0 (profiling off, or start and end
+  // read from the same counter) fails here.
+  EXPECT_GT(ms, 0.0);
   EXPECT_LT(ms, 10000.0);
 }
 

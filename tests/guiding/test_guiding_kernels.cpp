@@ -926,6 +926,10 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
     expect_guider_error([&] { guider.train(bad, vpls, 1, 0); }, "current." + name);
     bad.*m.field = cl::Buffer();
     expect_guider_error([&] { guider.sample(bad, 1, 0, 0, samples); }, "current." + name);
+    // A G-buffer of a larger resolution (one more row): its rows would be misread.
+    bad.*m.field = cl::Buffer(rt.context(), CL_MEM_READ_WRITE, (hg.n() + w) * m.element);
+    expect_guider_error([&] { guider.sample(bad, 1, 0, 0, samples); }, "current." + name);
+    expect_guider_error([&] { guider.reproject(good, bad); }, "previous." + name);
   }
   cl::Buffer short16(rt.context(), CL_MEM_READ_WRITE, hg.n() * 16 - 16);
   cl::Buffer short4(rt.context(), CL_MEM_READ_WRITE, hg.n() * 4 - 4);
