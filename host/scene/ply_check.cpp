@@ -118,7 +118,17 @@ class PlyChecker {
         have_format = true;
       } else if (keyword == "element") {
         Element e;
-        if (!(words >> e.name >> e.count)) fail("bad element line");
+        std::string extra;
+        if (!(words >> e.name >> e.count) || (words >> extra)) fail("bad element line");
+        // assimp 5.2.5 matches element names without regard to case, reads a repeated element
+        // again and skips unknown ones, and writes out of bounds on such headers (found by
+        // fuzzing; valgrind shows the invalid write). rtpg accepts the canonical layout only:
+        // 'vertex', then 'face', each at most once, in lower case.
+        if (e.name != "vertex" && e.name != "face")
+          fail("element '" + e.name + "' (rtpg reads PLY elements 'vertex' and 'face' only)");
+        for (const Element& other : elements_)
+          if (other.name == e.name) fail("a second element '" + e.name + "'");
+        if (e.name == "vertex" && !elements_.empty()) fail("element 'vertex' after 'face'");
         elements_.push_back(e);
       } else if (keyword == "property") {
         if (elements_.empty()) fail("a property before any element");
@@ -145,6 +155,10 @@ class PlyChecker {
         // assimp 5.2.5 misreads a body whose properties have no name and then aborts in its
         // triangulation (an assert; found by fuzzing).
         if (p.name.empty()) fail("a property without a name");
+        std::string extra;
+        if (words >> extra) fail("property '" + p.name + "' has extra words ('" + extra + "')");
+        for (const Property& other : elements_.back().properties)
+          if (other.name == p.name) fail("a second property '" + p.name + "'");
         elements_.back().properties.push_back(p);
       } else {
         fail("unknown header keyword '" + keyword + "'");

@@ -175,6 +175,37 @@ TEST(InputValidation, PlyAsciiBodyWithANulByte) {
                      {"nul.ply", "a control or non-ASCII byte in element 'vertex' 2"});
 }
 
+// The canonical PLY layout only: assimp 5.2.5 matches element names without regard to case,
+// reads repeated elements and writes out of bounds on such headers (found by fuzzing).
+TEST(InputValidation, PlyElementsVertexThenFaceOnce) {
+  const std::string vertex =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string face = "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::string body = "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string head = "ply\nformat ascii 1.0\n";
+  const struct {
+    std::string header, message;
+  } cases[] = {
+      {vertex + "element Face 1\nproperty list uchar int vertex_indices\n", "element 'Face'"},
+      {vertex + face + "element edge 0\nproperty int vertex1\n", "element 'edge'"},
+      {vertex + face + "element face 0\nproperty list uchar int vertex_indices\n",
+       "a second element 'face'"},
+      {face + vertex, "element 'vertex' after 'face'"},
+      {"element vertex 3 extra\nproperty float x\nproperty float y\nproperty float z\n" + face,
+       "bad element line"},
+      {"element vertex 3\nproperty float x 1.0\nproperty float y\nproperty float z\n" + face,
+       "property 'x' has extra words ('1.0')"},
+      {"element vertex 3\nproperty float x\nproperty float x\nproperty float z\n" + face,
+       "a second property 'x'"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.header);
+    TempDir dir;
+    write_file(dir / "e.ply", head + c.header + body);
+    expect_input_error([&] { load_scene(write_scene(dir, "e.ply")); }, {"e.ply", c.message});
+  }
+}
+
 TEST(InputValidation, TrailingCommentsAndOtherForms) {
   TempDir dir;
   write_file(dir / "m.obj", std::string("mtllib m.mtl\n") + "v 0 0 0 # origin\n" +
