@@ -243,8 +243,9 @@ TEST(GuidingImage, RejectsAFivePercentPdfError) {
 
 // cornell-indirect with one indirect bounce (max_bounces 2, the budget first-bounce guiding
 // targets), 128x128, fixed seed, 32 frames at 1 spp; the mean relMSE of the last 8 frames with
-// guiding is at most 0.7 times that without, against a 1024-spp reference rendered here. At the
-// scene's full depth the ratio is 0.79 today (docs/guiding.md): not yet guarded.
+// guiding is at most half that without (0.21 measured), against a 1024-spp reference rendered
+// here. At the scene's full depth (8 bounces) the equal-frame ratio is 0.97, not significant
+// (docs/results/equal-frame-2026-11-23/): that gain is not there to guard yet.
 TEST(GuidingImage, HalvesErrorOnCornellIndirect) {
   const Scene scene = load_scene(scene_file("cornell-indirect.json"));
   ClRuntime cl;
@@ -280,7 +281,7 @@ TEST(GuidingImage, HalvesErrorOnCornellIndirect) {
   }
   RecordProperty("relmse_pt", std::to_string(error[0]));
   RecordProperty("relmse_pg", std::to_string(error[1]));
-  EXPECT_LE(error[1], 0.7 * error[0]) << "PT " << error[0] << ", guided " << error[1];
+  EXPECT_LE(error[1], 0.5 * error[0]) << "PT " << error[0] << ", guided " << error[1];
   std::printf(
       "cornell-indirect 128x128, last 8 of 32 frames: relMSE PT %.4f, guided %.4f (ratio %.3f)\n",
       error[0], error[1], error[1] / error[0]);
