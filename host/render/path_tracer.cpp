@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "render/mis.h"
 #include "render/surface.h"
 #include "shared/guiding_pixel.h"
 #include "shared/rng.h"
@@ -25,12 +26,6 @@ double ms_since(Clock::time_point start) {
 }
 
 // Veach's power heuristic (beta = 2) for the strategy with density a against b.
-float power_heuristic(float a, float b) {
-  if (std::isinf(a)) return 1.0f;
-  const float a2 = a * a, b2 = b * b;
-  return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
-}
-
 bool is_black(const glm::vec3& c) {
   return c.x <= 0.0f && c.y <= 0.0f && c.z <= 0.0f;
 }

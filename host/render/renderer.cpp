@@ -133,8 +133,10 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
         const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
         g.motion[i] = glm::vec2(px * static_cast<float>(g.width) - (static_cast<float>(x) + 0.5f),
                                 py * static_cast<float>(g.height) - (static_cast<float>(y) + 0.5f));
-        // A static camera has exactly zero motion, whatever the jitter.
-        if (frame == 0 || settings_.camera_path.empty()) g.motion[i] = glm::vec2(0.0f);
+        // A static camera (no path, or a path held at one frame) has exactly zero motion,
+        // whatever the jitter.
+        if (frame == 0 || settings_.camera_path.empty() || settings_.camera_frame >= 0)
+          g.motion[i] = glm::vec2(0.0f);
       }
     }
   });

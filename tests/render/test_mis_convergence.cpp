@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "render/mis.h"
 #include "render/renderer.h"
 #include "scene/scene_loader.h"
 #include "support/statistics.h"
@@ -186,6 +187,29 @@ TEST_F(MisConvergence, RejectsATwoPercentBrighterLight) {
     EXPECT_LT(cmp.p_value, alpha) << "channel " << c << ": difference " << cmp.difference << " +- "
                                   << cmp.standard_error;
   }
+}
+
+// The power heuristic's values by hand, and at densities whose squares overflow a float (a
+// small light seen edge-on): the weight stays a weight, never NaN.
+TEST(PowerHeuristic, ValuesByHandAndNoOverflow) {
+  EXPECT_FLOAT_EQ(power_heuristic(1.0f, 1.0f), 0.5f);
+  EXPECT_FLOAT_EQ(power_heuristic(3.0f, 1.0f), 0.9f);
+  EXPECT_FLOAT_EQ(power_heuristic(1.0f, 3.0f), 0.1f);
+  EXPECT_EQ(power_heuristic(2.0f, 0.0f), 1.0f);
+  EXPECT_EQ(power_heuristic(0.0f, 2.0f), 0.0f);
+  EXPECT_EQ(power_heuristic(0.0f, 0.0f), 0.0f);
+  EXPECT_EQ(power_heuristic(INFINITY, 5.0f), 1.0f);
+  EXPECT_FLOAT_EQ(power_heuristic(3e20f, 1e20f), 0.9f);
+  EXPECT_FLOAT_EQ(power_heuristic(1e20f, 3e20f), 0.1f);
+  EXPECT_EQ(power_heuristic(1e30f, 1.0f), 1.0f);
+  for (float a : {1e-30f, 1.0f, 1e19f, 3e38f})
+    for (float b : {0.0f, 1e-30f, 1.0f, 1e19f, 3e38f}) {
+      const float w = power_heuristic(a, b), v = power_heuristic(b, a);
+      ASSERT_TRUE(w >= 0.0f && w <= 1.0f) << a << " " << b;
+      if (b > 0.0f) {
+        EXPECT_NEAR(w + v, 1.0f, 1e-6f) << a << " " << b;
+      }
+    }
 }
 
 }  // namespace

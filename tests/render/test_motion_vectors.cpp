@@ -81,17 +81,25 @@ TEST(MotionVectors, EqualTheProjectionIntoThePreviousFrame) {
               largest_motion, largest_error);
 }
 
-// A static camera has zero motion on every frame, jitter or not.
+// A static camera has zero motion on every frame, jitter or not: no camera path, or a path
+// held at one of its frames (how references are rendered).
 TEST(MotionVectors, ZeroForAStaticCamera) {
   const Scene scene = cornell_box();
-  RenderSettings settings;
-  settings.width = 19;
-  settings.height = 31;
-  settings.path_tracer.max_bounces = 1;
-  Renderer renderer(scene, settings);
-  for (int f = 0; f < 3; ++f) {
-    renderer.render_frame(f);
-    for (const glm::vec2& m : renderer.gbuffer().motion) ASSERT_EQ(m, glm::vec2(0.0f));
+  for (const int held_frame : {-1, 3}) {
+    SCOPED_TRACE(held_frame);
+    RenderSettings settings;
+    settings.width = 19;
+    settings.height = 31;
+    settings.path_tracer.max_bounces = 1;
+    if (held_frame >= 0) {
+      settings.camera_path = "pan";
+      settings.camera_frame = held_frame;
+    }
+    Renderer renderer(scene, settings);
+    for (int f = 0; f < 3; ++f) {
+      renderer.render_frame(f);
+      for (const glm::vec2& m : renderer.gbuffer().motion) ASSERT_EQ(m, glm::vec2(0.0f));
+    }
   }
 }
 
