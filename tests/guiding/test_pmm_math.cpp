@@ -439,6 +439,36 @@ TEST(PmmEm, UnusableWeightsMixedIntoAGoodBatchAreDropped) {
   }
 }
 
+// A frame that found fewer samples than the neighbourhood promises (target_count) takes a
+// proportionally smaller step (pmm.h, pg_pmm_update): with 3 of 12 samples the state moves a
+// quarter as far towards the batch as with a target of 3, so a starved frame cannot overwrite
+// the history.
+TEST(PmmEm, AStarvedBatchTakesAProportionallySmallerStep) {
+  const pg_kernel_settings p = default_params();
+  const pg_pmm_state s0 = make_state(0.5f, 0.5f, 0.02f, 0.02f, 0.0f, 0.5f, 3.0f);
+  const pg_pmm_model m = pg_pmm_model_from_state(s0, p);
+  const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
+  pg_pmm_batch b = pg_pmm_batch_empty();
+  for (const float2 v : {float2(0.55f, 0.45f), float2(0.6f, 0.5f), float2(0.52f, 0.58f)})
+    b = pg_pmm_batch_add(b, m, p, 1.0f, v,
+                         pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), s0.s0.x);
+  int full_updated = 0, starved_updated = 0;
+  const pg_pmm_state full = pg_pmm_update(s0, b, p, 3.0f, &full_updated);
+  const pg_pmm_state starved = pg_pmm_update(s0, b, p, 12.0f, &starved_updated);
+  ASSERT_EQ(full_updated, 1);
+  ASSERT_EQ(starved_updated, 1);
+  for (int c = 0; c < 4; ++c) {
+    const double step_full = double(full.s0[c]) - s0.s0[c];
+    EXPECT_NEAR(double(starved.s0[c]) - s0.s0[c], 0.25 * step_full, 1e-5 * std::fabs(s0.s0[c]))
+        << c;
+    if (c == 3) continue;  // s1.w is the epoch count k, which advances by one either way
+    const double step1 = double(full.s1[c]) - s0.s1[c];
+    EXPECT_NEAR(double(starved.s1[c]) - s0.s1[c], 0.25 * step1, 1e-5 * std::fabs(s0.s1[c])) << c;
+  }
+  EXPECT_EQ(full.s1.w, starved.s1.w);
+  EXPECT_GT(std::fabs(double(full.s0.z) - s0.s0.z), 1e-3) << "the batch must move the mean";
+}
+
 // One sample repeated (and the square's corners and edge midpoints, where the map M has its
 // kinks and the mean sits on the clamp): the empirical covariance is exactly zero, yet the
 // model keeps a positive definite Sigma and its mean at the sample.
