@@ -15,8 +15,9 @@
 //   ... the renderer traces its paths and writes one VPL per pixel ...
 //   guider.train(current, vpls, ...)        one EM step per pixel
 // Only the guider knows its state; it knows nothing of scenes, files or ray tracing. Every
-// method throws GuiderError for misuse and ClError (include/rtpg/cl_error.h) when OpenCL
-// fails.
+// method throws GuiderError for misuse (among it a buffer that does not hold exactly
+// width * height elements of its channel: another resolution's rows would be misread) and
+// ClError (include/rtpg/cl_error.h) when OpenCL fails.
 #pragma once
 
 #include <cstddef>
