@@ -1,6 +1,7 @@
 #include "render/path_tracer.h"
 
 #include <algorithm>
+#include <functional>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -8,6 +9,8 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_scan.h>
 
 #include "render/mis.h"
 #include "render/surface.h"
@@ -359,50 +362,84 @@ void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& 
   occluded_.resize(count);
   tracer_.occluded(shadow_rays_.data(), occluded_.data(), count);
   times.trace_ms += ms_since(start);
-  std::uint64_t valid = 0;
-  for (std::size_t j = 0; j < count; ++j) valid += shadow_rays_[j].tmin <= shadow_rays_[j].tmax;
-  rays.shadow += valid;
+  rays.shadow += tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, count, kGrain), std::uint64_t{0},
+      [&](const auto& range, std::uint64_t valid) {
+        for (std::size_t j = range.begin(); j != range.end(); ++j)
+          valid += shadow_rays_[j].tmin <= shadow_rays_[j].tmax;
+        return valid;
+      },
+      std::plus<std::uint64_t>());
 }
 
 void PathTracer::apply_shadow_rays(std::size_t count, const std::vector<std::uint32_t>* owners) {
-  for (std::size_t j = 0; j < count; ++j) {
-    if (occluded_[j] || shadow_rays_[j].tmin > shadow_rays_[j].tmax) continue;
-    PathState& p = paths_[owners ? (*owners)[j] : j];
-    p.radiance += shadow_work_[j].contribution;
-    p.vpl_radiance += shadow_work_[j].vpl_contribution;
-  }
+  // Every slot belongs to a different path: no two iterations touch one PathState.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
+    for (std::size_t j = range.begin(); j != range.end(); ++j) {
+      if (occluded_[j] || shadow_rays_[j].tmin > shadow_rays_[j].tmax) continue;
+      PathState& p = paths_[owners ? (*owners)[j] : j];
+      p.radiance += shadow_work_[j].contribution;
+      p.vpl_radiance += shadow_work_[j].vpl_contribution;
+    }
+  });
 }
 
 void PathTracer::compact(std::size_t count, const std::vector<std::uint32_t>* owners) {
-  next_active_.clear();
-  for (std::size_t j = 0; j < count; ++j)
-    if (alive_[j]) {
-      rays_[next_active_.size()] = rays_[j];
-      next_active_.push_back(owners ? (*owners)[j] : static_cast<std::uint32_t>(j));
-    }
+  // A parallel prefix sum of the alive flags gives each survivor its slot, in the serial
+  // order (so the frame is the same whatever the thread count); rays move to a second buffer,
+  // as an in-place parallel move could overwrite a ray before it is read.
+  slot_.resize(count);
+  const std::size_t alive = tbb::parallel_scan(
+      tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
+      [&](const auto& range, std::size_t sum, bool is_final) {
+        for (std::size_t j = range.begin(); j != range.end(); ++j) {
+          if (is_final) slot_[j] = static_cast<std::uint32_t>(sum);
+          sum += alive_[j];
+        }
+        return sum;
+      },
+      std::plus<std::size_t>());
+  next_active_.resize(alive);
+  next_rays_.resize(rays_.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
+    for (std::size_t j = range.begin(); j != range.end(); ++j)
+      if (alive_[j]) {
+        next_rays_[slot_[j]] = rays_[j];
+        next_active_[slot_[j]] = owners ? (*owners)[j] : static_cast<std::uint32_t>(j);
+      }
+  });
+  rays_.swap(next_rays_);
   active_.swap(next_active_);
 }
 
 void PathTracer::gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls,
                         std::uint64_t& nonfinite) const {
   const std::size_t n = paths_.size();
-  radiance.assign(n, glm::vec3(0.0f));
-  for (std::size_t i = 0; i < n; ++i) {
-    const PathState& p = paths_[i];
-    if (is_finite(p.radiance)) {
-      radiance[i] = p.radiance;
-    } else {
-      ++nonfinite;
-    }
-    if (vpls) {
-      const glm::vec3 vpl_l = p.vpl_radiance;
-      if (!is_finite(vpl_l) || !(vpls->position[i].w > 0.0f) || !std::isfinite(vpls->position[i].w))
-        vpls->info[i] &= ~PG_VPL_VALID;
-      // The kernels read the info bits from radiance_info.w (exact: small integers).
-      vpls->radiance_info[i] =
-          glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f), static_cast<float>(vpls->info[i]));
-    }
-  }
+  radiance.resize(n);
+  nonfinite += tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, kGrain), std::uint64_t{0},
+      [&](const auto& range, std::uint64_t bad) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+          const PathState& p = paths_[i];
+          if (is_finite(p.radiance)) {
+            radiance[i] = p.radiance;
+          } else {
+            radiance[i] = glm::vec3(0.0f);
+            ++bad;
+          }
+          if (vpls) {
+            const glm::vec3 vpl_l = p.vpl_radiance;
+            if (!is_finite(vpl_l) || !(vpls->position[i].w > 0.0f) ||
+                !std::isfinite(vpls->position[i].w))
+              vpls->info[i] &= ~PG_VPL_VALID;
+            // The kernels read the info bits from radiance_info.w (exact: small integers).
+            vpls->radiance_info[i] = glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f),
+                                               static_cast<float>(vpls->info[i]));
+          }
+        }
+        return bad;
+      },
+      std::plus<std::uint64_t>());
 }
 
 }  // namespace rtpg

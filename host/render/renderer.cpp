@@ -167,7 +167,9 @@ FrameStats Renderer::render_frame(int index) {
                         stats.nonfinite_samples, rays, times);
     t = Clock::now();
     const float weight = 1.0f / static_cast<float>(settings_.spp);
-    for (std::size_t i = 0; i < n; ++i) image_[i] += pass_[i] * weight;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) image_[i] += pass_[i] * weight;
+    });
     stats.time_ms["accumulate"] += ms_since(t);
   }
   // Training changes the model, so it waits for the frame's last sample: every sample of the

@@ -17,21 +17,6 @@ namespace rtpg {
 
 namespace {
 
-float srgb_to_linear(float c) {
-  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
-// 8-bit images are by far the most common (Sponza has ~70 of them): a table avoids a pow per
-// channel.
-const std::array<float, 256>& srgb_table() {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) t[i] = srgb_to_linear(static_cast<float>(i) / 255.0f);
-    return t;
-  }();
-  return table;
-}
-
 // The OIIO message, or a fallback when it set none.
 std::string reason(std::string message, const char* fallback) {
   while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
@@ -78,23 +63,35 @@ Texture read_opened(OIIO::ImageInput& in, const std::string& name, ImageDecode d
   if (alpha >= nch || (alpha < 0 && (nch == 2 || nch == 4))) alpha = nch - 1;
   const int colour_channels = alpha >= 0 ? alpha : nch;
   const bool linearise = decode.srgb && !spec.format.is_floating_point();
-  const std::array<float, 256>& table = srgb_table();
-
-  auto colour = [&](std::size_t i) {
-    if (eight_bit) return linearise ? table[bytes[i]] : static_cast<float>(bytes[i]) / 255.0f;
-    return linearise ? srgb_to_linear(values[i]) : values[i];
-  };
-  auto data = [&](std::size_t i) {
-    return eight_bit ? static_cast<float>(bytes[i]) / 255.0f : values[i];
-  };
 
   Texture texture;
   texture.path = name;
   texture.width = spec.width;
   texture.height = spec.height;
-  texture.texels.resize(static_cast<std::size_t>(spec.width) *
-                        static_cast<std::size_t>(spec.height));
-  for (std::size_t p = 0; p < texture.texels.size(); ++p) {
+  const std::size_t pixels = static_cast<std::size_t>(spec.width) * spec.height;
+  if (eight_bit) {
+    // Kept as stored (texture.h); RGB decoded by table on fetch, alpha as / 255.
+    texture.srgb = linearise;
+    texture.texels8.resize(pixels);
+    for (std::size_t p = 0; p < pixels; ++p) {
+      const std::size_t base = p * static_cast<std::size_t>(nch);
+      std::array<std::uint8_t, 4> t;
+      if (colour_channels >= 3) {
+        t = {bytes[base], bytes[base + 1], bytes[base + 2], 255};
+      } else {  // grey (or grey + alpha), expanded to RGB
+        t = {bytes[base], bytes[base], bytes[base], 255};
+      }
+      if (alpha >= 0)
+        t[3] = bytes[base + static_cast<std::size_t>(alpha)];
+      else if (decode.mask)
+        t[3] = bytes[base];
+      texture.texels8[p] = t;
+    }
+    return texture;
+  }
+  auto colour = [&](std::size_t i) { return linearise ? srgb_to_linear(values[i]) : values[i]; };
+  texture.texels.resize(pixels);
+  for (std::size_t p = 0; p < pixels; ++p) {
     const std::size_t base = p * static_cast<std::size_t>(nch);
     glm::vec4 t;
     if (colour_channels >= 3) {
@@ -104,9 +101,9 @@ Texture read_opened(OIIO::ImageInput& in, const std::string& name, ImageDecode d
       t = glm::vec4(g, g, g, 1.0f);
     }
     if (alpha >= 0)
-      t.w = data(base + static_cast<std::size_t>(alpha));
+      t.w = values[base + static_cast<std::size_t>(alpha)];
     else if (decode.mask)
-      t.w = data(base);
+      t.w = values[base];
     texture.texels[p] = t;
   }
   return texture;

@@ -24,17 +24,47 @@ float wrap_unit(float t) {
 
 }  // namespace
 
+float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
+const std::array<float, 256>& srgb_decode_table() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[i] = srgb_to_linear(static_cast<float>(i) / 255.0f);
+    return t;
+  }();
+  return table;
+}
+
+const std::array<float, 256>& unorm_decode_table() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[i] = static_cast<float>(i) / 255.0f;
+    return t;
+  }();
+  return table;
+}
+
 glm::vec4 Texture::fetch(int x, int y) const {
   // An empty texture is neutral for the multiplicative uses (colour, roughness, alpha).
-  if (width <= 0 || height <= 0 || texels.empty()) return glm::vec4(1.0f);
+  if (width <= 0 || height <= 0) return glm::vec4(1.0f);
   x = std::clamp(x, 0, width - 1);
   y = std::clamp(y, 0, height - 1);
-  return texels[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-                static_cast<std::size_t>(x)];
+  const std::size_t i =
+      static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+  if (i < texels8.size()) {
+    const std::array<std::uint8_t, 4>& b = texels8[i];
+    const std::array<float, 256>& rgb = srgb ? srgb_decode_table() : unorm_decode_table();
+    const std::array<float, 256>& unorm = unorm_decode_table();
+    return glm::vec4(rgb[b[0]], rgb[b[1]], rgb[b[2]], unorm[b[3]]);
+  }
+  if (i < texels.size()) return texels[i];
+  return glm::vec4(1.0f);
 }
 
 glm::vec4 Texture::sample(glm::vec2 uv) const {
-  if (width <= 0 || height <= 0 || texels.empty()) return glm::vec4(1.0f);
+  if (width <= 0 || height <= 0 || (texels.empty() && texels8.empty())) return glm::vec4(1.0f);
   // v = 0 is the bottom of the image but texel row 0 is its top: flip v. Texel centres sit
   // at half-integer positions.
   const float x = wrap_unit(uv.x) * static_cast<float>(width) - 0.5f;

@@ -1,6 +1,11 @@
-// A decoded image in linear float RGBA, sampled bilinearly with repeat wrapping.
+// A decoded image, sampled bilinearly with repeat wrapping. 8-bit sources stay 8-bit in memory
+// (4 bytes a texel instead of 16: Sponza's textures are fetched from memory, not cache, and the
+// fetches were a sixth of a frame) and are decoded on fetch by table, to exactly the floats a
+// decode at load time gave.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -8,10 +13,20 @@
 
 namespace rtpg {
 
+// The sRGB transfer function's inverse: an encoded value in [0, 1] to linear.
+float srgb_to_linear(float c);
+
+// Decode tables of 8-bit channels: value i to linear (sRGB transfer function) and to i / 255.
+const std::array<float, 256>& srgb_decode_table();
+const std::array<float, 256>& unorm_decode_table();
+
 struct Texture {
   std::string path;  // where it was read from (for messages and `rtpg info`)
   int width = 0, height = 0;
-  std::vector<glm::vec4> texels;  // row 0 = top of the image; linear values
+  // The texels, row 0 = top of the image, in one of two forms:
+  std::vector<glm::vec4> texels;  // linear floats (float images, textures built in code), or
+  std::vector<std::array<std::uint8_t, 4>> texels8;  // 8-bit RGBA as stored, decoded on fetch:
+  bool srgb = false;  // texels8's RGB through the sRGB table (else / 255); alpha always / 255
   glm::vec4 fetch(int x, int y) const;
   // uv in texture space with (0,0) = bottom-left (OBJ/glTF convention after loading), repeat.
   glm::vec4 sample(glm::vec2 uv) const;

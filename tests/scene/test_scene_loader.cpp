@@ -216,16 +216,23 @@ TEST(ImageLoader, DecodesSrgbOnlyForColourAndExpandsGrey) {
   const Texture data = load_image(dir / "grey.png", ImageDecode{false, false});
   const Texture mask = load_image(dir / "grey.png", ImageDecode{false, true});
   ASSERT_EQ(colour.width, 2);
-  EXPECT_NEAR(colour.texels[0].x, 0.2158605f, 1e-4f);
-  EXPECT_NEAR(colour.texels[0].z, 0.2158605f, 1e-4f);
-  EXPECT_FLOAT_EQ(colour.texels[0].w, 1.0f);
-  EXPECT_NEAR(data.texels[0].y, 128.0f / 255.0f, 1e-6f);
-  EXPECT_NEAR(mask.texels[0].w, 128.0f / 255.0f, 1e-6f);  // grey mask becomes alpha
+  EXPECT_NEAR(colour.fetch(0, 0).x, 0.2158605f, 1e-4f);
+  EXPECT_NEAR(colour.fetch(0, 0).z, 0.2158605f, 1e-4f);
+  EXPECT_FLOAT_EQ(colour.fetch(0, 0).w, 1.0f);
+  EXPECT_NEAR(data.fetch(0, 0).y, 128.0f / 255.0f, 1e-6f);
+  EXPECT_NEAR(mask.fetch(0, 0).w, 128.0f / 255.0f, 1e-6f);  // grey mask becomes alpha
+  // 8-bit sources stay 8-bit in memory and decode on fetch to what a decode at load gave:
+  // the sRGB transfer function, and i / 255 for data and alpha, exactly.
+  EXPECT_EQ(colour.texels8.size(), 4u);
+  EXPECT_TRUE(colour.texels.empty());
+  EXPECT_EQ(colour.fetch(1, 1).x, srgb_to_linear(128.0f / 255.0f));
+  EXPECT_EQ(data.fetch(1, 1).x, 128.0f / 255.0f);
+  EXPECT_EQ(colour.fetch(1, 1).w, 1.0f);
 
   write_png(dir / "rgba.png", 1, 1, 4, [](int, int, int c) { return c == 3 ? 51 : 128; });
   const Texture rgba = load_image(dir / "rgba.png", ImageDecode{true, false});
-  EXPECT_NEAR(rgba.texels[0].x, 0.2158605f, 1e-4f);  // colour not premultiplied by alpha
-  EXPECT_NEAR(rgba.texels[0].w, 0.2f, 1e-6f);        // alpha never sRGB-decoded
+  EXPECT_NEAR(rgba.fetch(0, 0).x, 0.2158605f, 1e-4f);  // colour not premultiplied by alpha
+  EXPECT_NEAR(rgba.fetch(0, 0).w, 0.2f, 1e-6f);        // alpha never sRGB-decoded
 
   write_float_image(dir / "env.exr", 2, 1, 7.5f);
   EXPECT_FLOAT_EQ(load_image(dir / "env.exr", ImageDecode{true, false}).texels[1].y, 7.5f);
@@ -314,8 +321,8 @@ TEST(SceneLoader, LoadsEveryFeature) {
   EXPECT_EQ(scene.textures.size(), 6u);
   // The grey mask: black left half is alpha 0.
   const Texture& mask = scene.textures.at(static_cast<std::size_t>(textured.alpha_texture));
-  EXPECT_FLOAT_EQ(mask.texels[0].w, 0.0f);
-  EXPECT_FLOAT_EQ(mask.texels[3].w, 1.0f);
+  EXPECT_FLOAT_EQ(mask.fetch(0, 0).w, 0.0f);
+  EXPECT_FLOAT_EQ(mask.fetch(3, 0).w, 1.0f);
 
   // The PLY: no normals in the file, so flat ones; mirrored by scale z = -1 and rotated.
   const Mesh* floor = nullptr;
@@ -446,8 +453,8 @@ TEST(SceneLoader, GlbWithEmbeddedTexture) {
   const Material& m = scene.materials.at(scene.meshes.at(0).material);
   ASSERT_GE(m.base_color_texture, 0);
   const Texture& t = scene.textures.at(static_cast<std::size_t>(m.base_color_texture));
-  EXPECT_NEAR(t.texels[0].x, 0.2158605f, 1e-4f);
-  EXPECT_NEAR(t.texels[0].w, 0.2f, 1e-6f);
+  EXPECT_NEAR(t.fetch(0, 0).x, 0.2158605f, 1e-4f);
+  EXPECT_NEAR(t.fetch(0, 0).w, 0.2f, 1e-6f);
 }
 
 TEST(SceneLoader, TransformsApplyScaleThenRotateThenTranslate) {
