@@ -115,14 +115,9 @@ SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& h
       perturbed = tn.x * t + tn.y * b + tn.z * ns;
     } else {
       // Height map: finite differences over one texel give the slope in tangent space.
-      const Texture& h = scene.textures[mat.bump_texture];
-      const float du = 1.0f / static_cast<float>(std::max(h.width, 1));
-      const float dv = 1.0f / static_cast<float>(std::max(h.height, 1));
-      const float h0 = h.sample(uv).x;
-      const float dhdu = (h.sample(uv + glm::vec2(du, 0.0f)).x - h0) / du;
-      const float dhdv = (h.sample(uv + glm::vec2(0.0f, dv)).x - h0) / dv;
+      const glm::vec2 slope = scene.textures[mat.bump_texture].sample_gradient(uv);
       // bump_scale converts height per unit uv into the normal's tilt.
-      perturbed = ns - mat.bump_scale * 0.01f * (dhdu * t + dhdv * b);
+      perturbed = ns - mat.bump_scale * 0.01f * (slope.x * t + slope.y * b);
     }
     if (glm::dot(perturbed, perturbed) > 1e-12f) {
       perturbed = glm::normalize(perturbed);

@@ -364,6 +364,8 @@ Scene load_scene(const std::string& json_path, const SceneLoadSettings& settings
   scene.source_path = json_path;
   SceneBuilder builder(json_path, settings, scene);
   builder.build(JsonNode(document, json_path, ""));
+  for (const Material& m : scene.materials)
+    if (m.bump_texture >= 0) prepare_bump_slopes(scene.textures[m.bump_texture]);
   return scene;
 }
 

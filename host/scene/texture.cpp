@@ -63,19 +63,69 @@ glm::vec4 Texture::fetch(int x, int y) const {
   return glm::vec4(1.0f);
 }
 
-glm::vec4 Texture::sample(glm::vec2 uv) const {
-  if (width <= 0 || height <= 0 || (texels.empty() && texels8.empty())) return glm::vec4(1.0f);
-  // v = 0 is the bottom of the image but texel row 0 is its top: flip v. Texel centres sit
-  // at half-integer positions.
+namespace {
+
+// The four texels around uv and their bilinear weights (v = 0 is the bottom of the image but
+// texel row 0 is its top: v is flipped; texel centres sit at half-integer positions).
+struct Bilinear {
+  int x0, x1, y0, y1;
+  float tx, ty;
+};
+
+Bilinear bilinear_at(glm::vec2 uv, int width, int height) {
   const float x = wrap_unit(uv.x) * static_cast<float>(width) - 0.5f;
   const float y = (1.0f - wrap_unit(uv.y)) * static_cast<float>(height) - 0.5f;
   const float fx = std::floor(x), fy = std::floor(y);
-  const float tx = x - fx, ty = y - fy;
-  const int x0 = wrap(static_cast<int>(fx), width), x1 = wrap(static_cast<int>(fx) + 1, width);
-  const int y0 = wrap(static_cast<int>(fy), height), y1 = wrap(static_cast<int>(fy) + 1, height);
-  const glm::vec4 top = glm::mix(fetch(x0, y0), fetch(x1, y0), tx);
-  const glm::vec4 bottom = glm::mix(fetch(x0, y1), fetch(x1, y1), tx);
-  return glm::mix(top, bottom, ty);
+  return {wrap(static_cast<int>(fx), width),
+          wrap(static_cast<int>(fx) + 1, width),
+          wrap(static_cast<int>(fy), height),
+          wrap(static_cast<int>(fy) + 1, height),
+          x - fx,
+          y - fy};
+}
+
+}  // namespace
+
+glm::vec4 Texture::sample(glm::vec2 uv) const {
+  if (width <= 0 || height <= 0 || (texels.empty() && texels8.empty())) return glm::vec4(1.0f);
+  const Bilinear b = bilinear_at(uv, width, height);
+  const glm::vec4 top = glm::mix(fetch(b.x0, b.y0), fetch(b.x1, b.y0), b.tx);
+  const glm::vec4 bottom = glm::mix(fetch(b.x0, b.y1), fetch(b.x1, b.y1), b.tx);
+  return glm::mix(top, bottom, b.ty);
+}
+
+glm::vec2 Texture::sample_gradient(glm::vec2 uv) const {
+  const float w = static_cast<float>(std::max(width, 1)),
+              h = static_cast<float>(std::max(height, 1));
+  if (slopes.empty() || width <= 0 || height <= 0) {
+    const float du = 1.0f / w, dv = 1.0f / h;
+    const float h0 = sample(uv).x;
+    return {(sample(uv + glm::vec2(du, 0.0f)).x - h0) / du,
+            (sample(uv + glm::vec2(0.0f, dv)).x - h0) / dv};
+  }
+  // The bilinear sample one texel further is the same weights on the shifted texels: its
+  // difference is the bilinear sample of the per-texel differences.
+  const Bilinear b = bilinear_at(uv, width, height);
+  const auto at = [&](int x, int y) {
+    return slopes[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                  static_cast<std::size_t>(x)];
+  };
+  const glm::vec2 top = glm::mix(at(b.x0, b.y0), at(b.x1, b.y0), b.tx);
+  const glm::vec2 bottom = glm::mix(at(b.x0, b.y1), at(b.x1, b.y1), b.tx);
+  return glm::mix(top, bottom, b.ty) * glm::vec2(w, h);
+}
+
+void prepare_bump_slopes(Texture& t) {
+  if (t.width <= 0 || t.height <= 0 || !t.slopes.empty()) return;
+  t.slopes.resize(static_cast<std::size_t>(t.width) * static_cast<std::size_t>(t.height));
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x) {
+      const float here = t.fetch(x, y).x;
+      // +u is the next column; +v the row above (row 0 is the top), both with repeat.
+      t.slopes[static_cast<std::size_t>(y) * static_cast<std::size_t>(t.width) +
+               static_cast<std::size_t>(x)] = glm::vec2(t.fetch(wrap(x + 1, t.width), y).x - here,
+                                                        t.fetch(x, wrap(y - 1, t.height)).x - here);
+    }
 }
 
 }  // namespace rtpg

@@ -27,9 +27,19 @@ struct Texture {
   std::vector<glm::vec4> texels;  // linear floats (float images, textures built in code), or
   std::vector<std::array<std::uint8_t, 4>> texels8;  // 8-bit RGBA as stored, decoded on fetch:
   bool srgb = false;  // texels8's RGB through the sRGB table (else / 255); alpha always / 255
+  // Bump maps only (prepare_bump_slopes): per texel, the difference of channel 0 to the next
+  // texel along +u and along +v (the row above), so that a bump's gradient is one bilinear
+  // lookup of 4 texels instead of three lookups of 12.
+  std::vector<glm::vec2> slopes;
   glm::vec4 fetch(int x, int y) const;
   // uv in texture space with (0,0) = bottom-left (OBJ/glTF convention after loading), repeat.
   glm::vec4 sample(glm::vec2 uv) const;
+  // d(channel 0)/du and d/dv at uv per unit of uv, as one-texel forward differences of the
+  // bilinear sample: from `slopes` when prepared, else from three samples.
+  glm::vec2 sample_gradient(glm::vec2 uv) const;
 };
+
+// Fills t.slopes (8 bytes a texel) for a texture used as a bump map.
+void prepare_bump_slopes(Texture& t);
 
 }  // namespace rtpg
