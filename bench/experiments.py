@@ -411,6 +411,7 @@ def main():
         own.update(experiment=name, seconds=results["seconds"][name], figures=results["experiments"][name])
         (ctx.out / f"{name}.json").write_text(json.dumps(own, indent=2))
         (ctx.out / "results.json").write_text(json.dumps(results, indent=2))
+    results["references"] = sorted(ctx.refs.timings.values(), key=lambda r: (r["scene"], r["res"], r["spp"]))
     results["finished"] = time.strftime("%Y-%m-%d %H:%M:%S")
     (ctx.out / "results.json").write_text(json.dumps(results, indent=2))
     report_dir = Path(args.report) if args.report else (ctx.out / "report" if args.quick else runner.ROOT / "docs" / "results")

@@ -192,6 +192,13 @@ def write(results, report_dir):
     if (report_dir / "reproducibility.md").exists():
         lines += ["A rerun of the same command against this report: [reproducibility.md](reproducibility.md) "
                   "(`bench/compare.py`).", ""]
+    if results.get("references"):
+        lines += ["References (`rtpg reference`, plain path tracing; cached ones rendered by an earlier run show no "
+                  "figures): " + "; ".join(
+                      f"{r['scene']}{' (' + r['camera'] + ')' if r.get('camera') else ''} {r['res']} {r['spp']} spp "
+                      + (f"{r['seconds']:.1f} s, {r['samples_per_second'] / 1e6:.2f} M samples/s"
+                         if "samples_per_second" in r else "cached")
+                      for r in results["references"]), ""]
     if results.get("skipped_scenes"):
         lines += ["Skipped scenes: " + ", ".join(f"{k} ({v})" for k, v in results["skipped_scenes"].items()), ""]
     if "equal_frame" in ex:

@@ -60,21 +60,35 @@ class ReferenceCache:
         self.folder = Path(folder)
         self.folder.mkdir(parents=True, exist_ok=True)
         self.source_hash = renderer_source_hash()
+        self.timings = {}  # what each reference used in this run cost (_note)
 
     def get(self, scene, res, spp, seed=1000, camera_path="", frame=0, max_bounces=0):
         key = json.dumps([scene, res, spp, seed, camera_path, frame, max_bounces, self.source_hash])
         digest = hashlib.sha256(key.encode()).hexdigest()[:20]
         path = self.folder / f"{scene}-{res}-{spp}spp-{digest}.exr"
+        timing = self.folder / f"{path.stem}.stats.json"
         if path.exists():
+            self._note(scene, res, spp, camera_path, frame, timing)
             return path
-        args = ["reference", scene_path(scene), "--res", res, "--spp", spp, "--seed", seed, "-o", path, "-q"]
+        args = ["reference", scene_path(scene), "--res", res, "--spp", spp, "--seed", seed, "-o", path, "-q",
+                "--stats-json", timing]
         if camera_path:
             args += ["--camera-path", camera_path, "--frame", frame]
         if max_bounces:
             args += ["--max-bounces", max_bounces]
         run(args)
         (self.folder / f"{path.stem}.key.json").write_text(key + "\n")
+        self._note(scene, res, spp, camera_path, frame, timing)
         return path
+
+    def _note(self, scene, res, spp, camera_path, frame, timing):
+        """Remembers what a reference cost (rtpg reference --stats-json); a reference cached by an
+        older rtpg has no such file and is listed without figures."""
+        entry = {"scene": scene, "res": res, "spp": spp, "camera": f"{camera_path} frame {frame}" if camera_path else ""}
+        if timing.exists():
+            stats = json.loads(timing.read_text())
+            entry.update(seconds=stats["seconds"], samples_per_second=stats["samples_per_second"])
+        self.timings[str(timing)] = entry
 
 
 def machine_info():

@@ -120,6 +120,8 @@ int main(int argc, char** argv) {
   reference_cmd->add_option("--spp", reference.spp, "Samples per pixel")->capture_default_str();
   reference_cmd->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
   reference_cmd->add_option("-o,--output", reference.output, "Output EXR")->required();
+  reference_cmd->add_option("--stats-json", reference.stats_json,
+                            "Write the render time and samples per second as JSON");
   reference_cmd->add_option("--camera-path", reference.camera_path,
                             "Named camera path of the scene");
   reference_cmd

@@ -514,6 +514,26 @@ TEST_F(Cli, DevicesListsAtLeastOneDevice) {
   EXPECT_FALSE(r.out.empty());
 }
 
+// rtpg reference reports what it cost: samples per second = width * height * spp / seconds, in
+// its line, in --stats-json and in the EXR metadata (rtpg:samples_per_second).
+TEST_F(Cli, ReferenceReportsSamplesPerSecond) {
+  const RunResult r =
+      run_rtpg(dir(), "reference " + shell_quote(source_dir() + "/scenes/cornell-box.json") +
+                          " --res 24x16 --spp 8 -o ref.exr --stats-json ref.json");
+  ASSERT_TRUE(r.exited) << describe(r);
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_NE(r.out.find("M samples/s"), std::string::npos) << r.out;
+  const nlohmann::json stats = nlohmann::json::parse(read_file(dir() / "ref.json"));
+  const double seconds = stats.at("seconds"), rate = stats.at("samples_per_second");
+  EXPECT_EQ(stats.at("spp"), 8);
+  ASSERT_GT(seconds, 0.0);
+  EXPECT_NEAR(rate, 24.0 * 16.0 * 8.0 / seconds, 1e-6 * rate);
+  auto in = OIIO::ImageInput::open((dir() / "ref.exr").string());
+  ASSERT_TRUE(in);
+  EXPECT_NEAR(std::stod(in->spec().get_string_attribute("rtpg:samples_per_second")), rate,
+              0.5 + 1e-6 * rate);
+}
+
 // No OpenCL platform at all (the ICD loader finds no vendor file): exit code 3, the OpenCL
 // failure's one line, and nothing written, for every command that needs a device.
 TEST_F(Cli, NoOpenClPlatformIsExitThree) {
