@@ -606,6 +606,16 @@ Cov raw_covariance(const pg_pmm_state& s) {
   return {s.s1.x / s0 - mx * mx, s.s1.y / s0 - my * my, s.s1.z / s0 - mx * my};
 }
 
+// Two frames: a random normal, and one tilted from it by up to max_tilt_deg degrees.
+std::pair<pg_frame, pg_frame> tilted_frames(std::mt19937& gen, float max_tilt_deg) {
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const float3 n1 = random_unit(gen);
+  const float3 t = normalize(cross(n1, random_unit(gen)));
+  const float tilt = max_tilt_deg * PG_PI / 180.0f * u(gen);
+  const float3 n2 = normalize(n1 * std::cos(tilt) + t * std::sin(tilt));
+  return {pg_frame_from_normal(n1), pg_frame_from_normal(n2)};
+}
+
 double angle(float3 a, float3 b) {
   return std::atan2(static_cast<double>(length(cross(a, b))), static_cast<double>(dot(a, b)));
 }
@@ -666,12 +676,9 @@ TEST(PmmReframe, RotationKeepsTheMeansWorldDirection) {
   int carried = 0, dropped = 0;
   std::vector<double> det_change;
   for (int i = 0; i < 5000; ++i) {
-    const float3 n1 = random_unit(gen);
-    // The new normal: tilted from n1 by up to 60 degrees.
-    const float3 t = normalize(cross(n1, random_unit(gen)));
-    const float tilt = 60.0f * PG_PI / 180.0f * u(gen);
-    const float3 n2 = normalize(n1 * std::cos(tilt) + t * std::sin(tilt));
-    const pg_frame f1 = pg_frame_from_normal(n1), f2 = pg_frame_from_normal(n2);
+    // The new normal: tilted from the old by up to 60 degrees.
+    const auto [f1, f2] = tilted_frames(gen, 60.0f);
+    const float3 n2 = f2.n;
     const float mx = 0.05f + 0.9f * u(gen), my = 0.05f + 0.9f * u(gen);
     const float sx = 0.01f + 0.05f * u(gen), sy = 0.01f + 0.05f * u(gen),
                 rho = -0.8f + 1.6f * u(gen);
@@ -782,11 +789,7 @@ TEST(PmmReframe, CovarianceMatchesCarriedSamples) {
            std::fabs(sample.xy - model.xy) <= 5.0 * se_xy + 0.03 * scale;
   };
   for (int i = 0; i < 300; ++i) {
-    const float3 n1 = random_unit(gen);
-    const float3 t = normalize(cross(n1, random_unit(gen)));
-    const float tilt = 45.0f * PG_PI / 180.0f * u(gen);
-    const float3 n2 = normalize(n1 * std::cos(tilt) + t * std::sin(tilt));
-    const pg_frame f1 = pg_frame_from_normal(n1), f2 = pg_frame_from_normal(n2);
+    const auto [f1, f2] = tilted_frames(gen, 45.0f);
     const double sx = 0.004 + 0.008 * u(gen), sy = 0.004 + 0.008 * u(gen);
     const double rho = -0.8 + 1.6 * u(gen);
     const float mx = 0.15f + 0.7f * u(gen), my = 0.15f + 0.7f * u(gen);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 #include <string>
 
@@ -46,6 +47,19 @@ float3 direction(float theta_deg, float phi_deg) {
   return float3(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t));
 }
 
+// Attempt i of the BSDF sampler as the chi-square test wants it (false: no direction).
+std::function<bool(std::size_t, glm::vec3&)> bsdf_attempts(const pg_lobes& lobes, float3 wo,
+                                                           uint seed) {
+  return [lobes, wo, seed](std::size_t i, glm::vec3& d) {
+    pg_rng rng = pg_rng_make(seed, static_cast<uint>(i), 0u, 0u, 9u);
+    const float a = pg_rng_next(&rng), b = pg_rng_next(&rng), e = pg_rng_next(&rng);
+    const pg_bsdf_sample_t s = pg_bsdf_sample(lobes, wo, a, b, e);
+    if (s.pdf <= 0.0f) return false;
+    d = s.wi;
+    return true;
+  };
+}
+
 }  // namespace
 
 TEST(Bsdf, SamplerMatchesPdfChiSquare) {
@@ -55,14 +69,7 @@ TEST(Bsdf, SamplerMatchesPdfChiSquare) {
     const float3 wo = direction(c.theta_o, 25.0f);
     const pg_lobes lobes = pg_make_lobes(c.material, wo);
     const auto result = rtpg::test::chi_square_test(
-        [&](std::size_t i, glm::vec3& d) {
-          pg_rng rng = pg_rng_make(1u, static_cast<uint>(i), 0u, 0u, 9u);
-          const float a = pg_rng_next(&rng), b = pg_rng_next(&rng), e = pg_rng_next(&rng);
-          const pg_bsdf_sample_t s = pg_bsdf_sample(lobes, wo, a, b, e);
-          if (s.pdf <= 0.0f) return false;
-          d = s.wi;
-          return true;
-        },
+        bsdf_attempts(lobes, wo, 1u),
         [&](const glm::vec3& wi) { return static_cast<double>(pg_bsdf_pdf(lobes, wo, wi)); },
         1000000, 40, 80, 12);
     EXPECT_GT(result.p_value, alpha) << c.name << ": " << result.describe();
@@ -272,14 +279,7 @@ TEST(Bsdf, ChiSquareRejectsAWrongDensity) {
   const pg_lobes lobes = pg_make_lobes(plastic, wo);
   pg_lobes rougher = lobes;
   rougher.alpha *= 1.1f;
-  const auto sample = [&](std::size_t i, glm::vec3& d) {
-    pg_rng rng = pg_rng_make(2u, static_cast<uint>(i), 0u, 0u, 9u);
-    const float a = pg_rng_next(&rng), b = pg_rng_next(&rng), e = pg_rng_next(&rng);
-    const pg_bsdf_sample_t s = pg_bsdf_sample(lobes, wo, a, b, e);
-    if (s.pdf <= 0.0f) return false;
-    d = s.wi;
-    return true;
-  };
+  const auto sample = bsdf_attempts(lobes, wo, 2u);
   const float3 mirror(-wo.x, -wo.y, wo.z);
   const auto five_percent = rtpg::test::chi_square_test(
       sample,
