@@ -42,10 +42,11 @@ LABEL = {"off": "PT", "pmm": "PG"}
 MODES = {
     "quick": dict(res="48x32", ref_spp=64, T=8, sweep=[2, 8], time_frames=6, repeats=2, flicker_frames=4,
                   path_res="24x16", path_frames=[1, 4], path_ref_spp=64, trade_res="24x16", trade_frames=8,
+                  svgf_large_res="96x64",
                   scenes=["cornell-box", "cornell-indirect"], tradeoff_scenes=["cornell-indirect"]),
     "full": dict(res="960x540", ref_spp=1024, T=32, sweep=[1, 4, 8, 16, 32, 64], time_frames=32, repeats=3,
                  flicker_frames=24, path_res="480x270", path_frames=[7, 15, 31, 59], path_ref_spp=256,
-                 trade_res="480x270", trade_frames=32,
+                 trade_res="480x270", trade_frames=32, svgf_large_res="1920x1080",
                  scenes=["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza"],
                  tradeoff_scenes=["cornell-indirect", "sponza"]),
 }
@@ -258,6 +259,81 @@ def convergence(ctx, scene):
     return result
 
 
+def denoised(ctx, scene):
+    """PT+SVGF against PG+SVGF (paper, table 2; docs/denoising.md): FLIP and relMSE of the denoised
+    frame after T frames against the reference (static camera), the same at checkpoints of the
+    camera path, the flicker of the denoised sequence along the path, and SVGF's time as a
+    fraction of the PT frame at the main resolution and at svgf_large_res."""
+    m = ctx.mode
+    T = m["T"]
+    ref = ctx.reference_image(scene, m["res"])
+    out = ctx.out / "denoised" / scene
+    out.mkdir(parents=True, exist_ok=True)
+    result = {"scene": scene, "T": T, "static": {}, "path": {}, "cost": {}}
+    images = {}
+    for method in METHODS:
+        noisy_path = out / f"{method}-noisy.exr"
+        stats, image = runner.render(scene, m["res"], T, method, out, method, reference=ctx.reference(scene, m["res"]),
+                                     extra=["--denoise", "svgf", "--noisy-output", noisy_path])
+        img, noisy = metrics.load_exr(image), metrics.load_exr(noisy_path)
+        images[method] = img
+        window = [f["relmse"] for f in stats["frames"][T - LAST:T]]
+        mean, sem = mean_sem(window)
+        result["static"][method] = {
+            "relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
+            "flip_ldr": metrics.flip_ldr(img, ref), "relmse_noisy": metrics.relmse(noisy, ref),
+            "flip_ldr_noisy": metrics.flip_ldr(noisy, ref),
+            "time_ms": {k: median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]},
+        }
+    # SVGF's cost against the path-traced frame it filters (the renderer's part of "total").
+    for res, method_stats in ((m["res"], result["static"]["off"]["time_ms"]), (m["svgf_large_res"], None)):
+        if method_stats is None:
+            stats, _ = runner.render(scene, res, 4, "off", out, "cost-large", extra=["--denoise", "svgf"])
+            method_stats = {k: median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}
+        svgf = method_stats["svgf_total"]
+        result["cost"][res] = {"svgf_ms": svgf, "pt_frame_ms": method_stats["total"] - svgf,
+                               "kernels_ms": {k: v for k, v in method_stats.items() if k.startswith("svgf_")}}
+    paths = json.loads(Path(runner.scene_path(scene)).read_text()).get("camera_paths", {})
+    if paths:
+        name = sorted(paths)[0]
+        result["path_name"] = name
+        frames = m["path_frames"]
+        refs = {f: metrics.load_exr(ctx.refs.get(scene, m["path_res"], m["path_ref_spp"], camera_path=name, frame=f))
+                for f in frames}
+        for method in METHODS:
+            stats, image = runner.render(scene, m["path_res"], max(frames) + 1, method, out, f"path-{method}",
+                                         extra=["--camera-path", name, "--denoise", "svgf",
+                                                "--save-frames", ",".join(map(str, frames))])
+            imgs = {f: metrics.load_exr(saved_frame(image, f)) for f in frames}
+            flicker = [f["flicker_mse"] for f in stats["frames"] if "flicker_mse" in f]
+            flicker_noisy = [f["flicker_mse_noisy"] for f in stats["frames"] if "flicker_mse_noisy" in f]
+            fm, fs = mean_sem(flicker)
+            result["path"][method] = {"frames": frames,
+                                      "relmse": [metrics.relmse(imgs[f], refs[f]) for f in frames],
+                                      "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f]) for f in frames],
+                                      "flicker_mse": fm, "flicker_sem": fs,
+                                      "flicker_mse_noisy": mean_sem(flicker_noisy)[0]}
+    err = np.mean((images["off"] - ref) ** 2 / (ref ** 2 + 0.01), axis=2)
+    y0, x0, s = crop_box(err, max(16, min(ref.shape[:2]) // 3))
+    fig, axes = plt.subplots(2, 3, figsize=(12, 8) if ref.shape[1] > 400 else (9, 6))
+    for col, (label, img) in enumerate((("Reference", ref), ("PT+SVGF", images["off"]), ("PG+SVGF", images["pmm"]))):
+        tm = metrics.tonemap_srgb(img)
+        axes[0, col].imshow(tm)
+        axes[0, col].add_patch(plt.Rectangle((x0, y0), s, s, fill=False, color="cyan"))
+        if col:
+            label += f"  FLIP {result['static']['off' if col == 1 else 'pmm']['flip_ldr']:.3f}"
+        axes[0, col].set_title(label, fontsize=9)
+        axes[1, col].imshow(tm[y0:y0 + s, x0:x0 + s], interpolation="nearest")
+        for a in axes[:, col]:
+            a.axis("off")
+    fig.suptitle(f"{scene}: 1 spp + SVGF after {T} frames ({m['res']})")
+    fig.tight_layout()
+    fig.savefig(out / "denoised.png", dpi=100)
+    plt.close(fig)
+    result["figure"] = str(out / "denoised.png")
+    return result
+
+
 TRADEOFFS = {
     "N schedule (paper)": [],
     "fixed N=5": ["--pg-n-min", 5, "--pg-n-max", 5],
@@ -323,7 +399,7 @@ def kernels(ctx, _scene=None):
 
 
 EXPERIMENTS = {"equal_frame": equal_frame, "equal_time": equal_time, "flicker": flicker, "convergence": convergence,
-               "tradeoffs": tradeoffs, "kernels": kernels}
+               "denoised": denoised, "tradeoffs": tradeoffs, "kernels": kernels}
 
 
 def parse_res(res):

@@ -33,8 +33,9 @@ class QuickRun(unittest.TestCase):
 
     def test_every_experiment_and_scene(self):
         ex = self.results["experiments"]
-        self.assertEqual(set(ex), {"equal_frame", "equal_time", "flicker", "convergence", "tradeoffs", "kernels"})
-        for name in ("equal_frame", "equal_time", "flicker", "convergence"):
+        self.assertEqual(set(ex), {"equal_frame", "equal_time", "flicker", "convergence", "denoised", "tradeoffs",
+                                   "kernels"})
+        for name in ("equal_frame", "equal_time", "flicker", "convergence", "denoised"):
             self.assertEqual(set(ex[name]), {"cornell-box", "cornell-indirect"}, name)
         self.assertEqual(set(ex["tradeoffs"]), {"cornell-indirect"})
         self.assertIn("benchmarks", ex["kernels"], ex["kernels"].get("skipped"))
@@ -67,6 +68,15 @@ class QuickRun(unittest.TestCase):
                 self.assertTrue(v == equal_time.NOT_REACHED or (math.isfinite(v) and v > 0), f"{scene} {key} = {v}")
         for r in ex["flicker"].values():
             self.assertGreater(r["methods"]["off"]["flicker_mse"], 0.0)
+        for scene, r in ex["denoised"].items():
+            for method in ("off", "pmm"):
+                m = r["static"][method]
+                for key in ("relmse", "relmse_last8", "flip_ldr", "flip_ldr_noisy", "relmse_noisy"):
+                    self.assertTrue(math.isfinite(m[key]) and m[key] > 0, f"{scene} {method} {key} = {m[key]}")
+                self.assertGreater(m["time_ms"]["svgf_atrous"], 0.0)
+                self.assertEqual(r["path"][method]["frames"], [1, 4])
+            self.assertEqual(set(r["cost"]), {"48x32", "96x64"})
+            self.assertTrue(Path(r["figure"]).exists())
         rows = ex["tradeoffs"]["cornell-indirect"]["rows"]
         self.assertEqual(rows["PT (no guiding)"]["train_ms"], 0.0)
         self.assertGreater(rows["fixed N=20"]["train_ms"], 0.0)

@@ -15,6 +15,7 @@
 
 #include "rtpg/cl_runtime.h"
 #include "cl/device.h"
+#include "denoise/svgf_denoiser.h"
 #include "render/image_kernels.h"
 #include "render/guided_first_bounce.h"
 #include "render/image_io.h"
@@ -75,12 +76,24 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
 }
 
-ImageRgb to_image(const Renderer& renderer) {
+ImageRgb to_image(const Renderer& renderer, const std::vector<glm::vec3>& pixels) {
   ImageRgb image;
   image.width = renderer.settings().width;
   image.height = renderer.settings().height;
-  image.pixels = renderer.image();
+  image.pixels = pixels;
   return image;
+}
+
+// Temporal flicker (docs/design.md, "Metrics"): MSE between consecutive frames over pixels and
+// channels; -1 for the first frame.
+double flicker_mse(const std::vector<glm::vec3>& image, const std::vector<glm::vec3>& previous) {
+  if (previous.size() != image.size()) return -1.0;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    const glm::vec3 d = image[i] - previous[i];
+    sum += static_cast<double>(glm::dot(d, d));
+  }
+  return sum / (3.0 * static_cast<double>(image.size()));
 }
 
 void write_output(const std::string& path, const ImageRgb& image, ClRuntime& cl,
@@ -124,6 +137,18 @@ nlohmann::json guiding_settings_json(const GuidingSettings& s) {
   return out;
 }
 
+nlohmann::json svgf_settings_json(const SvgfSettings& s) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const SvgfSettingInfo& row : svgf_settings_table()) {
+    if (row.int_field) {
+      out[row.name] = s.*row.int_field;
+    } else {
+      out[row.name] = s.*row.float_field;
+    }
+  }
+  return out;
+}
+
 nlohmann::json path_tracer_settings_json(const PathTracerSettings& s) {
   return {{"max_bounces", s.max_bounces},
           {"roulette_start", s.roulette_start},
@@ -154,9 +179,15 @@ std::string default_scene_path() {
 
 int run_render(const RenderCommand& command) {
   check_output_path(command.output, "--output", true);
+  check_output_path(command.noisy_output, "--noisy-output", true);
+  if (!command.noisy_output.empty() && command.denoise == "off")
+    throw InputError("--noisy-output", "needs --denoise (without it --output is the noisy image)");
+  if (command.denoise != "off" && command.denoise != "svgf")
+    throw InputError("--denoise", "unknown denoiser '" + command.denoise + "' (off or svgf)");
+  if (command.denoise == "svgf") validate(command.svgf_settings);
   if (!command.stats_json.empty()) check_output_folder(command.stats_json);
   if (command.frames <= 0) throw InputError("--frames", "must be at least 1");
-  if (!command.save_frames.empty() && command.output.empty())
+  if (!command.save_frames.empty() && command.output.empty() && command.noisy_output.empty())
     throw InputError("--save-frames", "needs --output (the frames are written beside it)");
   for (int f : command.save_frames)
     if (f < 0 || f >= command.frames)
@@ -187,6 +218,10 @@ int run_render(const RenderCommand& command) {
   if (command.guiding == "pmm")
     renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(
         cl, command.settings.width, command.settings.height, command.guiding_settings));
+  std::unique_ptr<SvgfDenoiser> denoiser;
+  if (command.denoise == "svgf")
+    denoiser =
+        std::make_unique<SvgfDenoiser>(cl, settings.width, settings.height, command.svgf_settings);
 
   nlohmann::json frames = nlohmann::json::array();
   std::vector<double> totals;
@@ -196,45 +231,61 @@ int run_render(const RenderCommand& command) {
   std::unique_ptr<Accumulator> accumulator;
   if (command.accumulate)
     accumulator = std::make_unique<Accumulator>(cl, settings.width, settings.height);
-  std::vector<glm::vec3> previous;  // last frame, for the temporal flicker metric
+  // Last frame's output and unfiltered image, for the temporal flicker metric.
+  std::vector<glm::vec3> previous, previous_noisy;
   std::vector<glm::vec4> frame_rgba;
+  std::vector<glm::vec3> shown;  // this frame's output: the denoised image with --denoise
   ImageRgb accumulated{settings.width, settings.height, {}};
-  // The current frame's image (the running mean with --accumulate) to --output or a
+  const std::map<std::string, std::string> metadata = {
+      {"scene", scene_path},
+      {"spp", std::to_string(command.settings.spp)},
+      {"seed", std::to_string(command.settings.seed)},
+      {"guiding", command.guiding},
+      {"denoise", command.denoise}};
+  // The current frame's output (the running mean with --accumulate) to --output or a
   // --save-frames file, with the metadata that says which frame it is.
   auto write_frame = [&](const std::string& path, int f) {
-    ImageRgb out = to_image(renderer);
+    ImageRgb out = to_image(renderer, shown);
     if (accumulator) {
       const std::vector<glm::vec4> mean = accumulator->read();
       for (std::size_t i = 0; i < mean.size(); ++i) out.pixels[i] = glm::vec3(mean[i]);
     }
-    write_output(path, out, cl,
-                 {{"scene", scene_path},
-                  {"spp", std::to_string(command.settings.spp)},
-                  {"seed", std::to_string(command.settings.seed)},
-                  {"frame", std::to_string(f)},
-                  {"accumulated_frames", std::to_string(accumulator ? f + 1 : 1)},
-                  {"render_time_ms", fmt::format("{:.3f}", totals.back())},
-                  {"guiding", command.guiding}});
+    std::map<std::string, std::string> m = metadata;
+    m["frame"] = std::to_string(f);
+    m["accumulated_frames"] = std::to_string(accumulator ? f + 1 : 1);
+    m["render_time_ms"] = fmt::format("{:.3f}", totals.back());
+    write_output(path, out, cl, m);
+  };
+  // The unfiltered frame (with --denoise) to --noisy-output or its --save-frames file.
+  auto write_noisy_frame = [&](const std::string& path, int f) {
+    std::map<std::string, std::string> m = metadata;
+    m["denoise"] = "off";
+    m["frame"] = std::to_string(f);
+    m["render_time_ms"] = fmt::format("{:.3f}", totals.back());
+    write_output(path, to_image(renderer, renderer.image()), cl, m);
   };
   for (int f = 0; f < command.frames; ++f) {
     FrameStats stats = renderer.render_frame(f);
-    totals.push_back(stats.time_ms["total"]);
     const std::vector<glm::vec3>& image = renderer.image();
-    double flicker = -1.0;
-    if (!previous.empty()) {
-      // Temporal flicker (docs/design.md, "Metrics"): MSE between consecutive frames over pixels
-      // and channels.
-      double sum = 0.0;
-      for (std::size_t i = 0; i < image.size(); ++i) {
-        const glm::vec3 d = image[i] - previous[i];
-        sum += static_cast<double>(glm::dot(d, d));
-      }
-      flicker = sum / (3.0 * static_cast<double>(image.size()));
-    }
-    previous = image;
-    if (accumulator) {
+    shown = image;
+    double svgf_bytes = 0.0;
+    if (denoiser) {
       frame_rgba.resize(image.size());
       for (std::size_t i = 0; i < image.size(); ++i) frame_rgba[i] = glm::vec4(image[i], 1.0f);
+      const std::vector<glm::vec4>& denoised = denoiser->denoise(frame_rgba, renderer.gbuffer());
+      for (std::size_t i = 0; i < image.size(); ++i) shown[i] = glm::vec3(denoised[i]);
+      for (const auto& [name, ms] : denoiser->times_ms()) stats.time_ms[name] = ms;
+      stats.time_ms["total"] += denoiser->times_ms().at("svgf_total");
+      svgf_bytes = denoiser->host_device_bytes_per_pixel();
+    }
+    totals.push_back(stats.time_ms["total"]);
+    const double flicker = flicker_mse(shown, previous);
+    const double flicker_noisy = denoiser ? flicker_mse(image, previous_noisy) : -1.0;
+    previous = shown;
+    if (denoiser) previous_noisy = image;
+    if (accumulator) {
+      frame_rgba.resize(shown.size());
+      for (std::size_t i = 0; i < shown.size(); ++i) frame_rgba[i] = glm::vec4(shown[i], 1.0f);
       const auto t = std::chrono::steady_clock::now();
       accumulator->add(frame_rgba).wait();
       stats.time_ms["accumulate_kernel"] =
@@ -251,9 +302,12 @@ int run_render(const RenderCommand& command) {
                             {"guided_vertices", stats.guided_vertices}};
     for (const auto& [key, value] : stats.extra) frame[key] = value;
     if (flicker >= 0.0) frame["flicker_mse"] = flicker;
+    if (flicker_noisy >= 0.0) frame["flicker_mse_noisy"] = flicker_noisy;
+    if (denoiser) frame["svgf_host_device_bytes_per_pixel"] = svgf_bytes;
     if (!command.reference.empty()) {
-      last_relmse = relative_mse(to_image(renderer), reference);
+      last_relmse = relative_mse(to_image(renderer, shown), reference);
       frame["relmse"] = last_relmse;
+      if (denoiser) frame["relmse_noisy"] = relative_mse(to_image(renderer, image), reference);
       if (accumulator) {
         const std::vector<glm::vec4> mean = accumulator->read();
         accumulated.pixels.resize(mean.size());
@@ -263,14 +317,18 @@ int run_render(const RenderCommand& command) {
     }
     frames.push_back(frame);
     if (std::find(command.save_frames.begin(), command.save_frames.end(), f) !=
-        command.save_frames.end())
-      write_frame(frame_output_path(command.output, f), f);
+        command.save_frames.end()) {
+      if (!command.output.empty()) write_frame(frame_output_path(command.output, f), f);
+      if (!command.noisy_output.empty())
+        write_noisy_frame(frame_output_path(command.noisy_output, f), f);
+    }
     if (!command.common.quiet && command.frames > 1)
       std::printf("frame %d: %.1f ms%s\n", f, stats.time_ms["total"],
                   last_relmse >= 0.0 ? fmt::format(", relMSE {:.4g}", last_relmse).c_str() : "");
   }
 
   if (!command.output.empty()) write_frame(command.output, command.frames - 1);
+  if (!command.noisy_output.empty()) write_noisy_frame(command.noisy_output, command.frames - 1);
   if (!command.stats_json.empty()) {
     const nlohmann::json stats = {
         {"scene", scene_path},
@@ -283,6 +341,8 @@ int run_render(const RenderCommand& command) {
         {"camera_path", command.settings.camera_path},
         {"guiding", command.guiding},
         {"guiding_settings", guiding_settings_json(command.guiding_settings)},
+        {"denoise", command.denoise},
+        {"svgf_settings", svgf_settings_json(command.svgf_settings)},
         {"max_bounces", settings.path_tracer.max_bounces},
         {"path_tracer", path_tracer_settings_json(settings.path_tracer)},
         {"camera_frame", settings.camera_frame},
@@ -294,14 +354,16 @@ int run_render(const RenderCommand& command) {
     write_text_atomically(command.stats_json, stats.dump(2) + "\n");
   }
   if (!command.common.quiet) {
-    std::printf("rendered %s at %dx%d, %d spp, %d frame%s (guiding %s) on %s + Embree\n",
-                scene_path.c_str(), command.settings.width, command.settings.height,
-                command.settings.spp, command.frames, command.frames == 1 ? "" : "s",
-                command.guiding.c_str(), cl.info().device_name.c_str());
+    std::printf(
+        "rendered %s at %dx%d, %d spp, %d frame%s (guiding %s, denoise %s) on %s + Embree\n",
+        scene_path.c_str(), command.settings.width, command.settings.height, command.settings.spp,
+        command.frames, command.frames == 1 ? "" : "s", command.guiding.c_str(),
+        command.denoise.c_str(), cl.info().device_name.c_str());
     std::printf("time per frame: %.1f ms (median of %zu)%s\n", median(totals), totals.size(),
                 nonfinite ? fmt::format(", {} non-finite samples dropped", nonfinite).c_str() : "");
     if (last_relmse >= 0.0) std::printf("relMSE of the last frame: %.5g\n", last_relmse);
     if (!command.output.empty()) std::printf("wrote %s\n", command.output.c_str());
+    if (!command.noisy_output.empty()) std::printf("wrote %s\n", command.noisy_output.c_str());
   }
   return 0;
 }

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "denoise/svgf_settings.h"
 #include "render/renderer.h"
 #include "rtpg/guider.h"
 
@@ -32,6 +33,9 @@ struct RenderCommand {
                                          // borrow the mixture of the pixel showing them)
   GuidingSettings guiding_settings;
   std::string train_memory = "auto";
+  std::string denoise = "off";  // "off" or "svgf" (docs/denoising.md)
+  SvgfSettings svgf_settings;
+  std::string noisy_output;  // with --denoise: the unfiltered last frame; "" = none
 };
 
 struct ReferenceCommand {

@@ -60,6 +60,31 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
       ->capture_default_str();
 }
 
+// "--svgf-" and the setting's name with '-' for '_', one flag per row of the denoiser's table
+// (host/denoise/svgf_settings.h), checked against its range before rendering (exit 2).
+void add_denoise_options(CLI::App* cmd, rtpg::RenderCommand& r) {
+  cmd->add_option("--denoise", r.denoise,
+                  "Denoiser of every frame: off or svgf (the output is the filtered image)")
+      ->check(CLI::IsMember({"off", "svgf"}))
+      ->capture_default_str();
+  cmd->add_option("--noisy-output", r.noisy_output,
+                  "With --denoise: also write the unfiltered last frame (.exr or .png); "
+                  "--save-frames writes its frames beside it");
+  auto* grp = cmd->add_option_group("Denoiser",
+                                    "Settings of the SVGF denoiser (host/denoise/svgf_settings.h)");
+  rtpg::SvgfSettings& s = r.svgf_settings;
+  for (const rtpg::SvgfSettingInfo& row : rtpg::svgf_settings_table()) {
+    std::string flag = std::string("--svgf-") + row.name;
+    std::replace(flag.begin(), flag.end(), '_', '-');
+    const std::string help = std::string(row.help) + ", in " + row.range_text();
+    if (row.int_field) {
+      grp->add_option(flag, s.*row.int_field, help)->capture_default_str();
+    } else {
+      grp->add_option(flag, s.*row.float_field, help)->capture_default_str();
+    }
+  }
+}
+
 bool parse_resolution(const std::string& text, int& w, int& h) {
   unsigned long long pw = 0, ph = 0;
   char x = 0, extra = 0;
@@ -102,8 +127,8 @@ int main(int argc, char** argv) {
                          "Last frame: .exr (linear) or .png (tonemapped)");
   render_cmd
       ->add_option("--save-frames", render.save_frames,
-                   "Also write these frames (0-based, comma-separated) beside --output as "
-                   "NAME-fNNNN.EXT")
+                   "Also write these frames (0-based, comma-separated) beside --output (and "
+                   "--noisy-output) as NAME-fNNNN.EXT")
       ->delimiter(',');
   render_cmd->add_option("--reference", render.reference, "Reference EXR: relMSE per frame");
   render_cmd->add_flag(
@@ -111,6 +136,7 @@ int main(int argc, char** argv) {
       "Output the running mean of all frames (static camera); adds relmse_accumulated");
   render_cmd->add_option("--stats-json", render.stats_json, "Write per-frame statistics as JSON");
   add_guiding_options(render_cmd, render);
+  add_denoise_options(render_cmd, render);
 
   rtpg::ReferenceCommand reference;
   std::string reference_res = "640x360";

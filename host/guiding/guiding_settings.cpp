@@ -3,7 +3,6 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <sstream>
 
 #include "rtpg/errors.h"
 
@@ -13,15 +12,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 using S = GuidingSettings;
 
-GuidingSettingInfo real(const char* name, float S::*field, double min, double max,
-                        bool min_exclusive, bool max_exclusive, const char* help) {
-  // An unbounded range still excludes infinity: every setting is a finite number.
-  return {name, help, min, max, min_exclusive, max_exclusive || std::isinf(max), field, nullptr};
-}
-GuidingSettingInfo integer(const char* name, int S::*field, double min, double max,
-                           const char* help) {
-  return {name, help, min, max, false, false, nullptr, field};
-}
+constexpr auto real = &GuidingSettingInfo::real;
+constexpr auto integer = &GuidingSettingInfo::integer;
 
 // A step through the neighbourhood window that visits every cell once: coprime with its size.
 int window_stride(int apron) {
@@ -29,13 +21,6 @@ int window_stride(int apron) {
   for (int s = std::max(1, size / 3); s < size; ++s)
     if (std::gcd(s, size) == 1) return s;
   return 1;
-}
-
-std::string number(double v) {
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  std::ostringstream out;
-  out << v;
-  return out.str();
 }
 
 }  // namespace
@@ -82,29 +67,6 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
   return table;
 }
 
-double GuidingSettingInfo::get(const GuidingSettings& s) const {
-  return float_field ? static_cast<double>(s.*float_field) : static_cast<double>(s.*int_field);
-}
-
-void GuidingSettingInfo::set(GuidingSettings& s, double value) const {
-  if (float_field) {
-    s.*float_field = static_cast<float>(value);
-  } else {
-    s.*int_field = static_cast<int>(std::lround(value));
-  }
-}
-
-bool GuidingSettingInfo::in_range(double v) const {
-  const bool above = min_exclusive ? v > min : v >= min;
-  const bool below = max_exclusive ? v < max : v <= max;
-  return above && below;  // false for NaN
-}
-
-std::string GuidingSettingInfo::range_text() const {
-  return std::string(min_exclusive ? "(" : "[") + number(min) + ", " + number(max) +
-         (max_exclusive ? ")" : "]");
-}
-
 const char* train_memory_name(GuidingSettings::TrainMemory memory) {
   switch (memory) {
     case GuidingSettings::TrainMemory::Local:
@@ -132,12 +94,14 @@ void validate(const GuidingSettings& s) {
   for (const GuidingSettingInfo& row : guiding_settings_table()) {
     const double v = row.get(s);
     if (!row.in_range(v))
-      fail(std::string(row.name) + " = " + number(v) + " is outside " + row.range_text());
+      fail(std::string(row.name) + " = " + setting_number(v) + " is outside " + row.range_text());
   }
   if (s.pi_min > s.pi_max)
-    fail("pi_min (" + number(s.pi_min) + ") must not exceed pi_max (" + number(s.pi_max) + ")");
+    fail("pi_min (" + setting_number(s.pi_min) + ") must not exceed pi_max (" +
+         setting_number(s.pi_max) + ")");
   if (s.n_min > s.n_max)
-    fail("n_min (" + number(s.n_min) + ") must not exceed n_max (" + number(s.n_max) + ")");
+    fail("n_min (" + setting_number(s.n_min) + ") must not exceed n_max (" +
+         setting_number(s.n_max) + ")");
 }
 
 pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rtpg/guiding_layout.h"
+#include "rtpg/setting_info.h"
 
 namespace rtpg {
 
@@ -42,21 +43,7 @@ struct GuidingSettings {
   TrainMemory train_memory = TrainMemory::Auto;
 };
 
-// One numeric setting: its name (the field's), meaning and valid range. Exactly one of
-// float_field and int_field is set.
-struct GuidingSettingInfo {
-  const char* name;
-  const char* help;
-  double min, max;
-  bool min_exclusive, max_exclusive;
-  float GuidingSettings::*float_field;
-  int GuidingSettings::*int_field;
-
-  double get(const GuidingSettings& s) const;
-  void set(GuidingSettings& s, double value) const;  // rounds for an integer field
-  bool in_range(double value) const;
-  std::string range_text() const;  // "[0, 1)", "(0, inf)", ...
-};
+using GuidingSettingInfo = SettingInfo<GuidingSettings>;
 
 // Every numeric field of GuidingSettings, in declaration order.
 const std::vector<GuidingSettingInfo>& guiding_settings_table();

@@ -574,5 +574,46 @@ TEST_F(Cli, UnwritableCacheFolderStillRenders) {
   EXPECT_FALSE(fs::exists("/proc/rtpg-cache"));
 }
 
+// ---- the denoiser ------------------------------------------------------------------------
+
+TEST_F(Cli, DenoiseWritesTheFilteredAndTheNoisyFrameWithTheirStatistics) {
+  const RunResult r = run_rtpg(dir(),
+                               "render --res 40x24 --frames 3 --denoise svgf -o out.exr "
+                               "--noisy-output noisy.exr --save-frames 1 --stats-json stats.json");
+  ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+  const ExrImage out = read_exr(dir() / "out.exr");
+  const ExrImage noisy = read_exr(dir() / "noisy.exr");
+  ASSERT_EQ(out.pixels.size(), noisy.pixels.size());
+  ASSERT_FALSE(out.pixels.empty());
+  EXPECT_EQ(out.metadata.at("rtpg:denoise"), "svgf");
+  EXPECT_EQ(noisy.metadata.at("rtpg:denoise"), "off");
+  EXPECT_TRUE(fs::exists(dir() / "out-f0001.exr"));
+  EXPECT_TRUE(fs::exists(dir() / "noisy-f0001.exr"));
+  // The filter changes the image; both stay finite.
+  double differ = 0.0;
+  for (std::size_t i = 0; i < out.pixels.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(out.pixels[i]));
+    differ += std::fabs(out.pixels[i] - noisy.pixels[i]);
+  }
+  EXPECT_GT(differ, 0.0);
+  const nlohmann::json stats = nlohmann::json::parse(read_file(dir() / "stats.json"));
+  EXPECT_EQ(stats.value("denoise", std::string()), "svgf");
+  EXPECT_EQ(stats["svgf_settings"].value("iterations", 0), 5);
+  const nlohmann::json& last = stats["frames"][2];
+  for (const char* key :
+       {"svgf_temporal", "svgf_variance", "svgf_atrous", "svgf_remodulate", "svgf_total"})
+    EXPECT_TRUE(last["time_ms"].contains(key)) << key;
+  EXPECT_TRUE(last.contains("flicker_mse_noisy"));
+  EXPECT_GT(last.value("svgf_host_device_bytes_per_pixel", 0.0), 0.0);
+}
+
+TEST_F(Cli, RejectsBadDenoiserSettings) {
+  expect_rejected(render("--res 16x16 --denoise svgf --svgf-iterations 0"), "iterations");
+  expect_rejected(render("--res 16x16 --denoise svgf --svgf-history-iteration 5"),
+                  "history_iteration");
+  expect_rejected(render("--res 16x16 --noisy-output noisy.exr"), "--noisy-output",
+                  {"out.exr", "stats.json", "noisy.exr"});
+}
+
 }  // namespace
 }  // namespace rtpg

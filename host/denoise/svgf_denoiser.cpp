@@ -1,0 +1,223 @@
+#include "denoise/svgf_denoiser.h"
+
+#include <chrono>
+#include <initializer_list>
+
+#include "denoise/svgf_reference.h"
+#include "rtpg/cl_error.h"
+#include "rtpg/errors.h"
+
+namespace rtpg {
+namespace {
+
+static_assert(sizeof(shared::pg_svgf_settings) == 10 * 4, "pg_svgf_settings: 4-byte fields only");
+static_assert(sizeof(glm::vec4) == sizeof(cl_float4), "glm::vec4 must match cl_float4");
+
+// Bytes per pixel the upload of one frame copies: colour, emission, position_depth,
+// shading_normal, base_color_roughness (16 each), flags, material (4 each), motion (8).
+constexpr double kUploadBytesPerPixel = 5 * 16 + 4 + 4 + 8;
+constexpr double kDownloadBytesPerPixel = 16;
+
+using BufferList = std::initializer_list<const cl::Buffer*>;
+
+template <class T>
+void upload(ClRuntime& rt, const cl::Buffer& b, const std::vector<T>& v) {
+  rt.queue().enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
+}
+
+}  // namespace
+
+SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings)
+    : runtime_(runtime), width_(width), height_(height), settings_(settings) {
+  validate(settings);
+  if (width <= 0 || height <= 0)
+    throw InputError("svgf", "image size must be positive, got " + std::to_string(width) + "x" +
+                                 std::to_string(height));
+  kernel_settings_ = to_kernel_settings(settings);
+  temporal_ = runtime.kernel("svgf_temporal.cl", "svgf_temporal");
+  variance_ = runtime.kernel("svgf_variance.cl", "svgf_variance");
+  atrous_ = runtime.kernel("svgf_atrous.cl", "svgf_atrous");
+  remodulate_ = runtime.kernel("svgf_remodulate.cl", "svgf_remodulate");
+  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  translate_cl_errors([&] {
+    const std::size_t group = static_cast<std::size_t>(settings.local_x) * settings.local_y;
+    const std::vector<std::size_t> max_items =
+        runtime.device().getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>();
+    for (cl::Kernel* k : {&temporal_, &variance_, &atrous_, &remodulate_}) {
+      const std::size_t limit = k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device());
+      if (group > limit || static_cast<std::size_t>(settings.local_x) > max_items.at(0) ||
+          static_cast<std::size_t>(settings.local_y) > max_items.at(1))
+        throw InputError("svgf settings", "local size " + std::to_string(settings.local_x) + "x" +
+                                              std::to_string(settings.local_y) + " is refused by " +
+                                              runtime.info().device_name + " (at most " +
+                                              std::to_string(limit) + " work-items for kernel " +
+                                              k->getInfo<CL_KERNEL_FUNCTION_NAME>() + ")");
+    }
+    const cl::Context& c = runtime.context();
+    auto buffer = [&](std::size_t bytes) { return cl::Buffer(c, CL_MEM_READ_WRITE, n * bytes); };
+    for (Surfaces& s : surfaces_) {
+      s.position_depth = buffer(16);
+      s.shading_normal = buffer(16);
+      s.material = buffer(4);
+    }
+    for (cl::Buffer& b : moments_) b = buffer(16);
+    for (cl::Buffer& b : illumination_) b = buffer(16);
+    colour_ = buffer(16);
+    emission_ = buffer(16);
+    base_color_roughness_ = buffer(16);
+    flags_ = buffer(4);
+    motion_ = buffer(8);
+    surface_ = buffer(16);
+    depth_slope_ = buffer(4);
+    integrated_ = buffer(16);
+    history_ = buffer(16);
+    output_ = buffer(16);
+  });
+  output_host_.resize(n);
+}
+
+double SvgfDenoiser::run(cl::Kernel& kernel) {
+  auto round_up = [](int v, int m) { return static_cast<std::size_t>((v + m - 1) / m * m); };
+  cl::Event done;
+  runtime_.queue().enqueueNDRangeKernel(
+      kernel, cl::NullRange,
+      cl::NDRange(round_up(width_, settings_.local_x), round_up(height_, settings_.local_y)),
+      cl::NDRange(settings_.local_x, settings_.local_y), nullptr, &done);
+  done.wait();
+  return ClRuntime::event_ms(done);
+}
+
+const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>& colour,
+                                                    const GBuffer& g) {
+  check_svgf_input(width_, height_, colour, g);
+  using Clock = std::chrono::steady_clock;
+  const auto ms_since = [](Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+  };
+  times_.clear();
+  const cl_uint w = static_cast<cl_uint>(width_), h = static_cast<cl_uint>(height_);
+  const Surfaces& cur = surfaces_[current_];
+  const Surfaces& prev = surfaces_[1 - current_];
+  translate_cl_errors([&] {
+    const auto start = Clock::now();
+    upload(runtime_, colour_, colour);
+    upload(runtime_, emission_, g.emission);
+    upload(runtime_, cur.position_depth, g.position_depth);
+    upload(runtime_, cur.shading_normal, g.shading_normal);
+    upload(runtime_, base_color_roughness_, g.base_color_roughness);
+    upload(runtime_, flags_, g.flags);
+    upload(runtime_, cur.material, g.material);
+    upload(runtime_, motion_, g.motion);
+    runtime_.queue().finish();  // the host vectors may change once denoise() returns
+    times_["svgf_upload"] = ms_since(start);
+
+    int a = 0;
+    for (const cl::Buffer* b :
+         BufferList{&colour_, &emission_, &cur.position_depth, &cur.shading_normal,
+                    &base_color_roughness_, &flags_, &cur.material, &motion_, &prev.position_depth,
+                    &prev.shading_normal, &prev.material, &history_, &moments_[1 - current_],
+                    &surface_, &depth_slope_, &integrated_, &moments_[current_]})
+      temporal_.setArg(a++, *b);
+    temporal_.setArg(a++, w);
+    temporal_.setArg(a++, h);
+    temporal_.setArg(a++, static_cast<cl_uint>(has_history_ ? 1 : 0));
+    temporal_.setArg(a++, kernel_settings_);
+    times_["svgf_temporal"] = run(temporal_);
+
+    a = 0;
+    for (const cl::Buffer* b :
+         BufferList{&integrated_, &moments_[current_], &surface_, &depth_slope_, &illumination_[2]})
+      variance_.setArg(a++, *b);
+    variance_.setArg(a++, w);
+    variance_.setArg(a++, h);
+    variance_.setArg(a++, kernel_settings_);
+    times_["svgf_variance"] = run(variance_);
+
+    double atrous_ms = 0.0;
+    // Iteration k reads the variance pass's output (k = 0) or iteration k - 1's, and writes
+    // illumination_[k % 2], or history_ for the iteration whose output the next frame keeps
+    // (written in place: no copy).
+    const cl::Buffer* in = &illumination_[2];
+    for (int k = 0; k < settings_.iterations; ++k) {
+      const cl::Buffer* out = k == settings_.history_iteration ? &history_ : &illumination_[k % 2];
+      atrous_.setArg(0, *in);
+      atrous_.setArg(1, *out);
+      atrous_.setArg(2, surface_);
+      atrous_.setArg(3, depth_slope_);
+      atrous_.setArg(4, w);
+      atrous_.setArg(5, h);
+      atrous_.setArg(6, static_cast<cl_int>(1 << k));
+      atrous_.setArg(7, kernel_settings_);
+      atrous_ms += run(atrous_);
+      in = out;
+    }
+    filtered_ = in;
+    times_["svgf_atrous"] = atrous_ms;
+
+    a = 0;
+    for (const cl::Buffer* b :
+         BufferList{filtered_, &colour_, &emission_, &base_color_roughness_, &flags_, &output_})
+      remodulate_.setArg(a++, *b);
+    remodulate_.setArg(a++, w);
+    remodulate_.setArg(a++, h);
+    remodulate_.setArg(a++, kernel_settings_);
+    times_["svgf_remodulate"] = run(remodulate_);
+
+    const auto download = Clock::now();
+    runtime_.queue().enqueueReadBuffer(output_, CL_TRUE, 0, output_host_.size() * 16,
+                                       output_host_.data());
+    times_["svgf_download"] = ms_since(download);
+  });
+  double total = 0.0;
+  for (const auto& [name, ms] : times_) total += ms;
+  times_["svgf_total"] = total;
+  current_ = 1 - current_;
+  has_history_ = true;
+  return output_host_;
+}
+
+double SvgfDenoiser::host_device_bytes_per_pixel() const {
+  return kUploadBytesPerPixel + kDownloadBytesPerPixel;
+}
+
+std::vector<glm::vec4> SvgfDenoiser::read(SvgfStage stage) {
+  if (filtered_ == nullptr) throw InputError("svgf", "no frame has been denoised yet");
+  const cl::Buffer* b = &output_;
+  // After denoise() current_ points at the next frame: last frame's moments are the other one.
+  switch (stage) {
+    case SvgfStage::Surface:
+      b = &surface_;
+      break;
+    case SvgfStage::Integrated:
+      b = &integrated_;
+      break;
+    case SvgfStage::Moments:
+      b = &moments_[1 - current_];
+      break;
+    case SvgfStage::Illumination:
+      b = &illumination_[2];
+      break;
+    case SvgfStage::Filtered:
+      b = filtered_;
+      break;
+    case SvgfStage::History:
+      b = &history_;
+      break;
+    case SvgfStage::Output:
+      break;
+  }
+  std::vector<glm::vec4> out(static_cast<std::size_t>(width_) * height_);
+  translate_cl_errors(
+      [&] { runtime_.queue().enqueueReadBuffer(*b, CL_TRUE, 0, out.size() * 16, out.data()); });
+  return out;
+}
+
+std::vector<float> SvgfDenoiser::read_depth_slope() {
+  std::vector<float> out(static_cast<std::size_t>(width_) * height_);
+  translate_cl_errors([&] {
+    runtime_.queue().enqueueReadBuffer(depth_slope_, CL_TRUE, 0, out.size() * 4, out.data());
+  });
+  return out;
+}
+
+}  // namespace rtpg

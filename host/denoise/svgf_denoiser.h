@@ -1,0 +1,75 @@
+// SVGF on the OpenCL device (docs/denoising.md): per frame, the noisy colour and the G-buffer go
+// up, four kernels run (kernels/svgf_temporal.cl, svgf_variance.cl, svgf_atrous.cl once per
+// iteration, svgf_remodulate.cl) and the denoised colour comes back. The history (filtered
+// illumination, moments, last frame's surfaces) stays on the device between frames.
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "denoise/svgf_settings.h"
+#include "denoise/svgf_stage.h"
+#include "render/gbuffer.h"
+#include "rtpg/cl_runtime.h"
+
+namespace rtpg {
+
+class SvgfDenoiser {
+ public:
+  // Throws InputError for settings out of range, a size below 1x1 or a work-group size the
+  // device refuses.
+  SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings = {});
+  SvgfDenoiser(const SvgfDenoiser&) = delete;
+  SvgfDenoiser& operator=(const SvgfDenoiser&) = delete;
+
+  // Filters one frame of noisy colour (rgb; w ignored) seen through the G-buffer g, blocking;
+  // returns the denoised colour (w = 1 on surfaces; pixels without a surface keep their input).
+  // Throws InputError when the sizes do not match.
+  const std::vector<glm::vec4>& denoise(const std::vector<glm::vec4>& colour, const GBuffer& g);
+  // Forgets the history: the next frame starts anew (a camera cut).
+  void reset() { has_history_ = false; }
+
+  // Milliseconds of the last denoise() from profiling events: "svgf_upload", "svgf_temporal",
+  // "svgf_variance", "svgf_atrous" (all iterations), "svgf_remodulate", "svgf_download".
+  const std::map<std::string, double>& times_ms() const { return times_; }
+  // Bytes copied between host and device per pixel by denoise().
+  double host_device_bytes_per_pixel() const;
+
+  // Downloads an intermediate image of the last frame (tests compare it with SvgfReference).
+  std::vector<glm::vec4> read(SvgfStage stage);
+  std::vector<float> read_depth_slope();
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const SvgfSettings& settings() const { return settings_; }
+
+ private:
+  double run(cl::Kernel& kernel);
+  // The G-buffer channels the kernels read, this frame's and last frame's (ping-pong).
+  struct Surfaces {
+    cl::Buffer position_depth, shading_normal, material;
+  };
+
+  ClRuntime& runtime_;
+  int width_, height_;
+  SvgfSettings settings_;
+  shared::pg_svgf_settings kernel_settings_;
+  cl::Kernel temporal_, variance_, atrous_, remodulate_;
+  std::array<Surfaces, 2> surfaces_;
+  std::array<cl::Buffer, 2> moments_;  // this frame's and last frame's
+  int current_ = 0;
+  bool has_history_ = false;
+  cl::Buffer colour_, emission_, base_color_roughness_, flags_, motion_;
+  cl::Buffer surface_, depth_slope_, integrated_, history_, output_;
+  // The a-trous ping-pong ([0], [1]) and the variance pass's output ([2]).
+  std::array<cl::Buffer, 3> illumination_;
+  const cl::Buffer* filtered_ = nullptr;  // the last iteration's output
+  std::vector<glm::vec4> output_host_;
+  std::map<std::string, double> times_;
+};
+
+}  // namespace rtpg

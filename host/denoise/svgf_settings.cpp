@@ -1,0 +1,75 @@
+#include "denoise/svgf_settings.h"
+
+#include <cstdint>
+#include <limits>
+
+#include "rtpg/errors.h"
+
+namespace rtpg {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+using S = SvgfSettings;
+constexpr auto real = &SvgfSettingInfo::real;
+constexpr auto integer = &SvgfSettingInfo::integer;
+
+}  // namespace
+
+const std::vector<SvgfSettingInfo>& svgf_settings_table() {
+  static const std::vector<SvgfSettingInfo> table = {
+      real("alpha_colour", &S::alpha_colour, 0, 1, false, false,
+           "Temporal blend weight of the new frame's illumination (0: plain mean of the history)"),
+      real("alpha_moments", &S::alpha_moments, 0, 1, false, false,
+           "Temporal blend weight of the new frame's luminance moments"),
+      integer("max_history", &S::max_history, 1, 1e6, "History length cap in frames"),
+      integer("min_history", &S::min_history, 1, 1e6,
+              "Shorter histories estimate the variance spatially (7x7)"),
+      real("phi_depth", &S::phi_depth, 0, kInf, true, false,
+           "Depth weight scale (sigma_z), times the depth gradient"),
+      integer("phi_normal", &S::phi_normal, 0, 4096, "Exponent of the normal weight (sigma_n)"),
+      real("phi_luminance", &S::phi_luminance, 0, kInf, true, false,
+           "Luminance weight scale (sigma_l), times the standard deviation"),
+      real("reproject_position", &S::reproject_position, 0, kInf, false, false,
+           "Position change, relative to the depth, that rejects history"),
+      real("reproject_normal", &S::reproject_normal, -1, 1, false, false,
+           "Normal cosine below which history is rejected"),
+      real("albedo_floor", &S::albedo_floor, 0, 1, true, false,
+           "Demodulation divides by max(albedo, this)"),
+      integer("iterations", &S::iterations, 1, 12, "A-trous iterations (steps 1, 2, 4, ...)"),
+      integer("history_iteration", &S::history_iteration, 0, 11,
+              "The a-trous iteration (from 0) whose output is the next frame's history"),
+      integer("local_x", &S::local_x, 1, 65536, "Work-group width of the kernels"),
+      integer("local_y", &S::local_y, 1, 65536, "Work-group height of the kernels"),
+  };
+  return table;
+}
+
+void validate(const SvgfSettings& s) {
+  for (const SvgfSettingInfo& row : svgf_settings_table()) {
+    const double v = row.get(s);
+    if (!row.in_range(v))
+      throw InputError("svgf settings", std::string(row.name) + " = " + setting_number(v) +
+                                            " is outside " + row.range_text());
+  }
+  if (s.history_iteration >= s.iterations)
+    throw InputError("svgf settings", "history_iteration (" + std::to_string(s.history_iteration) +
+                                          ") must be below iterations (" +
+                                          std::to_string(s.iterations) + ")");
+}
+
+shared::pg_svgf_settings to_kernel_settings(const SvgfSettings& c) {
+  shared::pg_svgf_settings p{};
+  p.alpha_colour = c.alpha_colour;
+  p.alpha_moments = c.alpha_moments;
+  p.max_history = static_cast<float>(c.max_history);
+  p.min_history = static_cast<float>(c.min_history);
+  p.phi_depth = c.phi_depth;
+  p.phi_normal = static_cast<std::uint32_t>(c.phi_normal);
+  p.phi_luminance = c.phi_luminance;
+  p.reproject_position = c.reproject_position;
+  p.reproject_normal = c.reproject_normal;
+  p.albedo_floor = c.albedo_floor;
+  return p;
+}
+
+}  // namespace rtpg

@@ -1,0 +1,42 @@
+// Every setting of the SVGF denoiser (docs/denoising.md), its default, bounds and meaning, in one
+// table: the command line builds its --svgf-* flags from it, the denoiser validates against it
+// and the stats JSON records every row. The kernels receive the settings as one
+// pg_svgf_settings block (kernels/shared/svgf.h).
+#pragma once
+
+#include <vector>
+
+#include "rtpg/setting_info.h"
+#include "shared/svgf.h"
+
+namespace rtpg {
+
+struct SvgfSettings {
+  // Defaults are the paper's (Schied et al. 2017, section 5) where it gives one.
+  float alpha_colour = 0.2f;         // temporal blend weight of the new frame's illumination
+  float alpha_moments = 0.2f;        // ... of its luminance moments
+  int max_history = 32;              // history length cap (frames)
+  int min_history = 4;               // shorter histories estimate variance spatially (7x7)
+  float phi_depth = 1.0f;            // sigma_z: depth weight scale, times the depth gradient
+  int phi_normal = 128;              // sigma_n: exponent of the normal weight
+  float phi_luminance = 4.0f;        // sigma_l: luminance weight scale, times the std. dev.
+  float reproject_position = 0.05f;  // history test, as guiding's: relative position change
+  float reproject_normal = 0.9f;     // ... and normal cosine
+  float albedo_floor = 1e-3f;        // demodulation divides by max(albedo, albedo_floor)
+  int iterations = 5;                // a-trous iterations (steps 1, 2, 4, ...)
+  int history_iteration = 0;         // the iteration whose output is next frame's history
+  int local_x = 16, local_y = 16;    // work-group size of the kernels
+};
+
+using SvgfSettingInfo = SettingInfo<SvgfSettings>;
+
+// Every numeric field of SvgfSettings, in declaration order.
+const std::vector<SvgfSettingInfo>& svgf_settings_table();
+
+// Throws InputError ("svgf settings", "<name> = <value> is outside <range>") for a value outside
+// its row's range, or a history iteration beyond the last iteration.
+void validate(const SvgfSettings& settings);
+
+shared::pg_svgf_settings to_kernel_settings(const SvgfSettings& settings);
+
+}  // namespace rtpg

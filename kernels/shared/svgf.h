@@ -1,0 +1,183 @@
+/* Spatiotemporal variance-guided filtering (Schied et al., HPG 2017, "SVGF"; docs/denoising.md):
+ * the per-pixel math of kernels/svgf_*.cl, shared with the host reference
+ * (host/denoise/svgf_reference.cpp) so that tests compare the two pixel by pixel.
+ *
+ * The denoiser's buffers, the one description of their layout (one entry per pixel, row-major,
+ * pixel i = y * width + x):
+ *   surface       float4  xyz shading normal, w linear depth of the primary hit (0: no surface)
+ *   depth_slope   float   max(|dz/dx|, |dz/dy|) in depth units per pixel (pg_svgf_depth_slope)
+ *   integrated    float4  rgb demodulated illumination after temporal accumulation, w 0
+ *   moments       float4  x first, y second moment of its luminance (temporal), z history
+ *                         length in frames (0: no surface), w 0
+ *   illumination  float4  rgb demodulated illumination, w its variance (the a-trous ping-pong)
+ *   history       float4  rgb the filtered illumination kept for the next frame (the output of
+ *                         a-trous iteration `history_iteration`), w 0
+ * The inputs are the noisy colour (float4, rgb) and the G-buffer channels of
+ * include/rtpg/guiding_layout.h (position_depth, shading_normal, base_color_roughness, flags,
+ * material, motion) with the primary hit's emission (float4, rgb): colour = albedo *
+ * illumination + emission, so the filter never blurs texture or emitters. */
+#ifndef RTPG_SHARED_SVGF_H
+#define RTPG_SHARED_SVGF_H
+
+#include "rtpg/guiding_layout.h"
+#include "shared/compat.h"
+#include "shared/same_surface.h"
+
+PG_NAMESPACE_BEGIN
+
+/* Every tunable of the SVGF kernels, passed by value (plain 4-byte fields). The host builds it
+ * from rtpg::SvgfSettings (host/denoise/svgf_settings.h), which documents each. */
+typedef struct pg_svgf_settings {
+  float alpha_colour;       /* temporal blend weight of the new illumination (paper: 0.2) */
+  float alpha_moments;      /* ... of the new luminance moments (paper: 0.2) */
+  float max_history;        /* history length cap, frames */
+  float min_history;        /* below this many frames variance is estimated spatially (4) */
+  float phi_depth;          /* sigma_z of the depth edge-stopping function (paper: 1) */
+  uint phi_normal;          /* sigma_n, the normal weight's exponent (paper: 128) */
+  float phi_luminance;      /* sigma_l, scales the luminance weight by the std. dev. (4) */
+  float reproject_position; /* history test (shared/same_surface.h): relative distance */
+  float reproject_normal;   /* ... and normal cosine */
+  float albedo_floor;       /* demodulation divides by max(albedo, albedo_floor) */
+} pg_svgf_settings;
+
+/* Below this a depth slope counts as flat: keeps phi_z above 0 for surfaces facing the camera,
+ * relative to the depth so that no absolute length enters. */
+#define PG_SVGF_DEPTH_EPSILON 1.0e-3f
+/* Added to the standard deviation of the luminance weight (SVGF: 1e-10 on the variance). */
+#define PG_SVGF_LUMINANCE_EPSILON 1.0e-10f
+/* Illumination is clamped to this magnitude, so that its square and sums of squares over a
+ * filter window stay finite in float. */
+#define PG_SVGF_MAX_ILLUMINATION 1.0e17f
+/* Reprojection keeps history only where the valid bilinear taps carry this much weight. */
+#define PG_SVGF_MIN_TAP_WEIGHT 0.01f
+
+PG_FN int pg_svgf_has_surface(uint flags) {
+  return (flags & PG_GBUF_SKY) == 0u;
+}
+
+/* The albedo the illumination is demodulated by: the primary hit's base colour, each channel at
+ * least the floor so that black surfaces do not divide by zero (remodulation multiplies by the
+ * same value, so the floor changes only what is filtered, not the identity). */
+PG_FN float3 pg_svgf_albedo(float4 base_color_roughness, float albedo_floor) {
+  return pg_make_float3(fmax(base_color_roughness.x, albedo_floor),
+                        fmax(base_color_roughness.y, albedo_floor),
+                        fmax(base_color_roughness.z, albedo_floor));
+}
+
+/* Illumination = (colour - emission) / albedo, clamped to +-PG_SVGF_MAX_ILLUMINATION; a
+ * non-finite result counts as no light. */
+PG_FN float3 pg_svgf_demodulate(float3 colour, float3 emission, float3 albedo) {
+  float3 r = pg_make_float3((colour.x - emission.x) / albedo.x, (colour.y - emission.y) / albedo.y,
+                            (colour.z - emission.z) / albedo.z);
+  if (!pg_all_finite3(r)) return pg_make_float3(0.0f, 0.0f, 0.0f);
+  return pg_make_float3(clamp(r.x, -PG_SVGF_MAX_ILLUMINATION, PG_SVGF_MAX_ILLUMINATION),
+                        clamp(r.y, -PG_SVGF_MAX_ILLUMINATION, PG_SVGF_MAX_ILLUMINATION),
+                        clamp(r.z, -PG_SVGF_MAX_ILLUMINATION, PG_SVGF_MAX_ILLUMINATION));
+}
+
+PG_FN float3 pg_svgf_remodulate(float3 illumination, float3 emission, float3 albedo) {
+  return pg_make_float3(illumination.x * albedo.x + emission.x,
+                        illumination.y * albedo.y + emission.y,
+                        illumination.z * albedo.z + emission.z);
+}
+
+/* The smaller of the two one-sided differences (centre - before, after - centre), so that a
+ * depth edge on one side does not make a flat surface look steep; a neighbour without a surface
+ * (depth 0) gives no difference. */
+PG_FN float pg_svgf_one_axis_slope(float z, float z_before, float z_after) {
+  float a = z_before > 0.0f ? fabs(z - z_before) : PG_FLOAT_MAX;
+  float b = z_after > 0.0f ? fabs(z_after - z) : PG_FLOAT_MAX;
+  float s = fmin(a, b);
+  return s < PG_FLOAT_MAX ? s : 0.0f;
+}
+
+/* max(|dz/dx|, |dz/dy|) at a pixel with depth z from its four neighbours' depths (0 outside the
+ * image or on sky): the screen-space depth gradient the depth weight is scaled by (SVGF 4.2). */
+PG_FN float pg_svgf_depth_slope(float z, float z_left, float z_right, float z_down, float z_up) {
+  return fmax(pg_svgf_one_axis_slope(z, z_left, z_right), pg_svgf_one_axis_slope(z, z_down, z_up));
+}
+
+/* Bilinear tap t (0..3) of a back-projected position (in pixel indices, centres at integers):
+ * writes the tap's pixel and returns its bilinear weight. */
+PG_FN float pg_svgf_bilinear_tap(float2 position, int t, PG_PRIVATE int* px, PG_PRIVATE int* py) {
+  float fx = floor(position.x), fy = floor(position.y);
+  float ax = position.x - fx, ay = position.y - fy;
+  int dx = t & 1, dy = t >> 1;
+  *px = (int)fx + dx;
+  *py = (int)fy + dy;
+  return (dx != 0 ? ax : 1.0f - ax) * (dy != 0 ? ay : 1.0f - ay);
+}
+
+/* The blend weight of the new frame: the running mean while the history is short (1 / length),
+ * then alpha (SVGF 4.1). length counts the new frame. */
+PG_FN float pg_svgf_blend_weight(float alpha, float length) {
+  return fmax(alpha, 1.0f / length);
+}
+
+/* Written out rather than mix() so that host and device do the same roundings (the kernels turn
+ * off FP contraction). */
+PG_FN float3 pg_svgf_blend3(float3 history, float3 current, float weight_new) {
+  return history + (current - history) * weight_new;
+}
+PG_FN float pg_svgf_blend(float history, float current, float weight_new) {
+  return history + (current - history) * weight_new;
+}
+
+/* The 1D B3-spline weights of the 5x5 a-trous kernel at offset -2..2 (SVGF 4.3): 1/16, 1/4,
+ * 3/8, 1/4, 1/16. */
+PG_FN float pg_svgf_b3(int offset) {
+  int a = offset < 0 ? -offset : offset;
+  return a == 0 ? 0.375f : (a == 1 ? 0.25f : 0.0625f);
+}
+
+/* The 3x3 Gaussian the variance is prefiltered with before it scales the luminance weight
+ * (SVGF 4.3): 1/4 at the centre, 1/8 at the edges, 1/16 at the corners. */
+PG_FN float pg_svgf_gauss3(int dx, int dy) {
+  int a = (dx != 0) + (dy != 0);
+  return a == 0 ? 0.25f : (a == 1 ? 0.125f : 0.0625f);
+}
+
+/* 1 / (sigma_l * std_dev + eps): the luminance weight's scale at a centre pixel. */
+PG_FN float pg_svgf_inverse_phi_luminance(float std_dev, pg_svgf_settings s) {
+  return 1.0f / (s.phi_luminance * std_dev + PG_SVGF_LUMINANCE_EPSILON);
+}
+
+/* x^n for an integer n >= 0 by repeated squaring: a loop whose trip count is the same for every
+ * pixel (vectorises, unlike pow's log and exp). */
+PG_FN float pg_svgf_power(float x, uint n) {
+  float r = 1.0f;
+  for (; n != 0u; n >>= 1) {
+    if ((n & 1u) != 0u) r *= x;
+    x *= x;
+  }
+  return r;
+}
+
+/* The edge-stopping weight between the centre pixel c and a tap q (SVGF eq. 3-5):
+ *   depth      exp(-|z_c - z_q| / phi_z), phi_z = sigma_z * slope_c * distance + eps * z_c;
+ *   normal     max(0, n_c . n_q)^sigma_n (sigma_n an integer, pg_svgf_power);
+ *   luminance  exp(-|l_c - l_q| * inverse_phi_l), inverse_phi_l from
+ *              pg_svgf_inverse_phi_luminance (0: no luminance term).
+ * distance is the tap's offset in pixels. One exp for depth and luminance. A tap without a
+ * surface (depth 0) gets 0. */
+PG_FN float pg_svgf_edge_weight(float4 surface_c, float slope_c, float luminance_c,
+                                float4 surface_q, float luminance_q, float distance,
+                                float inverse_phi_l, pg_svgf_settings s) {
+  float cos_n = fmin(fmax(dot(pg_float4_xyz(surface_c), pg_float4_xyz(surface_q)), 0.0f), 1.0f);
+  float phi_z = s.phi_depth * slope_c * distance + PG_SVGF_DEPTH_EPSILON * surface_c.w;
+  float e =
+      fabs(surface_c.w - surface_q.w) / phi_z + fabs(luminance_c - luminance_q) * inverse_phi_l;
+  float w = pg_svgf_power(cos_n, s.phi_normal) * exp(-e);
+  return surface_q.w > 0.0f ? w : 0.0f;
+}
+
+/* Variance from temporal moments; a short history boosts it (SVGF 4.2: 4 / length) since
+ * few frames underestimate it. */
+PG_FN float pg_svgf_variance(float m1, float m2, float length, float min_history) {
+  float v = fmax(m2 - m1 * m1, 0.0f);
+  return length < min_history ? v * (min_history / fmax(length, 1.0f)) : v;
+}
+
+PG_NAMESPACE_END
+
+#endif

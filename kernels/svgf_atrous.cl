@@ -1,0 +1,62 @@
+/* One a-trous wavelet iteration of SVGF (docs/denoising.md; Schied et al. 2017, 4.3): a 5x5
+ * B3-spline kernel with taps `step` pixels apart, each weighted by the edge-stopping functions
+ * of depth, normal and luminance (the luminance scaled by the prefiltered standard deviation);
+ * the variance is filtered with the squared weights. Taps outside the image are skipped: on
+ * PoCL's CPU device this is 2x faster than clamped reads with zero weights (docs/denoising.md,
+ * "Cost"), since its work-item loops are not vectorised either way. */
+#pragma OPENCL FP_CONTRACT OFF
+
+#include "shared/svgf.h"
+
+/* clang-format off */
+__kernel void svgf_atrous(__global const float4* in, __global float4* out,
+                          __global const float4* surface, __global const float* depth_slope,
+                          uint width, uint height, int step, pg_svgf_settings settings) {
+  /* clang-format on */
+  uint x = get_global_id(0), y = get_global_id(1);
+  if (x >= width || y >= height) return;
+  uint i = y * width + x;
+  float4 sc = surface[i];
+  float4 c = in[i];
+  if (sc.w <= 0.0f) {
+    out[i] = c;
+    return;
+  }
+  /* The centre's variance through a 3x3 Gaussian (taps inside the image, renormalised). */
+  float sum_g = 0.0f, sum_gv = 0.0f;
+  for (int dy = -1; dy <= 1; ++dy) {
+    int qy = (int)y + dy;
+    if (qy < 0 || qy >= (int)height) continue;
+    for (int dx = -1; dx <= 1; ++dx) {
+      int qx = (int)x + dx;
+      if (qx < 0 || qx >= (int)width) continue;
+      float g = pg_svgf_gauss3(dx, dy);
+      sum_gv += g * in[(uint)qy * width + (uint)qx].w;
+      sum_g += g;
+    }
+  }
+  float inverse_phi_l = pg_svgf_inverse_phi_luminance(sqrt(fmax(sum_gv / sum_g, 0.0f)), settings);
+  float slope = depth_slope[i];
+  float lc = pg_luminance(c.xyz);
+  float3 sum_c = (float3)(0.0f);
+  float sum_v = 0.0f, sum_w = 0.0f;
+  for (int dy = -2; dy <= 2; ++dy) {
+    int qy = (int)y + dy * step;
+    if (qy < 0 || qy >= (int)height) continue;
+    for (int dx = -2; dx <= 2; ++dx) {
+      int qx = (int)x + dx * step;
+      if (qx < 0 || qx >= (int)width) continue;
+      uint j = (uint)qy * width + (uint)qx;
+      float4 q = in[j];
+      float distance = (float)step * sqrt((float)(dx * dx + dy * dy));
+      float w = pg_svgf_b3(dx) * pg_svgf_b3(dy) *
+                pg_svgf_edge_weight(sc, slope, lc, surface[j], pg_luminance(q.xyz), distance,
+                                    inverse_phi_l, settings);
+      sum_c += w * q.xyz;
+      sum_v += w * w * q.w;
+      sum_w += w;
+    }
+  }
+  /* sum_w >= 9/64: the centre's weight is b3(0)^2 exp(0). */
+  out[i] = (float4)(sum_c / sum_w, sum_v / (sum_w * sum_w));
+}

@@ -1,0 +1,23 @@
+/* SVGF's last step (docs/denoising.md): colour = albedo * filtered illumination + emission.
+ * Pixels without a surface keep their input colour (the sky is not filtered). */
+#pragma OPENCL FP_CONTRACT OFF
+
+#include "shared/svgf.h"
+
+/* clang-format off */
+__kernel void svgf_remodulate(__global const float4* illumination, __global const float4* colour,
+                              __global const float4* emission,
+                              __global const float4* base_color_roughness,
+                              __global const uint* flags, __global float4* out, uint width,
+                              uint height, pg_svgf_settings settings) {
+  /* clang-format on */
+  uint x = get_global_id(0), y = get_global_id(1);
+  if (x >= width || y >= height) return;
+  uint i = y * width + x;
+  if (!pg_svgf_has_surface(flags[i])) {
+    out[i] = colour[i];
+    return;
+  }
+  float3 albedo = pg_svgf_albedo(base_color_roughness[i], settings.albedo_floor);
+  out[i] = (float4)(pg_svgf_remodulate(illumination[i].xyz, emission[i].xyz, albedo), 1.0f);
+}

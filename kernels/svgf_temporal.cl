@@ -1,0 +1,85 @@
+/* SVGF's temporal pass (docs/denoising.md; Schied et al. 2017, 4.1). Demodulates this frame's
+ * colour by the primary hit's albedo, reprojects last frame's filtered illumination and
+ * luminance moments through the motion vector (2x2 bilinear taps, each kept only where
+ * pg_same_surface holds: the test guiding's reprojection uses), and blends them with this
+ * frame's. Also writes the surface and depth slope the later passes read. */
+/* Each operation rounded on its own, as in the host reference. */
+#pragma OPENCL FP_CONTRACT OFF
+
+#include "shared/svgf.h"
+
+/* clang-format off */
+__kernel void svgf_temporal(__global const float4* colour, __global const float4* emission,
+                            __global const float4* position_depth,
+                            __global const float4* shading_normal,
+                            __global const float4* base_color_roughness,
+                            __global const uint* flags, __global const uint* material,
+                            __global const float2* motion,
+                            __global const float4* prev_position_depth,
+                            __global const float4* prev_shading_normal,
+                            __global const uint* prev_material,
+                            __global const float4* prev_history,
+                            __global const float4* prev_moments,
+                            __global float4* surface, __global float* depth_slope,
+                            __global float4* integrated, __global float4* moments,
+                            uint width, uint height, uint has_history,
+                            pg_svgf_settings settings) {
+  /* clang-format on */
+  uint x = get_global_id(0), y = get_global_id(1);
+  if (x >= width || y >= height) return;
+  uint i = y * width + x;
+  if (!pg_svgf_has_surface(flags[i])) {
+    surface[i] = (float4)(0.0f, 0.0f, 1.0f, 0.0f);
+    depth_slope[i] = 0.0f;
+    integrated[i] = (float4)(0.0f);
+    moments[i] = (float4)(0.0f);
+    return;
+  }
+  float4 pd = position_depth[i];
+  float3 n = shading_normal[i].xyz;
+  surface[i] = (float4)(n, pd.w);
+  float z_left = x > 0u ? position_depth[i - 1u].w : 0.0f;
+  float z_right = x + 1u < width ? position_depth[i + 1u].w : 0.0f;
+  float z_down = y > 0u ? position_depth[i - width].w : 0.0f;
+  float z_up = y + 1u < height ? position_depth[i + width].w : 0.0f;
+  depth_slope[i] = pg_svgf_depth_slope(pd.w, z_left, z_right, z_down, z_up);
+
+  float3 albedo = pg_svgf_albedo(base_color_roughness[i], settings.albedo_floor);
+  float3 illumination = pg_svgf_demodulate(colour[i].xyz, emission[i].xyz, albedo);
+  float luminance = pg_luminance(illumination);
+
+  float3 sum_history = (float3)(0.0f);
+  float4 sum_moments = (float4)(0.0f);
+  float sum_weight = 0.0f;
+  if (has_history != 0u) {
+    float2 position = (float2)((float)x, (float)y) + motion[i];
+    uint m = material[i];
+    for (int t = 0; t < 4; ++t) {
+      int px, py;
+      float w = pg_svgf_bilinear_tap(position, t, &px, &py);
+      if (w <= 0.0f || px < 0 || py < 0 || px >= (int)width || py >= (int)height) continue;
+      uint j = (uint)py * width + (uint)px;
+      if (!pg_same_surface(pd, n, m, prev_position_depth[j], prev_shading_normal[j].xyz,
+                           prev_material[j], settings.reproject_position,
+                           settings.reproject_normal))
+        continue;
+      sum_history += w * prev_history[j].xyz;
+      sum_moments += w * prev_moments[j];
+      sum_weight += w;
+    }
+  }
+  float length = 1.0f;
+  float3 c = illumination;
+  float2 mo = (float2)(luminance, luminance * luminance);
+  if (sum_weight >= PG_SVGF_MIN_TAP_WEIGHT) {
+    float3 history = sum_history / sum_weight;
+    float4 history_moments = sum_moments / sum_weight;
+    length = fmin(history_moments.z + 1.0f, settings.max_history);
+    c = pg_svgf_blend3(history, illumination, pg_svgf_blend_weight(settings.alpha_colour, length));
+    float wm = pg_svgf_blend_weight(settings.alpha_moments, length);
+    mo = (float2)(pg_svgf_blend(history_moments.x, mo.x, wm),
+                  pg_svgf_blend(history_moments.y, mo.y, wm));
+  }
+  integrated[i] = (float4)(c, 0.0f);
+  moments[i] = (float4)(mo.x, mo.y, length, 0.0f);
+}

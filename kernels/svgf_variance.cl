@@ -1,0 +1,56 @@
+/* SVGF's variance estimate (docs/denoising.md; Schied et al. 2017, 4.2): the luminance variance
+ * from the temporal moments where the history holds min_history frames or more, else from the
+ * moments of a 7x7 neighbourhood weighted by depth and normal (the illumination is averaged the
+ * same way there). Writes illumination (rgb) with its variance (w), the input of the first
+ * a-trous iteration. */
+#pragma OPENCL FP_CONTRACT OFF
+
+#include "shared/svgf.h"
+
+/* clang-format off */
+__kernel void svgf_variance(__global const float4* integrated, __global const float4* moments,
+                            __global const float4* surface, __global const float* depth_slope,
+                            __global float4* illumination, uint width, uint height,
+                            pg_svgf_settings settings) {
+  /* clang-format on */
+  uint x = get_global_id(0), y = get_global_id(1);
+  if (x >= width || y >= height) return;
+  uint i = y * width + x;
+  float4 sc = surface[i];
+  if (sc.w <= 0.0f) {
+    illumination[i] = (float4)(0.0f);
+    return;
+  }
+  float4 mc = moments[i];
+  float4 ic = integrated[i];
+  if (mc.z >= settings.min_history) {
+    float v = pg_svgf_variance(mc.x, mc.y, mc.z, settings.min_history);
+    illumination[i] = (float4)(ic.xyz, v);
+    return;
+  }
+  float slope = depth_slope[i];
+  float lc = pg_luminance(ic.xyz);
+  float3 sum_c = (float3)(0.0f);
+  float sum_m1 = 0.0f, sum_m2 = 0.0f, sum_w = 0.0f;
+  for (int dy = -3; dy <= 3; ++dy) {
+    int qy = (int)y + dy;
+    if (qy < 0 || qy >= (int)height) continue;
+    for (int dx = -3; dx <= 3; ++dx) {
+      int qx = (int)x + dx;
+      if (qx < 0 || qx >= (int)width) continue;
+      uint j = (uint)qy * width + (uint)qx;
+      float4 iq = integrated[j];
+      float distance = sqrt((float)(dx * dx + dy * dy));
+      float w = pg_svgf_edge_weight(sc, slope, lc, surface[j], pg_luminance(iq.xyz), distance, 0.0f,
+                                    settings);
+      float4 mq = moments[j];
+      sum_c += w * iq.xyz;
+      sum_m1 += w * mq.x;
+      sum_m2 += w * mq.y;
+      sum_w += w;
+    }
+  }
+  /* sum_w >= 1: the centre's own weight is exp(0). */
+  float v = pg_svgf_variance(sum_m1 / sum_w, sum_m2 / sum_w, mc.z, settings.min_history);
+  illumination[i] = (float4)(sum_c / sum_w, v);
+}

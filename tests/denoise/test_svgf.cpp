@@ -1,0 +1,361 @@
+// kernels/svgf_*.cl against SvgfReference (host/denoise/svgf_reference.h), stage by stage, and
+// the properties a denoiser must have (docs/denoising.md), on synthetic G-buffers whose answer
+// is known.
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "denoise/svgf_denoiser.h"
+#include "denoise/svgf_reference.h"
+#include "rtpg/errors.h"
+
+namespace rtpg {
+namespace {
+
+// Oclgrind simulates each work-item (about 100x slower than PoCL): keep its images small.
+bool simulated(const ClRuntime& rt) {
+  return rt.info().platform_name.find("Oclgrind") != std::string::npos;
+}
+
+// A G-buffer of a few surfaces the camera sees, as a renderer fills it: a floor plane whose
+// depth grows with y (a slope), two boxes at other depths with their own normals and materials,
+// a sky band, an emitter, textured albedo. The boxes have moved shift_x pixels right since
+// frame 0 and the floor has not, with the motion vectors saying so: the boxes' trailing edges
+// uncover floor.
+GBuffer scene_gbuffer(int w, int h, float shift_x, std::mt19937& rng) {
+  GBuffer g;
+  g.resize(w, h);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const float bx = static_cast<float>(x) - shift_x;  // a box point's x in frame 0
+      const float jitter = 0.5f * (unit(rng) - 0.5f);
+      g.motion[i] = glm::vec2(0.0f);
+      if (y < h / 6) {  // sky
+        g.flags[i] = PG_GBUF_SKY;
+        g.emission[i] = glm::vec4(0.3f, 0.5f, 0.9f, 0.0f);
+        continue;
+      }
+      float sx = static_cast<float>(x);  // this point's x in frame 0
+      float depth =
+          2.0f + 8.0f * static_cast<float>(h - y) / static_cast<float>(h) + 0.01f * jitter;
+      glm::vec3 n(0.0f, 1.0f, 0.0f);
+      std::uint32_t material = 0;
+      if (bx > 0.25f * w && bx < 0.5f * w && y > h / 3) {  // a box, nearer, facing the camera
+        depth = 1.5f;
+        n = glm::vec3(0.0f, 0.0f, 1.0f);
+        material = 1;
+      } else if (bx >= 0.6f * w && y > h / 2) {  // another, tilted
+        depth = 3.0f + 0.02f * bx;
+        n = glm::normalize(glm::vec3(0.6f, 0.0f, 0.8f));
+        material = 2;
+      }
+      if (material != 0) {
+        sx = bx;
+        g.motion[i] = glm::vec2(-shift_x, 0.0f);
+      }
+      g.flags[i] = 0;
+      g.position_depth[i] =
+          glm::vec4(sx * 0.01f * depth, static_cast<float>(y) * 0.01f, depth, depth);
+      g.shading_normal[i] = glm::vec4(n, 0.0f);
+      g.material[i] = material;
+      // A checker texture: demodulation must keep it sharp.
+      const bool checker = ((static_cast<int>(std::floor(sx / 3.0f)) + y / 3) & 1) != 0;
+      const float a = material == 0 ? (checker ? 0.8f : 0.2f) : 0.5f + 0.2f * material;
+      g.base_color_roughness[i] = glm::vec4(a, 0.9f * a, 0.7f * a, 0.5f);
+      if (material == 2 && y > h - 3) {  // an emitter strip
+        g.flags[i] |= PG_GBUF_EMITTER;
+        g.emission[i] = glm::vec4(4.0f, 3.0f, 2.0f, 0.0f);
+      }
+    }
+  return g;
+}
+
+// Noisy colour on g: albedo * (smooth illumination * heavy-tailed noise) + emission.
+std::vector<glm::vec4> noisy_colour(const GBuffer& g, std::mt19937& rng) {
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::vector<glm::vec4> c(g.pixel_count());
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (!g.has_surface(i)) {
+      c[i] = g.emission[i];
+      continue;
+    }
+    const float u = unit(rng);
+    const float noise = u < 0.05f ? 12.0f * unit(rng) : 0.5f * unit(rng);  // mean 0.8375
+    const float light = 1.0f + 0.5f * static_cast<float>(g.material[i]);
+    c[i] = glm::vec4(glm::vec3(g.base_color_roughness[i]) * light * noise, 1.0f) +
+           glm::vec4(glm::vec3(g.emission[i]), 0.0f);
+  }
+  return c;
+}
+
+// |a - b| within a relative tolerance of the larger magnitude (plus a floor for values near 0).
+void expect_close(const std::vector<glm::vec4>& device, const std::vector<glm::vec4>& host,
+                  const char* stage, float tolerance) {
+  ASSERT_EQ(device.size(), host.size());
+  int reported = 0;
+  for (std::size_t i = 0; i < host.size(); ++i)
+    for (int c = 0; c < 4; ++c) {
+      const float a = device[i][c], b = host[i][c];
+      const float scale = std::max({std::fabs(a), std::fabs(b), 1e-3f});
+      if (!(std::fabs(a - b) <= tolerance * scale) && reported++ < 5)
+        ADD_FAILURE() << stage << ": pixel " << i << " channel " << c << ": device " << a
+                      << ", host " << b;
+    }
+}
+
+struct Case {
+  int width, height, local_x, local_y;
+};
+
+// Every stage of three frames of a panning camera, device against host.
+TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
+  ClRuntime rt;
+  std::vector<Case> cases = {{37, 23, 16, 16}, {17, 13, 1, 1}, {40, 9, 7, 3}, {1, 1, 8, 8}};
+  if (!simulated(rt)) cases.push_back({130, 71, 16, 8});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::to_string(c.width) + "x" + std::to_string(c.height) + ", local " +
+                 std::to_string(c.local_x) + "x" + std::to_string(c.local_y));
+    SvgfSettings s;
+    s.local_x = c.local_x;
+    s.local_y = c.local_y;
+    s.history_iteration = 1;
+    SvgfDenoiser device(rt, c.width, c.height, s);
+    SvgfReference host(c.width, c.height, s);
+    std::mt19937 rng(7);
+    for (int f = 0; f < 3; ++f) {
+      const GBuffer g = scene_gbuffer(c.width, c.height, 1.7f * static_cast<float>(f), rng);
+      const std::vector<glm::vec4> colour = noisy_colour(g, rng);
+      const std::vector<glm::vec4> out = device.denoise(colour, g);
+      host.denoise(colour, g);
+      // The exp and log of the device may be 3 ulp off the host's; sums of 25-49 terms.
+      const float tol = 2e-4f;
+      expect_close(device.read(SvgfStage::Surface), host.stage(SvgfStage::Surface), "surface", 0);
+      std::vector<glm::vec4> slope_d, slope_h;
+      for (float v : device.read_depth_slope()) slope_d.emplace_back(v);
+      for (float v : host.depth_slope()) slope_h.emplace_back(v);
+      expect_close(slope_d, slope_h, "depth slope", 0);
+      expect_close(device.read(SvgfStage::Integrated), host.stage(SvgfStage::Integrated),
+                   "integrated", tol);
+      expect_close(device.read(SvgfStage::Moments), host.stage(SvgfStage::Moments), "moments", tol);
+      expect_close(device.read(SvgfStage::Illumination), host.stage(SvgfStage::Illumination),
+                   "illumination", tol);
+      expect_close(device.read(SvgfStage::History), host.stage(SvgfStage::History), "history", tol);
+      expect_close(device.read(SvgfStage::Filtered), host.stage(SvgfStage::Filtered), "filtered",
+                   tol);
+      expect_close(out, host.stage(SvgfStage::Output), "output", tol);
+    }
+  }
+}
+
+// A frame whose illumination is the same everywhere comes out as it went in, texture included:
+// every weight sums colours equal to the centre's.
+TEST(SvgfKernels, FlatIlluminationPassesThroughUnchanged) {
+  ClRuntime rt;
+  const int w = simulated(rt) ? 20 : 64, h = simulated(rt) ? 14 : 40;
+  SvgfDenoiser device(rt, w, h);
+  std::mt19937 rng(3);
+  for (int f = 0; f < 3; ++f) {
+    const GBuffer g = scene_gbuffer(w, h, 0.0f, rng);
+    std::vector<glm::vec4> colour(g.pixel_count());
+    for (std::size_t i = 0; i < colour.size(); ++i)
+      colour[i] =
+          g.has_surface(i)
+              ? glm::vec4(glm::vec3(g.base_color_roughness[i]) * 0.7f + glm::vec3(g.emission[i]),
+                          1.0f)
+              : g.emission[i];
+    const std::vector<glm::vec4> out = device.denoise(colour, g);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(out[i][c], colour[i][c], 1e-5f * std::max(1.0f, colour[i][c]))
+            << "frame " << f << " pixel " << i;
+  }
+}
+
+// Two constant regions side by side: a depth step, then a normal step at equal depth. Neither
+// leaks into the other, though the a-trous taps reach 32 pixels across.
+TEST(SvgfKernels, EdgesOfDepthAndNormalAreNotBlurred) {
+  ClRuntime rt;
+  const int w = simulated(rt) ? 24 : 80, h = simulated(rt) ? 8 : 24;
+  for (const bool normal_edge : {false, true}) {
+    SCOPED_TRACE(normal_edge ? "normal edge" : "depth edge");
+    GBuffer g;
+    g.resize(w, h);
+    std::vector<glm::vec4> colour(g.pixel_count());
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * w + x;
+        const bool right = x >= w / 2;
+        const float depth = right && !normal_edge ? 3.0f : 2.0f;
+        g.flags[i] = 0;
+        g.position_depth[i] = glm::vec4(0.01f * x, 0.01f * y, depth, depth);
+        g.shading_normal[i] = right && normal_edge ? glm::vec4(1, 0, 0, 0) : glm::vec4(0, 0, 1, 0);
+        g.base_color_roughness[i] = glm::vec4(0.5f, 0.5f, 0.5f, 0.5f);
+        colour[i] = right ? glm::vec4(2.0f, 1.0f, 0.5f, 1.0f) : glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+      }
+    SvgfDenoiser device(rt, w, h);
+    const std::vector<glm::vec4> out = device.denoise(colour, g);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(out[i][c], colour[i][c], 1e-5f) << "pixel " << i % w << "," << i / w;
+  }
+}
+
+// A static camera. The luminance moments are a purely temporal average: with alpha 0 the first
+// moment is exactly the mean of all frames' luminance. The colour history is the filtered
+// illumination (SVGF feeds back the first a-trous output), so its expectation, not its value, is
+// the mean of the inputs: tested over independent runs, with alpha 0 and the paper's 0.2.
+TEST(SvgfKernels, TemporalAccumulationConvergesToTheMean) {
+  ClRuntime rt;
+  const int w = simulated(rt) ? 16 : 64, h = simulated(rt) ? 8 : 32, frames = 12;
+  const int runs = simulated(rt) ? 3 : 10;
+  GBuffer g;
+  g.resize(w, h);
+  for (std::size_t i = 0; i < g.pixel_count(); ++i) {
+    g.flags[i] = 0;
+    g.position_depth[i] = glm::vec4(0.01f * (i % w), 0.01f * (i / w), 2.0f, 2.0f);
+    g.shading_normal[i] = glm::vec4(0, 0, 1, 0);
+    g.base_color_roughness[i] = glm::vec4(1.0f, 1.0f, 1.0f, 0.5f);
+  }
+  for (const float alpha : {0.0f, 0.2f}) {
+    SCOPED_TRACE("alpha " + std::to_string(alpha));
+    SvgfSettings s;
+    s.alpha_colour = alpha;
+    s.alpha_moments = alpha;
+    s.max_history = 64;
+    std::vector<double> image_means;
+    for (int run = 0; run < runs; ++run) {
+      SvgfDenoiser device(rt, w, h, s);
+      std::mt19937 rng(11 + run);
+      std::uniform_real_distribution<float> unit(0.0f, 1.0f);  // mean 1/2
+      std::vector<double> sum(g.pixel_count(), 0.0);
+      for (int f = 0; f < frames; ++f) {
+        std::vector<glm::vec4> colour(g.pixel_count());
+        for (std::size_t i = 0; i < colour.size(); ++i) {
+          colour[i] = glm::vec4(glm::vec3(unit(rng)), 1.0f);
+          sum[i] += shared::pg_luminance(glm::vec3(colour[i]));
+        }
+        device.denoise(colour, g);
+      }
+      const std::vector<glm::vec4> integrated = device.read(SvgfStage::Integrated);
+      const std::vector<glm::vec4> moments = device.read(SvgfStage::Moments);
+      double mean = 0.0;
+      for (std::size_t i = 0; i < integrated.size(); ++i) {
+        ASSERT_EQ(moments[i].z, static_cast<float>(frames));
+        if (alpha == 0.0f) {
+          ASSERT_NEAR(moments[i].x, sum[i] / frames, 1e-5) << "pixel " << i;
+        }
+        mean += integrated[i].x;
+      }
+      image_means.push_back(mean / static_cast<double>(integrated.size()));
+    }
+    double m = 0.0, v = 0.0;
+    for (double x : image_means) m += x;
+    m /= runs;
+    for (double x : image_means) v += (x - m) * (x - m);
+    const double se = std::sqrt(v / (runs - 1) / runs);
+    EXPECT_NEAR(m, 0.5, 4.0 * se + 1e-6) << "standard error " << se;
+  }
+}
+
+// Boxes that moved 3 pixels over a still floor: history is kept where last frame showed the
+// same surface at the back-projected position (length 2 after two frames) and dropped where it
+// did not (floor the boxes uncovered, box pixels that came in across the image border: 1).
+TEST(SvgfKernels, ReprojectionKeepsHistoryOnlyOnTheSameSurface) {
+  ClRuntime rt;
+  const int w = simulated(rt) ? 24 : 64, h = simulated(rt) ? 12 : 32;
+  std::mt19937 rng(5);
+  const GBuffer g0 = scene_gbuffer(w, h, 0.0f, rng);
+  const GBuffer g1 = scene_gbuffer(w, h, 3.0f, rng);
+  SvgfDenoiser device(rt, w, h);
+  SvgfReference host(w, h);
+  for (const GBuffer* g : {&g0, &g1}) {
+    const std::vector<glm::vec4> colour = noisy_colour(*g, rng);
+    device.denoise(colour, *g);
+    host.denoise(colour, *g);
+  }
+  const std::vector<glm::vec4> moments = device.read(SvgfStage::Moments);
+  int kept = 0, dropped = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (!g1.has_surface(i)) {
+        EXPECT_EQ(moments[i].z, 0.0f);
+        continue;
+      }
+      // Motion is a whole number of pixels (0 or -3): one bilinear tap, the pixel it points at.
+      const int px = x + static_cast<int>(g1.motion[i].x);
+      bool same = px >= 0;
+      if (same) {
+        const std::size_t j = static_cast<std::size_t>(y) * w + px;
+        same = g0.has_surface(j) && g0.material[j] == g1.material[i] &&
+               std::fabs(g0.position_depth[j].w - g1.position_depth[i].w) <
+                   0.05f * g1.position_depth[i].w;
+      }
+      EXPECT_EQ(moments[i].z, same ? 2.0f : 1.0f) << "pixel " << x << "," << y;
+      (same ? kept : dropped)++;
+    }
+  EXPECT_GT(kept, 0);
+  EXPECT_GT(dropped, 0);
+  expect_close(moments, host.stage(SvgfStage::Moments), "moments", 2e-4f);
+}
+
+TEST(SvgfKernels, BadInputIsAClearError) {
+  ClRuntime rt;
+  SvgfSettings zero;
+  zero.iterations = 0;
+  EXPECT_THROW(SvgfDenoiser(rt, 8, 8, zero), InputError);
+  SvgfSettings late;
+  late.history_iteration = 5;
+  try {
+    SvgfDenoiser d(rt, 8, 8, late);
+    ADD_FAILURE() << "history_iteration 5 of 5 iterations accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("history_iteration"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(SvgfDenoiser(rt, 0, 8), InputError);
+  SvgfSettings nan;
+  nan.phi_luminance = std::nanf("");
+  EXPECT_THROW(SvgfReference(8, 8, nan), InputError);
+  SvgfDenoiser d(rt, 8, 8);
+  GBuffer g;
+  g.resize(8, 8);
+  try {
+    d.denoise(std::vector<glm::vec4>(63), g);
+    ADD_FAILURE() << "63 pixels accepted for 8x8";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("63 colour pixels"), std::string::npos) << e.what();
+  }
+  GBuffer small;
+  small.resize(8, 7);
+  EXPECT_THROW(d.denoise(std::vector<glm::vec4>(64), small), InputError);
+}
+
+// Non-finite and huge colours (a broken or a firefly sample) give finite output everywhere.
+TEST(SvgfKernels, ExtremeInputStaysFinite) {
+  ClRuntime rt;
+  const int w = simulated(rt) ? 16 : 48, h = simulated(rt) ? 12 : 32;
+  std::mt19937 rng(9);
+  SvgfDenoiser device(rt, w, h);
+  for (int f = 0; f < 3; ++f) {
+    const GBuffer g = scene_gbuffer(w, h, static_cast<float>(f), rng);
+    std::vector<glm::vec4> colour = noisy_colour(g, rng);
+    for (std::size_t i = 0; i < colour.size(); i += 7)
+      colour[i] = i % 3 == 0   ? glm::vec4(std::nanf(""))
+                  : i % 3 == 1 ? glm::vec4(3e38f, 1e30f, 0.0f, 1.0f)
+                               : glm::vec4(INFINITY, 0.0f, -INFINITY, 1.0f);
+    const std::vector<glm::vec4> out = device.denoise(colour, g);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      if (!g.has_surface(i)) continue;  // the sky is passed through as it came
+      for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(out[i][c])) << "pixel " << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rtpg
