@@ -99,6 +99,27 @@ def saved_frame(image_path, frame):
     return Path(image_path).with_name(f"{Path(image_path).stem}-f{frame:04d}{Path(image_path).suffix}")
 
 
+def comparison_figure(ref, images, titles, suptitle, path):
+    """Reference, PT and PG (images["off"], images["pmm"]) side by side, each with a zoomed crop
+    where PT's error is largest; titles: the reference's, PT's and PG's."""
+    err = np.mean((images["off"] - ref) ** 2 / (ref ** 2 + 0.01), axis=2)
+    y0, x0, s = crop_box(err, max(16, min(ref.shape[:2]) // 3))
+    fig, axes = plt.subplots(2, 3, figsize=(12, 8) if ref.shape[1] > 400 else (9, 6))
+    for col, (title, img) in enumerate(zip(titles, (ref, images["off"], images["pmm"]))):
+        tm = metrics.tonemap_srgb(img)
+        axes[0, col].imshow(tm)
+        axes[0, col].add_patch(plt.Rectangle((x0, y0), s, s, fill=False, color="cyan"))
+        axes[0, col].set_title(title, fontsize=9)
+        axes[1, col].imshow(tm[y0:y0 + s, x0:x0 + s], interpolation="nearest")
+        for a in axes[:, col]:
+            a.axis("off")
+    fig.suptitle(suptitle)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return str(path)
+
+
 def static_run(ctx, scene, method):
     """The static-camera run shared by equal_frame and convergence: max(sweep, T) frames at 1 spp
     with relMSE per frame, and the frames of the sweep saved as EXR. Rendered once per scene."""
@@ -145,24 +166,10 @@ def equal_frame(ctx, scene):
             img = metrics.load_exr(static_run(ctx, scene, method)[1][t])
             row[method] = {"relmse": metrics.relmse(img, ref), "flip_ldr": metrics.flip_ldr(img, ref)}
         result["sweep"][str(t)] = row
-    # Figure: reference, PT, PG, each with a zoomed crop where PT's error is largest.
-    err = np.mean((images["off"] - ref) ** 2 / (ref ** 2 + 0.01), axis=2)
-    y0, x0, s = crop_box(err, max(16, min(ref.shape[:2]) // 3))
-    fig, axes = plt.subplots(2, 3, figsize=(12, 8) if ref.shape[1] > 400 else (9, 6))
-    for col, (name, img) in enumerate((("Reference", ref), ("PT 1 spp", images["off"]), ("PG 1 spp", images["pmm"]))):
-        tm = metrics.tonemap_srgb(img)
-        axes[0, col].imshow(tm)
-        axes[0, col].add_patch(plt.Rectangle((x0, y0), s, s, fill=False, color="cyan"))
-        label = name if col == 0 else f"{name}  FLIP {result['methods']['off' if col == 1 else 'pmm']['flip_ldr']:.3f}"
-        axes[0, col].set_title(label, fontsize=9)
-        axes[1, col].imshow(tm[y0:y0 + s, x0:x0 + s], interpolation="nearest")
-        for a in axes[:, col]:
-            a.axis("off")
-    fig.suptitle(f"{scene}: 1 spp after {T} frames ({m['res']})")
-    fig.tight_layout()
-    fig.savefig(out / "comparison.png", dpi=100)
-    plt.close(fig)
-    result["figure"] = str(out / "comparison.png")
+    flips = {k: result["methods"][k]["flip_ldr"] for k in METHODS}
+    result["figure"] = comparison_figure(
+        ref, images, ("Reference", f"PT 1 spp  FLIP {flips['off']:.3f}", f"PG 1 spp  FLIP {flips['pmm']:.3f}"),
+        f"{scene}: 1 spp after {T} frames ({m['res']})", out / "comparison.png")
     return result
 
 
@@ -313,24 +320,10 @@ def denoised(ctx, scene):
                                       "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f]) for f in frames],
                                       "flicker_mse": fm, "flicker_sem": fs,
                                       "flicker_mse_noisy": mean_sem(flicker_noisy)[0]}
-    err = np.mean((images["off"] - ref) ** 2 / (ref ** 2 + 0.01), axis=2)
-    y0, x0, s = crop_box(err, max(16, min(ref.shape[:2]) // 3))
-    fig, axes = plt.subplots(2, 3, figsize=(12, 8) if ref.shape[1] > 400 else (9, 6))
-    for col, (label, img) in enumerate((("Reference", ref), ("PT+SVGF", images["off"]), ("PG+SVGF", images["pmm"]))):
-        tm = metrics.tonemap_srgb(img)
-        axes[0, col].imshow(tm)
-        axes[0, col].add_patch(plt.Rectangle((x0, y0), s, s, fill=False, color="cyan"))
-        if col:
-            label += f"  FLIP {result['static']['off' if col == 1 else 'pmm']['flip_ldr']:.3f}"
-        axes[0, col].set_title(label, fontsize=9)
-        axes[1, col].imshow(tm[y0:y0 + s, x0:x0 + s], interpolation="nearest")
-        for a in axes[:, col]:
-            a.axis("off")
-    fig.suptitle(f"{scene}: 1 spp + SVGF after {T} frames ({m['res']})")
-    fig.tight_layout()
-    fig.savefig(out / "denoised.png", dpi=100)
-    plt.close(fig)
-    result["figure"] = str(out / "denoised.png")
+    flips = {k: result["static"][k]["flip_ldr"] for k in METHODS}
+    result["figure"] = comparison_figure(
+        ref, images, ("Reference", f"PT+SVGF  FLIP {flips['off']:.3f}", f"PG+SVGF  FLIP {flips['pmm']:.3f}"),
+        f"{scene}: 1 spp + SVGF after {T} frames ({m['res']})", out / "denoised.png")
     return result
 
 

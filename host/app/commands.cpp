@@ -123,29 +123,23 @@ decltype(auto) with_flag_names(F&& f) {
   }
 }
 
-// Every guiding setting of the run, by its name in the settings table.
-nlohmann::json guiding_settings_json(const GuidingSettings& s) {
+// Every row of a settings table (guiding's or the denoiser's) by its name.
+template <class Settings>
+nlohmann::json settings_json(const std::vector<SettingInfo<Settings>>& table, const Settings& s) {
   nlohmann::json out = nlohmann::json::object();
-  for (const GuidingSettingInfo& row : guiding_settings_table()) {
+  for (const SettingInfo<Settings>& row : table) {
     if (row.int_field) {
       out[row.name] = s.*row.int_field;
     } else {
       out[row.name] = s.*row.float_field;
     }
   }
-  out["train_memory"] = train_memory_name(s.train_memory);
   return out;
 }
 
-nlohmann::json svgf_settings_json(const SvgfSettings& s) {
-  nlohmann::json out = nlohmann::json::object();
-  for (const SvgfSettingInfo& row : svgf_settings_table()) {
-    if (row.int_field) {
-      out[row.name] = s.*row.int_field;
-    } else {
-      out[row.name] = s.*row.float_field;
-    }
-  }
+nlohmann::json guiding_settings_json(const GuidingSettings& s) {
+  nlohmann::json out = settings_json(guiding_settings_table(), s);
+  out["train_memory"] = train_memory_name(s.train_memory);
   return out;
 }
 
@@ -342,7 +336,7 @@ int run_render(const RenderCommand& command) {
         {"guiding", command.guiding},
         {"guiding_settings", guiding_settings_json(command.guiding_settings)},
         {"denoise", command.denoise},
-        {"svgf_settings", svgf_settings_json(command.svgf_settings)},
+        {"svgf_settings", settings_json(svgf_settings_table(), command.svgf_settings)},
         {"max_bounces", settings.path_tracer.max_bounces},
         {"path_tracer", path_tracer_settings_json(settings.path_tracer)},
         {"camera_frame", settings.camera_frame},
