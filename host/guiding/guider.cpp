@@ -57,6 +57,7 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
   const std::size_t n = pixels(width, height);
   validate(settings);
   const DeviceInfo& info = runtime.info();
+  const bool cpu = info.type == "cpu";
   switch (settings.train_memory) {
     case GuidingSettings::TrainMemory::Local:
       local_tile_ = true;
@@ -65,14 +66,24 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
       local_tile_ = false;
       break;
     case GuidingSettings::TrainMemory::Auto:
-      local_tile_ = info.type != "cpu";
+      local_tile_ = !cpu;
       break;
   }
-  const std::string train_options =
-      std::string("-DPG_TRAIN_LOCAL_TILE=") + (local_tile_ ? "1" : "0");
+  // Several pixels per work-item where the device's compiler turns the lanes into SIMD code
+  // (CPUs); a GPU runs a pixel per work-item and keeps the VPL tile (docs/guiding.md).
+  train_lanes_ = settings.train_lanes;
+  if (train_lanes_ == 0) train_lanes_ = cpu && !local_tile_ ? 8 : 1;
+  if (train_lanes_ > 1 && local_tile_)
+    throw GuiderError("guiding settings: train_lanes = " + std::to_string(train_lanes_) +
+                      " reads VPLs from global memory; it cannot be combined with "
+                      "train_memory = local");
   reproject_ = runtime.kernel("reproject.cl", "reproject");
   sample_ = runtime.kernel("sample.cl", "sample");
-  train_ = runtime.kernel("train.cl", "train", train_options);
+  train_ = train_lanes_ > 1
+               ? runtime.kernel("train_wide.cl", "train_wide",
+                                "-DPG_LANES=" + std::to_string(train_lanes_))
+               : runtime.kernel("train.cl", "train",
+                                std::string("-DPG_TRAIN_LOCAL_TILE=") + (local_tile_ ? "1" : "0"));
 
   translate_cl_errors([&] {
     const std::size_t group = static_cast<std::size_t>(settings.local_x) * settings.local_y;
@@ -144,18 +155,19 @@ void Guider::check_gbuffer(const GuiderGBuffer& g, const char* which) const {
 #undef RTPG_CHECK
 }
 
-double Guider::run(cl::Kernel& kernel) {
+double Guider::run(cl::Kernel& kernel, int lanes) {
   cl::Event done;
-  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, global_range(),
+  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, global_range(lanes),
                                         cl::NDRange(settings_.local_x, settings_.local_y), nullptr,
                                         &done);
   done.wait();
   return ClRuntime::event_ms(done);
 }
 
-cl::NDRange Guider::global_range() const {
+cl::NDRange Guider::global_range(int lanes) const {
   auto round_up = [](int v, int m) { return static_cast<std::size_t>((v + m - 1) / m * m); };
-  return cl::NDRange(round_up(width_, settings_.local_x), round_up(height_, settings_.local_y));
+  return cl::NDRange(round_up((width_ + lanes - 1) / lanes, settings_.local_x),
+                     round_up(height_, settings_.local_y));
 }
 
 void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous) {
@@ -199,11 +211,12 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
                                      (settings_.local_y + 2 * settings_.apron) * 16
                                : 16;
   translate_cl_errors([&] {
-    KernelArgs(train_) << current << vpls << from.state0 << from.state1 << to.state0 << to.state1
-                       << trained_ << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
-                       << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame)
-                       << kernel_settings_ << cl::Local(tile) << cl::Local(tile) << cl::Local(tile);
-    times_.train_ms = run(train_);
+    KernelArgs args(train_);
+    args << current << vpls << from.state0 << from.state1 << to.state0 << to.state1 << trained_
+         << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
+         << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame) << kernel_settings_;
+    if (train_lanes_ == 1) args << cl::Local(tile) << cl::Local(tile) << cl::Local(tile);
+    times_.train_ms = run(train_, train_lanes_);
   });
   current_ = 1 - current_;
 }

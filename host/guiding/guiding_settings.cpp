@@ -63,6 +63,8 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
               "1: train on every VPL at its mixture density; 0: BSDF samples only"),
       integer("local_x", &S::local_x, 1, 65536, "Work-group (VPL tile) width"),
       integer("local_y", &S::local_y, 1, 65536, "Work-group (VPL tile) height"),
+      integer("train_lanes", &S::train_lanes, 0, 16,
+              "Pixels per work-item of the train kernel: 1, 2, 4, 8 or 16 (0 = 8 on CPUs, else 1)"),
   };
   return table;
 }
@@ -99,6 +101,9 @@ void validate(const GuidingSettings& s) {
   if (s.pi_min > s.pi_max)
     fail("pi_min (" + setting_number(s.pi_min) + ") must not exceed pi_max (" +
          setting_number(s.pi_max) + ")");
+  if (s.train_lanes & (s.train_lanes - 1))
+    fail("train_lanes = " + setting_number(s.train_lanes) +
+         " must be 0 (auto) or a power of two: 1, 2, 4, 8 or 16");
   if (s.n_min > s.n_max)
     fail("n_min (" + setting_number(s.n_min) + ") must not exceed n_max (" +
          setting_number(s.n_max) + ")");

@@ -119,6 +119,8 @@ class Guider {
   // What the kernels receive (to_kernel_settings(settings()), built once).
   const pg_kernel_settings& kernel_settings() const { return kernel_settings_; }
   bool train_uses_local_memory() const { return local_tile_; }
+  // Pixels per work-item of the train kernel (settings().train_lanes, 0 resolved per device).
+  int train_lanes() const { return train_lanes_; }
 
   void reset();  // every pixel back to the initial state (k = 0: BSDF sampling)
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
@@ -140,14 +142,17 @@ class Guider {
  private:
   void check_gbuffer(const GuiderGBuffer& g, const char* which) const;
   void check_buffer(const cl::Buffer& b, std::size_t element_size, const std::string& name) const;
-  cl::NDRange global_range() const;
-  double run(cl::Kernel& kernel);  // launches over the image, waits, returns profiled ms
+  // Work-items over the image when each covers `lanes` pixels of a row.
+  cl::NDRange global_range(int lanes = 1) const;
+  // Launches over the image, waits, returns profiled ms.
+  double run(cl::Kernel& kernel, int lanes = 1);
 
   ClRuntime& runtime_;
   int width_, height_;
   GuidingSettings settings_;
   pg_kernel_settings kernel_settings_;
   bool local_tile_ = false;
+  int train_lanes_ = 1;
   struct State {  // the mixtures of every pixel (PG_STATE_CHANNELS)
     cl::Buffer state0, state1;
   };

@@ -583,19 +583,24 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
 
 // ---- train ---------------------------------------------------------------------------------
 
-// Device and host agree after one EM step per pixel, for both variants of the kernel (VPL tile
-// in local memory and direct global reads), which must also agree bit for bit with each other
-// (the same arithmetic on the same VPLs). Tolerance 1e-4 relative (of the value, plus of S0 for
-// the moments): the step size uses exp and log (3 ulp each in OpenCL), the E-step exp of a
-// quadratic form, and the device may contract a*b+c into fma. A pixel may differ beyond that
+// Device and host agree after one EM step per pixel, for every variant of the kernel: train.cl
+// with the VPL tile in local memory and with direct global reads (which must also agree bit
+// for bit with each other: the same arithmetic on the same VPLs), and train_wide.cl with 2, 4,
+// 8 and 16 pixels per work-item (kernels/wide/). Tolerance 1e-4 relative (of the value, plus of
+// S0 for the moments): the step size uses exp and log (3 ulp each in OpenCL), the E-step exp of
+// a quadratic form, and the device may contract a*b+c into fma. A pixel may differ beyond that
 // only where a decision flips on a few-ulp difference: a responsibility at the re-seeding
-// threshold (gamma = 1e-3) or a weight at max_weight. The bound allows 0.1% of the pixels.
-TEST(GuidingKernels, TrainMatchesHostReferenceInBothMemoryVariants) {
+// threshold (gamma = 1e-3) or a weight at max_weight. The bound allows 0.1% of the pixels. In
+// one case the lower half of the image is Lambert only, so that whole work-items of the wide
+// kernel skip the GGX lobe.
+TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
   ClRuntime rt;
   Random r(303);
   std::size_t pixels = 0, trained_total = 0, off = 0;
   for (const KernelCase& kc : kernel_cases(rt)) {
-    const HostGBuffer g = random_gbuffer(r, kc.width, kc.height);
+    HostGBuffer g = random_gbuffer(r, kc.width, kc.height);
+    if (kc.apron == 3)
+      for (std::size_t i = g.n() / 2; i < g.n(); ++i) g.metallic_specular[i] = float4(0.0f);
     const HostVpls v = random_vpls(r, g.n());
     const GuiderGBuffer dg = upload(rt, g);
     const GuiderVpls dv = upload(rt, v, g.width, g.height);
@@ -610,11 +615,16 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInBothMemoryVariants) {
     const pg_kernel_settings p = to_kernel_settings(settings);
     std::vector<float> state = random_states(r, g.n(), p.k_max, false);
     std::vector<float> per_variant[2];
-    for (int variant = 0; variant < 2; ++variant) {
+    const int lanes[] = {1, 1, 2, 4, 8, 16};
+    for (int variant = 0; variant < 6; ++variant) {
       settings.train_memory =
           variant == 0 ? GuidingSettings::TrainMemory::Local : GuidingSettings::TrainMemory::Global;
+      settings.train_lanes = lanes[variant];
+      const std::string variant_name =
+          variant == 0 ? " local" : " global, " + std::to_string(lanes[variant]) + " lanes";
       Guider guider(rt, kc.width, kc.height, settings);
       ASSERT_EQ(guider.train_uses_local_memory(), variant == 0);
+      ASSERT_EQ(guider.train_lanes(), lanes[variant]);
       std::vector<float> s = state;
       // Two frames: the second starts from the first's result (models seeded at k = 0 train on).
       for (std::uint32_t frame = 0; frame < 2; ++frame) {
@@ -630,9 +640,9 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInBothMemoryVariants) {
           if (states_agree(state_at(expected, i), state_at(got, i), 1e-4f)) continue;
           ++mismatched;
           if (mismatched <= 5)
-            ADD_FAILURE() << name(kc) << (variant == 0 ? " local" : " global") << " frame " << frame
-                          << " pixel " << i << ": host " << describe(state_at(expected, i))
-                          << " device " << describe(state_at(got, i));
+            ADD_FAILURE() << name(kc) << variant_name << " frame " << frame << " pixel " << i
+                          << ": host " << describe(state_at(expected, i)) << " device "
+                          << describe(state_at(got, i));
         }
         off += mismatched;
         std::size_t host_trained = 0;
@@ -641,7 +651,7 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInBothMemoryVariants) {
         EXPECT_LE(device_trained > host_trained ? device_trained - host_trained
                                                 : host_trained - device_trained,
                   mismatched)
-            << name(kc);
+            << name(kc) << variant_name;
         trained_total += host_trained;
         pixels += g.n();
         s = expected;  // continue from the host's result: device differences do not compound
@@ -993,6 +1003,11 @@ TEST(GuiderMisuse, ConfigurationsTheDeviceCannotRunAreRefused) {
   bad.pi_max = 0.5f;
   expect_guider_error([&] { Guider g(rt, 8, 8, bad); }, "pi_min");
   expect_guider_error([&] { Guider g(rt, 0, 8); }, "resolution");
+  // Several pixels per work-item read VPLs from global memory: no tile in local memory.
+  bad = GuidingSettings{};
+  bad.train_lanes = 8;
+  bad.train_memory = GuidingSettings::TrainMemory::Local;
+  expect_guider_error([&] { Guider g(rt, 8, 8, bad); }, "train_lanes");
   // A local size no device accepts.
   GuidingSettings huge;
   huge.local_x = 4096;

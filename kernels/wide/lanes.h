@@ -1,0 +1,79 @@
+/* Several pixels per work-item in OpenCL vector types (docs/guiding.md, "Several pixels per
+ * work-item"): PG_LANES (2, 4, 8 or 16, a build option) pixels of one row run in the lanes of
+ * floatN/intN, so a CPU device's compiler emits SIMD code for loops whose trip counts differ
+ * from pixel to pixel, which a work-group vectoriser cannot do. OpenCL C only.
+ *
+ * Conventions: a comparison gives an intN mask (-1 true, 0 false), select(a, b, mask) takes b
+ * where the mask is set, and a lane whose work is done or absent is masked, never branched
+ * around. Per-pixel values that the host reference computes once per pixel (the frame, the
+ * lobes, the M-step) stay scalar and move in and out of the lanes through private arrays. */
+#ifndef RTPG_WIDE_LANES_H
+#define RTPG_WIDE_LANES_H
+
+#ifndef PG_LANES
+#define PG_LANES 8
+#endif
+
+#define PG_PASTE2(a, b) a##b
+#define PG_PASTE(a, b) PG_PASTE2(a, b)
+#define pg_floatw PG_PASTE(float, PG_LANES)
+#define pg_intw PG_PASTE(int, PG_LANES)
+#define pg_uintw PG_PASTE(uint, PG_LANES)
+#define pg_vloadw PG_PASTE(vload, PG_LANES)
+#define pg_vstorew PG_PASTE(vstore, PG_LANES)
+#define pg_convert_uintw PG_PASTE(convert_uint, PG_LANES)
+#define pg_convert_intw PG_PASTE(convert_int, PG_LANES)
+#define pg_convert_floatw PG_PASTE(convert_float, PG_LANES)
+
+/* Three coordinates of PG_LANES points or directions. */
+typedef struct {
+  pg_floatw x, y, z;
+} pg_float3w;
+
+static inline pg_float3w pg_make_float3w(pg_floatw x, pg_floatw y, pg_floatw z) {
+  pg_float3w v;
+  v.x = x;
+  v.y = y;
+  v.z = z;
+  return v;
+}
+
+/* One point or direction per lane from three private arrays of PG_LANES floats. */
+static inline pg_float3w pg_load_float3w(__private const float* xs, __private const float* ys,
+                                         __private const float* zs) {
+  return pg_make_float3w(pg_vloadw(0, xs), pg_vloadw(0, ys), pg_vloadw(0, zs));
+}
+
+static inline pg_floatw pg_dot3w(pg_float3w a, pg_float3w b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+static inline pg_float3w pg_sub3w(pg_float3w a, pg_float3w b) {
+  return pg_make_float3w(a.x - b.x, a.y - b.y, a.z - b.z);
+}
+
+static inline pg_float3w pg_add3w(pg_float3w a, pg_float3w b) {
+  return pg_make_float3w(a.x + b.x, a.y + b.y, a.z + b.z);
+}
+
+static inline pg_float3w pg_mul3w(pg_float3w a, pg_float3w b) {
+  return pg_make_float3w(a.x * b.x, a.y * b.y, a.z * b.z);
+}
+
+static inline pg_float3w pg_scale3w(pg_float3w a, pg_floatw s) {
+  return pg_make_float3w(a.x * s, a.y * s, a.z * s);
+}
+
+static inline pg_float3w pg_select3w(pg_float3w a, pg_float3w b, pg_intw mask) {
+  return pg_make_float3w(select(a.x, b.x, mask), select(a.y, b.y, mask), select(a.z, b.z, mask));
+}
+
+static inline pg_floatw pg_luminance3w(pg_float3w c) {
+  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
+
+static inline pg_floatw pg_max3w(pg_float3w c) {
+  return fmax(c.x, fmax(c.y, c.z));
+}
+
+#endif
