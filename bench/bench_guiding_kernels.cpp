@@ -20,9 +20,12 @@
 //   gflops               (FmaPeak/floatW) multiply-add rate of kernels/fma_peak.cl at vector
 //                        width W: 1 is the scalar rate, 8 and 16 what vector code can reach
 //   vs_16x16_global      kernel time / the same kernel's time at 16x16 with VPLs read from
-//                        global memory, launched in the same iterations (1 for that one):
-//                        the local-size sweep and Local vs Global as ratios that host drift
-//                        does not disturb
+//                        global memory and the train kernel's lanes chosen per device,
+//                        launched in the same iterations (1 for that one): the local-size
+//                        sweep, Local vs Global and the lanes as ratios that host drift does
+//                        not disturb
+//   lanes                pixels per work-item of the train kernel (1: train.cl, else
+//                        train_wide.cl)
 // Bytes per pixel, counted from the inputs along each pixel's path through the kernel (each
 // buffer element counted once, at its full width; a pixel's neighbours' VPLs are the same
 // memory as its own, so the VPL buffers count 48 bytes per pixel):
@@ -381,11 +384,12 @@ void BM_CopyFloat4(benchmark::State& state) {
 enum class Kernel { Reproject, Sample, Train };
 
 std::unique_ptr<Guider> make_guider(int w, int h, int lx, int ly,
-                                    GuidingSettings::TrainMemory memory) {
+                                    GuidingSettings::TrainMemory memory, int lanes) {
   GuidingSettings settings;
   settings.local_x = lx;
   settings.local_y = ly;
   settings.train_memory = memory;
+  settings.train_lanes = lanes;
   auto guider = std::make_unique<Guider>(runtime(), w, h, settings);
   Inputs& in = inputs_for(w, h);
   guider->write_state(in.state);  // first launches of all three kernels, untimed
@@ -396,8 +400,9 @@ std::unique_ptr<Guider> make_guider(int w, int h, int lx, int ly,
 }
 
 // The configuration every other one is compared with, in the same iterations: 16x16 work-groups,
-// VPLs read from global memory (what GuidingSettings's Auto picks on CPU devices).
-constexpr int kRefX = 16, kRefY = 16;
+// VPLs read from global memory and the train kernel's lanes chosen per device (what
+// GuidingSettings's Auto picks on CPU devices: as many pixels per work-item as SIMD lanes).
+constexpr int kRefX = 16, kRefY = 16, kRefLanes = 0;
 constexpr GuidingSettings::TrainMemory kRefMemory = GuidingSettings::TrainMemory::Global;
 
 Guider& reference_guider(int w, int h) {
@@ -405,7 +410,7 @@ Guider& reference_guider(int w, int h) {
   static std::pair<int, int> key;
   if (!guider || key != std::make_pair(w, h)) {
     guider.reset();
-    guider = make_guider(w, h, kRefX, kRefY, kRefMemory);
+    guider = make_guider(w, h, kRefX, kRefY, kRefMemory, kRefLanes);
     key = {w, h};
   }
   return *guider;
@@ -413,14 +418,15 @@ Guider& reference_guider(int w, int h) {
 
 // One other guider alive at a time (a 1080p guider's buffers take 130 MB): the repetitions of
 // one benchmark run back to back and reuse it.
-Guider& guider_for(int w, int h, int lx, int ly, GuidingSettings::TrainMemory memory) {
-  if (lx == kRefX && ly == kRefY && memory == kRefMemory) return reference_guider(w, h);
+Guider& guider_for(int w, int h, int lx, int ly, GuidingSettings::TrainMemory memory, int lanes) {
+  if (lx == kRefX && ly == kRefY && memory == kRefMemory && lanes == kRefLanes)
+    return reference_guider(w, h);
   static std::unique_ptr<Guider> guider;
-  static std::tuple<int, int, int, int, GuidingSettings::TrainMemory> key;
-  const auto want = std::make_tuple(w, h, lx, ly, memory);
+  static std::tuple<int, int, int, int, GuidingSettings::TrainMemory, int> key;
+  const auto want = std::make_tuple(w, h, lx, ly, memory, lanes);
   if (!guider || key != want) {
     guider.reset();
-    guider = make_guider(w, h, lx, ly, memory);
+    guider = make_guider(w, h, lx, ly, memory, lanes);
     key = want;
   }
   return *guider;
@@ -443,13 +449,13 @@ double launch(Guider& g, Inputs& in, Kernel k, std::uint32_t frame) {
 }
 
 void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int lx, int ly,
-                      GuidingSettings::TrainMemory memory) {
+                      GuidingSettings::TrainMemory memory, int lanes) {
   Inputs& in = inputs_for(w, h);
   Guider* g = nullptr;
   Guider* ref = nullptr;
   try {
     ref = &reference_guider(w, h);
-    g = &guider_for(w, h, lx, ly, memory);
+    g = &guider_for(w, h, lx, ly, memory, lanes);
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
     return;
@@ -478,8 +484,10 @@ void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int 
       benchmark::Counter(copy_bw, benchmark::Counter::kDefaults, benchmark::Counter::kIs1024);
   state.counters["copy_fraction"] = kernel_bw / copy_bw;
   state.counters["vs_16x16_global"] = kernel_ms / ref_ms;
-  if (kernel == Kernel::Train)
+  if (kernel == Kernel::Train) {
     state.counters["local_tile"] = g->train_uses_local_memory() ? 1.0 : 0.0;
+    state.counters["lanes"] = g->train_lanes();
+  }
 }
 
 // ---- train as plain C++ over TBB -------------------------------------------------------------
@@ -602,8 +610,9 @@ void register_all(bool full) {
       if (!sweep_here && !(l.x == 16 && l.y == 16)) continue;
       const std::string res = std::to_string(w) + "x" + std::to_string(h);
       const std::string local = "/local:" + std::to_string(l.x) + "x" + std::to_string(l.y);
-      auto add = [&](const std::string& name, Kernel k, M memory) {
-        benchmark::RegisterBenchmark(name.c_str(), BM_GuidingKernel, k, w, h, l.x, l.y, memory)
+      auto add = [&](const std::string& name, Kernel k, M memory, int lanes = kRefLanes) {
+        benchmark::RegisterBenchmark(name.c_str(), BM_GuidingKernel, k, w, h, l.x, l.y, memory,
+                                     lanes)
             ->UseManualTime()
             ->Unit(benchmark::kMillisecond)
             ->MinTime(0.2);
@@ -612,6 +621,11 @@ void register_all(bool full) {
       add("Sample/" + res + local, Kernel::Sample, M::Global);
       add("Train/" + res + local + "/memory:global", Kernel::Train, M::Global);
       add("Train/" + res + local + "/memory:local", Kernel::Train, M::Local);
+      // Pixels per work-item of the train kernel (kernels/train_wide.cl), at 16x16 work-items.
+      if (l.x == kRefX && l.y == kRefY)
+        for (int lanes : {1, 2, 4, 16})
+          add("Train/" + res + local + "/memory:global/lanes:" + std::to_string(lanes),
+              Kernel::Train, M::Global, lanes);
     }
   }
   for (auto [w, h] : sizes) {

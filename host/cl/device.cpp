@@ -89,6 +89,7 @@ std::vector<SelectedDevice> enumerate() {
         info.local_mem_size = dev.getInfo<CL_DEVICE_LOCAL_MEM_SIZE>();
         info.max_work_group_size = dev.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>();
         info.global_mem_size = dev.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+        info.native_float_width = dev.getInfo<CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT>();
         out.push_back({std::move(info), dev});
       }
     }

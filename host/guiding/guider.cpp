@@ -69,10 +69,16 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
       local_tile_ = !cpu;
       break;
   }
-  // Several pixels per work-item where the device's compiler turns the lanes into SIMD code
-  // (CPUs); a GPU runs a pixel per work-item and keeps the VPL tile (docs/guiding.md).
+  // On a CPU device as many pixels per work-item as its SIMD registers hold floats (its
+  // compiler turns the lanes into SIMD code); a GPU runs a pixel per work-item and keeps the
+  // VPL tile (docs/guiding.md, "Several pixels per work-item").
   train_lanes_ = settings.train_lanes;
-  if (train_lanes_ == 0) train_lanes_ = cpu && !local_tile_ ? 8 : 1;
+  if (train_lanes_ == 0) {
+    train_lanes_ = 1;
+    if (cpu && !local_tile_)
+      while (train_lanes_ < 16 && 2 * train_lanes_ <= static_cast<int>(info.native_float_width))
+        train_lanes_ *= 2;
+  }
   if (train_lanes_ > 1 && local_tile_)
     throw GuiderError("guiding settings: train_lanes = " + std::to_string(train_lanes_) +
                       " reads VPLs from global memory; it cannot be combined with "

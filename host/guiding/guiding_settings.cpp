@@ -64,7 +64,8 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
       integer("local_x", &S::local_x, 1, 65536, "Work-group (VPL tile) width"),
       integer("local_y", &S::local_y, 1, 65536, "Work-group (VPL tile) height"),
       integer("train_lanes", &S::train_lanes, 0, 16,
-              "Pixels per work-item of the train kernel: 1, 2, 4, 8 or 16 (0 = 8 on CPUs, else 1)"),
+              "Pixels per work-item of the train kernel: 1, 2, 4, 8 or 16 (0: the SIMD width on "
+              "CPUs, else 1)"),
   };
   return table;
 }

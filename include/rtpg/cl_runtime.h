@@ -26,7 +26,8 @@ struct DeviceInfo {
   std::uint32_t compute_units = 0;
   std::uint64_t local_mem_size = 0;  // bytes
   std::size_t max_work_group_size = 0;
-  std::uint64_t global_mem_size = 0;  // bytes
+  std::uint64_t global_mem_size = 0;     // bytes
+  std::uint32_t native_float_width = 1;  // CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT: SIMD lanes
 
   // "P:D", the index form of a device spec.
   std::string spec() const;
