@@ -5,8 +5,8 @@
  *
  * Conventions: a comparison gives an intN mask (-1 true, 0 false), select(a, b, mask) takes b
  * where the mask is set, and a lane whose work is done or absent is masked, never branched
- * around. Per-pixel values that the host reference computes once per pixel (the frame, the
- * lobes, the M-step) stay scalar and move in and out of the lanes through private arrays. */
+ * around. What a pixel computes once before its loops (its frame, its lobes, the start of its
+ * walk) stays scalar code per lane and moves into the lanes through private arrays. */
 #ifndef RTPG_WIDE_LANES_H
 #define RTPG_WIDE_LANES_H
 
