@@ -127,14 +127,14 @@ __kernel void train_wide(
   if (any_active) {
     pg_train_pixels_w px;
     px.x = get3(pixel, PX_X);
-    px.t = get3(pixel, PX_T);
-    px.b = get3(pixel, PX_B);
-    px.n = get3(pixel, PX_N);
+    px.frame.t = get3(pixel, PX_T);
+    px.frame.b = get3(pixel, PX_B);
+    px.frame.n = get3(pixel, PX_N);
     px.wo = get3(pixel, PX_WO);
-    px.diffuse = get3(pixel, PX_DIFFUSE);
-    px.f0 = get3(pixel, PX_F0);
-    px.alpha = pg_vloadw(0, pixel[PX_ALPHA]);
-    px.p_specular = pg_vloadw(0, pixel[PX_P_SPECULAR]);
+    px.lobes.diffuse = get3(pixel, PX_DIFFUSE);
+    px.lobes.f0 = get3(pixel, PX_F0);
+    px.lobes.alpha = pg_vloadw(0, pixel[PX_ALPHA]);
+    px.lobes.p_specular = pg_vloadw(0, pixel[PX_P_SPECULAR]);
 
     /* The s-th neighbour of every lane's walk (pg_train_window_index, stepped without
      * integer division: w += stride modulo the window size; the row is w / side, exact in

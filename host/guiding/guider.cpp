@@ -72,19 +72,20 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
   // On a CPU device as many pixels per work-item as its SIMD registers hold floats (its
   // compiler turns the lanes into SIMD code); a GPU runs a pixel per work-item and keeps the
   // VPL tile (docs/guiding.md, "Several pixels per work-item").
-  train_lanes_ = settings.train_lanes;
-  if (train_lanes_ == 0) {
-    train_lanes_ = 1;
-    if (cpu && !local_tile_)
-      while (train_lanes_ < 16 && 2 * train_lanes_ <= static_cast<int>(info.native_float_width))
-        train_lanes_ *= 2;
-  }
+  int simd_lanes = 1;
+  if (cpu)
+    while (simd_lanes < 16 && 2 * simd_lanes <= static_cast<int>(info.native_float_width))
+      simd_lanes *= 2;
+  train_lanes_ = settings.train_lanes != 0 ? settings.train_lanes : local_tile_ ? 1 : simd_lanes;
+  sample_lanes_ = settings.sample_lanes != 0 ? settings.sample_lanes : simd_lanes;
   if (train_lanes_ > 1 && local_tile_)
     throw GuiderError("guiding settings: train_lanes = " + std::to_string(train_lanes_) +
                       " reads VPLs from global memory; it cannot be combined with "
                       "train_memory = local");
   reproject_ = runtime.kernel("reproject.cl", "reproject");
-  sample_ = runtime.kernel("sample.cl", "sample");
+  sample_ = sample_lanes_ > 1 ? runtime.kernel("sample_wide.cl", "sample_wide",
+                                               "-DPG_LANES=" + std::to_string(sample_lanes_))
+                              : runtime.kernel("sample.cl", "sample");
   train_ = train_lanes_ > 1
                ? runtime.kernel("train_wide.cl", "train_wide",
                                 "-DPG_LANES=" + std::to_string(train_lanes_))
@@ -201,7 +202,7 @@ void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint3
                         << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
                         << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame)
                         << static_cast<cl_uint>(sample_index) << kernel_settings_;
-    times_.sample_ms = run(sample_);
+    times_.sample_ms = run(sample_, sample_lanes_);
   });
 }
 

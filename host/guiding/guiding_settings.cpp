@@ -66,6 +66,9 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
       integer("train_lanes", &S::train_lanes, 0, 16,
               "Pixels per work-item of the train kernel: 1, 2, 4, 8 or 16 (0: the SIMD width on "
               "CPUs, else 1)"),
+      integer("sample_lanes", &S::sample_lanes, 0, 16,
+              "Pixels per work-item of the sample kernel: 1, 2, 4, 8 or 16 (0: the SIMD width "
+              "on CPUs, else 1)"),
   };
   return table;
 }
@@ -102,9 +105,12 @@ void validate(const GuidingSettings& s) {
   if (s.pi_min > s.pi_max)
     fail("pi_min (" + setting_number(s.pi_min) + ") must not exceed pi_max (" +
          setting_number(s.pi_max) + ")");
-  if (s.train_lanes & (s.train_lanes - 1))
-    fail("train_lanes = " + setting_number(s.train_lanes) +
-         " must be 0 (auto) or a power of two: 1, 2, 4, 8 or 16");
+  const std::pair<const char*, int> lanes[] = {{"train_lanes", s.train_lanes},
+                                               {"sample_lanes", s.sample_lanes}};
+  for (const auto& [name, value] : lanes)
+    if (value & (value - 1))
+      fail(std::string(name) + " = " + setting_number(value) +
+           " must be 0 (auto) or a power of two: 1, 2, 4, 8 or 16");
   if (s.n_min > s.n_max)
     fail("n_min (" + setting_number(s.n_min) + ") must not exceed n_max (" +
          setting_number(s.n_max) + ")");

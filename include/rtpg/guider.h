@@ -121,6 +121,8 @@ class Guider {
   bool train_uses_local_memory() const { return local_tile_; }
   // Pixels per work-item of the train kernel (settings().train_lanes, 0 resolved per device).
   int train_lanes() const { return train_lanes_; }
+  // Pixels per work-item of the sample kernel (settings().sample_lanes, resolved likewise).
+  int sample_lanes() const { return sample_lanes_; }
 
   void reset();  // every pixel back to the initial state (k = 0: BSDF sampling)
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
@@ -153,6 +155,7 @@ class Guider {
   pg_kernel_settings kernel_settings_;
   bool local_tile_ = false;
   int train_lanes_ = 1;
+  int sample_lanes_ = 1;
   struct State {  // the mixtures of every pixel (PG_STATE_CHANNELS)
     cl::Buffer state0, state1;
   };

@@ -37,10 +37,12 @@ struct GuidingSettings {
   int train_all_samples = 0;       // 1: every VPL trains, weighted by its full mixture density;
                                    // 0: BSDF-strategy VPLs only (paper 3.2)
   int local_x = 16, local_y = 16;  // work-group size of the kernels (the VPL tile)
-  int train_lanes = 0;  // pixels per work-item of the train kernel: 1 (train.cl), or 2, 4, 8, 16
-                        // in vector lanes (train_wide.cl); 0 = auto: on CPU devices the SIMD
-                        // width in floats (CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT), else 1
-                        // (docs/guiding.md, "Several pixels per work-item")
+  int train_lanes = 0;   // pixels per work-item of the train kernel: 1 (train.cl), or 2, 4, 8, 16
+                         // in vector lanes (train_wide.cl); 0 = auto: on CPU devices the SIMD
+                         // width in floats (CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT), else 1
+                         // (docs/guiding.md, "Several pixels per work-item")
+  int sample_lanes = 0;  // the same for the sample kernel: 1 (sample.cl), or 2, 4, 8, 16
+                         // (sample_wide.cl); 0 = auto as for train_lanes
   enum class TrainMemory { Auto, Local, Global };
   // Local: VPL tile in local memory (GPUs); Global: direct reads (faster on PoCL). Auto
   // picks Global on CPU devices and Local elsewhere.

@@ -68,6 +68,14 @@ static inline pg_float3w pg_select3w(pg_float3w a, pg_float3w b, pg_intw mask) {
   return pg_make_float3w(select(a.x, b.x, mask), select(a.y, b.y, mask), select(a.z, b.z, mask));
 }
 
+static inline pg_float3w pg_cross3w(pg_float3w a, pg_float3w b) {
+  return pg_make_float3w(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+
+static inline pg_float3w pg_normalize3w(pg_float3w a) {
+  return pg_scale3w(a, 1.0f / sqrt(pg_dot3w(a, a)));
+}
+
 static inline pg_floatw pg_luminance3w(pg_float3w c) {
   return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
 }

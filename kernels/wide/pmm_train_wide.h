@@ -9,16 +9,16 @@
 
 #include "rtpg/guiding_layout.h"
 #include "shared/compat.h"
+#include "wide/bsdf_wide.h"
 #include "wide/lanes.h"
+#include "wide/pmm_wide.h"
 
 /* What PG_LANES pixels know about themselves while training (pg_train_pixel per lane). */
 typedef struct {
-  pg_float3w x;       /* surface point */
-  pg_float3w t, b, n; /* shading frame */
-  pg_float3w wo;      /* local view direction */
-  pg_float3w diffuse; /* pg_lobes */
-  pg_float3w f0;
-  pg_floatw alpha, p_specular;
+  pg_float3w x;     /* surface point */
+  pg_frame_w frame; /* shading frame */
+  pg_float3w wo;    /* local view direction */
+  pg_lobes_w lobes;
 } pg_train_pixels_w;
 
 /* One VPL per lane (the three channels of include/rtpg/guiding_layout.h, split). */
@@ -37,81 +37,6 @@ typedef struct {
   pg_floatw a, ux, uy, bsdf_pdf;
 } pg_train_samples_w;
 
-/* Smith Lambda of GGX (pg_ggx_lambda). */
-static inline pg_floatw pg_ggx_lambda_w(pg_floatw cos_theta, pg_floatw alpha) {
-  pg_floatw c2 = cos_theta * cos_theta;
-  pg_floatw t2 = fmax(1.0f - c2, 0.0f) / c2;
-  pg_floatw lambda = 0.5f * (-1.0f + sqrt(1.0f + alpha * alpha * t2));
-  return select(lambda, (pg_floatw)(0.0f), c2 <= 0.0f);
-}
-
-/* GGX D (pg_ggx_d) of a half vector with cosine h_z. */
-static inline pg_floatw pg_ggx_d_w(pg_floatw h_z, pg_floatw alpha) {
-  pg_floatw a2 = alpha * alpha;
-  pg_floatw d = h_z * h_z * (a2 - 1.0f) + 1.0f;
-  return a2 / (PG_PI * d * d);
-}
-
-/* f_r(wo, wi) and the BSDF sampling density of wi (pg_bsdf_eval, pg_bsdf_pdf) where wi.z > 0.
- * any_specular = 0 promises that no lane has a GGX lobe: the Lambert-only scene skips it. */
-static inline pg_float3w pg_bsdf_eval_pdf_w(pg_train_pixels_w px, pg_float3w wi, int any_specular,
-                                            __private pg_floatw* pdf) {
-  pg_intw below = px.wo.z <= 0.0f;
-  pg_float3w f = pg_scale3w(px.diffuse, (pg_floatw)(PG_INV_PI));
-  *pdf = (1.0f - px.p_specular) * (fmax(wi.z, 0.0f) * PG_INV_PI);
-  if (any_specular) {
-    pg_intw coated = px.p_specular > 0.0f;
-    pg_floatw a = 1.0f - 0.5f * wi.z, b = 1.0f - 0.5f * px.wo.z;
-    pg_floatw ta = 1.0f - (a * a) * (a * a) * a, tb = 1.0f - (b * b) * (b * b) * b;
-    pg_float3w fd = pg_scale3w(px.diffuse, (28.0f / 23.0f) * PG_INV_PI * ta * tb);
-    pg_float3w h = pg_add3w(px.wo, wi);
-    h = pg_scale3w(h, 1.0f / sqrt(pg_dot3w(h, h)));
-    pg_floatw m = clamp(1.0f - pg_dot3w(wi, h), 0.0f, 1.0f);
-    pg_floatw m5 = (m * m) * (m * m) * m;
-    pg_float3w fresnel =
-        pg_make_float3w(px.f0.x + (1.0f - px.f0.x) * m5, px.f0.y + (1.0f - px.f0.y) * m5,
-                        px.f0.z + (1.0f - px.f0.z) * m5);
-    pg_floatw d = pg_ggx_d_w(h.z, px.alpha);
-    pg_floatw lambda_o = pg_ggx_lambda_w(px.wo.z, px.alpha);
-    pg_floatw g2 = 1.0f / (1.0f + lambda_o + pg_ggx_lambda_w(wi.z, px.alpha));
-    pg_floatw spec = d * g2 / (4.0f * px.wo.z * wi.z);
-    f = pg_select3w(f, pg_add3w(fd, pg_scale3w(fresnel, spec)), coated);
-    pg_floatw pdf_spec = 1.0f / (1.0f + lambda_o) * d / (4.0f * px.wo.z);
-    *pdf = select(*pdf, *pdf + px.p_specular * pdf_spec, coated);
-  }
-  *pdf = select(*pdf, (pg_floatw)(0.0f), below);
-  return pg_select3w(f, pg_make_float3w(0.0f, 0.0f, 0.0f), below);
-}
-
-/* M^-1 (pg_hemisphere_to_square with pg_disk_to_square) for wl.z >= 0. */
-static inline void pg_hemisphere_to_square_w(pg_float3w w, __private pg_floatw* ux,
-                                             __private pg_floatw* uy) {
-  pg_floatw r2 = clamp(1.0f - w.z, 0.0f, 1.0f);
-  pg_floatw xy = sqrt(w.x * w.x + w.y * w.y);
-  pg_floatw scale = select((pg_floatw)(0.0f), sqrt(r2) / xy, xy > 0.0f);
-  pg_floatw dx = w.x * scale, dy = w.y * scale;
-  pg_floatw r = sqrt(dx * dx + dy * dy);
-  /* The wedge |x| >= |y| takes its radius from x and its angle from y / x; the other wedge
-   * swaps the roles (pg_disk_to_square). */
-  pg_intw swap = fabs(dx) < fabs(dy);
-  pg_floatw p = select(dx, dy, swap), q = select(dy, dx, swap);
-  pg_floatw radius = select(-r, r, p > 0.0f);
-  pg_floatw z = q / p, z2 = z * z;
-  pg_floatw t = 0.0028662257f;
-  t = t * z2 - 0.0161657367f;
-  t = t * z2 + 0.0429096138f;
-  t = t * z2 - 0.0752896400f;
-  t = t * z2 + 0.1065626393f;
-  t = t * z2 - 0.1420889944f;
-  t = t * z2 + 0.1999355085f;
-  t = t * z2 - 0.3333314528f;
-  pg_floatw angle = radius * (z + z * z2 * t) * (4.0f / PG_PI);
-  pg_floatw a = select(radius, angle, swap), b = select(angle, radius, swap);
-  pg_intw centre = r == 0.0f;
-  *ux = select(clamp(0.5f * (a + 1.0f), 0.0f, 1.0f), (pg_floatw)(0.5f), centre);
-  *uy = select(clamp(0.5f * (b + 1.0f), 0.0f, 1.0f), (pg_floatw)(0.5f), centre);
-}
-
 /* pg_train_sample_from_vpl for every lane whose mask `asked` is set. */
 static inline pg_train_samples_w pg_train_samples_from_vpls_w(pg_train_pixels_w px, pg_vpls_w v,
                                                               pg_intw asked, pg_kernel_settings p,
@@ -129,12 +54,12 @@ static inline pg_train_samples_w pg_train_samples_from_vpls_w(pg_train_pixels_w 
   pg_floatw r = select(density * d2 / cos_y, density, distant);
   ok &= distant | ((d2 > 0.0f) & (cos_y > 1e-4f));
   ok &= (r > 0.0f) & isfinite(r);
-  pg_float3w wl = pg_make_float3w(pg_dot3w(w, px.t), pg_dot3w(w, px.b), pg_dot3w(w, px.n));
+  pg_float3w wl = pg_to_local_w(px.frame, w);
   ok &= wl.z > 0.0f;
   pg_train_samples_w s;
   s.kept = ok;
   pg_floatw pdf;
-  pg_float3w f = pg_scale3w(pg_bsdf_eval_pdf_w(px, wl, any_specular, &pdf), wl.z);
+  pg_float3w f = pg_scale3w(pg_bsdf_eval_pdf_w(px.lobes, px.wo, wl, any_specular, &pdf), wl.z);
   pg_hemisphere_to_square_w(wl, &s.ux, &s.uy);
   s.a = pg_luminance3w(pg_mul3w(v.radiance, f)) / r;
   s.bsdf_pdf = pdf;
@@ -146,12 +71,6 @@ static inline pg_train_samples_w pg_train_samples_from_vpls_w(pg_train_pixels_w 
   s.bsdf_pdf = select(s.bsdf_pdf, (pg_floatw)(0.0f), dark);
   return s;
 }
-
-/* Mixture models of PG_LANES pixels (pg_pmm_model per lane). */
-typedef struct {
-  pg_intw valid;
-  pg_floatw pi, mx, my, l11, l21, l22;
-} pg_pmm_model_w;
 
 /* E-step sums of PG_LANES pixels (pg_pmm_batch per lane). */
 typedef struct {
@@ -203,77 +122,6 @@ static inline pg_pmm_batch_w pg_pmm_batch_add_w(pg_pmm_batch_w b, pg_pmm_model_w
   b.agyy = select(b.agyy, b.agyy + ag * s.uy * s.uy, add);
   b.agxy = select(b.agxy, b.agxy + ag * s.ux * s.uy, add);
   return b;
-}
-
-/* The running statistics of PG_LANES pixels (pg_pmm_state per lane, kernels/shared/pmm.h). */
-typedef struct {
-  pg_floatw w, s0, sx, sy;    /* pg_pmm_state.s0 */
-  pg_floatw sxx, syy, sxy, k; /* pg_pmm_state.s1 */
-} pg_pmm_state_w;
-
-static inline pg_pmm_state_w pg_pmm_initial_state_w(void) {
-  pg_pmm_state_w s;
-  s.w = s.s0 = s.sx = s.sy = s.sxx = s.syy = s.sxy = s.k = (pg_floatw)(0.0f);
-  return s;
-}
-
-static inline pg_pmm_state_w pg_pmm_state_select_w(pg_pmm_state_w a, pg_pmm_state_w b,
-                                                   pg_intw mask) {
-  pg_pmm_state_w s;
-  s.w = select(a.w, b.w, mask);
-  s.s0 = select(a.s0, b.s0, mask);
-  s.sx = select(a.sx, b.sx, mask);
-  s.sy = select(a.sy, b.sy, mask);
-  s.sxx = select(a.sxx, b.sxx, mask);
-  s.syy = select(a.syy, b.syy, mask);
-  s.sxy = select(a.sxy, b.sxy, mask);
-  s.k = select(a.k, b.k, mask);
-  return s;
-}
-
-static inline pg_intw pg_pmm_state_finite_w(pg_pmm_state_w s) {
-  return isfinite(s.w) & isfinite(s.s0) & isfinite(s.sx) & isfinite(s.sy) & isfinite(s.sxx) &
-         isfinite(s.syy) & isfinite(s.sxy) & isfinite(s.k);
-}
-
-/* pg_pmm_model_from_state; a lane without a model has valid = 0 and the defaults. */
-static inline pg_pmm_model_w pg_pmm_model_from_state_w(pg_pmm_state_w s, pg_kernel_settings p) {
-  pg_intw usable = (s.k > 0.0f) & (s.w > 0.0f) & (s.s0 > 0.0f) & pg_pmm_state_finite_w(s);
-  pg_pmm_model_w m;
-  m.pi = clamp(s.s0 / s.w, p.pi_min, p.pi_max);
-  m.mx = clamp(s.sx / s.s0, 0.0f, 1.0f);
-  m.my = clamp(s.sy / s.s0, 0.0f, 1.0f);
-  pg_floatw inv = 1.0f / s.s0;
-  pg_floatw cxx = s.sxx * inv - m.mx * m.mx, cyy = s.syy * inv - m.my * m.my;
-  pg_floatw cxy = s.sxy * inv - m.mx * m.my;
-  pg_floatw prior = p.sigma_eps + p.sigma_prior / (s.k + 1.0f);
-  pg_floatw sxx = clamp(cxx, 0.0f, 1.0f) + prior, syy = clamp(cyy, 0.0f, 1.0f) + prior;
-  pg_floatw lim = p.max_correlation * sqrt(sxx * syy);
-  pg_floatw sxy = clamp(cxy, -lim, lim);
-  m.l11 = sqrt(sxx);
-  m.l21 = sxy / m.l11;
-  m.l22 = sqrt(fmax(syy - m.l21 * m.l21, 0.0f));
-  m.valid = usable & (m.l22 > 0.0f) & isfinite(m.l21);
-  m.pi = select((pg_floatw)(0.0f), m.pi, usable);
-  m.mx = select((pg_floatw)(0.5f), m.mx, usable);
-  m.my = select((pg_floatw)(0.5f), m.my, usable);
-  m.l11 = select((pg_floatw)(1.0f), m.l11, usable);
-  m.l21 = select((pg_floatw)(0.0f), m.l21, usable);
-  m.l22 = select((pg_floatw)(1.0f), m.l22, usable);
-  return m;
-}
-
-static inline pg_pmm_model_w pg_pmm_model_select_w(pg_pmm_model_w a, pg_pmm_model_w b,
-                                                   pg_intw mask) {
-  pg_pmm_model_w m;
-  m.valid = select(a.valid, b.valid, mask);
-  m.pi = select(a.pi, b.pi, mask);
-  m.mx = select(a.mx, b.mx, mask);
-  m.my = select(a.my, b.my, mask);
-  m.l11 = select(a.l11, b.l11, mask);
-  m.l21 = select(a.l21, b.l21, mask);
-  m.l22 = select(a.l22, b.l22, mask);
-  return m;
 }
 
 /* pg_pmm_update: the M-step of every lane; *updated is the mask of lanes whose state changed

@@ -243,7 +243,7 @@ TEST(GuiderApi, HostDistributionHasTheSampleKernelsDensity) {
 TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
   EXPECT_NO_THROW(rtpg::validate(rtpg::GuidingSettings{}));
   const auto& table = rtpg::guiding_settings_table();
-  EXPECT_EQ(table.size(), 23u);
+  EXPECT_EQ(table.size(), 24u);
   for (const rtpg::GuidingSettingInfo& row : table) {
     ASSERT_TRUE((row.float_field != nullptr) != (row.int_field != nullptr)) << row.name;
     EXPECT_TRUE(row.in_range(row.get(rtpg::GuidingSettings{}))) << row.name;
@@ -270,18 +270,20 @@ TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
   s.n_min = 9;
   s.n_max = 8;
   EXPECT_THROW(rtpg::validate(s), rtpg::GuiderError);
-  // Pixels per work-item of the train kernel: a vector width of OpenCL C, or 0 (auto).
-  for (int lanes = 0; lanes <= 16; ++lanes) {
-    s = rtpg::GuidingSettings{};
-    s.train_lanes = lanes;
-    const bool valid =
-        lanes == 0 || lanes == 1 || lanes == 2 || lanes == 4 || lanes == 8 || lanes == 16;
-    if (valid) {
-      EXPECT_NO_THROW(rtpg::validate(s)) << lanes;
-    } else {
-      EXPECT_THROW(rtpg::validate(s), rtpg::GuiderError) << lanes;
+  // Pixels per work-item of the train and sample kernels: a vector width of OpenCL C, or 0
+  // (auto).
+  for (int lanes = 0; lanes <= 16; ++lanes)
+    for (int kernel = 0; kernel < 2; ++kernel) {
+      s = rtpg::GuidingSettings{};
+      (kernel == 0 ? s.train_lanes : s.sample_lanes) = lanes;
+      const bool valid =
+          lanes == 0 || lanes == 1 || lanes == 2 || lanes == 4 || lanes == 8 || lanes == 16;
+      if (valid) {
+        EXPECT_NO_THROW(rtpg::validate(s)) << lanes;
+      } else {
+        EXPECT_THROW(rtpg::validate(s), rtpg::GuiderError) << lanes;
+      }
     }
-  }
   // The kernels' block carries the values (integers as floats where the kernels want them).
   s = rtpg::GuidingSettings{};
   s.k_max = 17;
