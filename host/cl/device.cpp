@@ -90,6 +90,7 @@ std::vector<SelectedDevice> enumerate() {
         info.max_work_group_size = dev.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>();
         info.global_mem_size = dev.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
         info.native_float_width = dev.getInfo<CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT>();
+        info.host_unified_memory = dev.getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>() == CL_TRUE;
         out.push_back({std::move(info), dev});
       }
     }

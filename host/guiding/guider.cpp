@@ -40,9 +40,10 @@ GuiderVpls make_guider_vpls(cl::Context& context, int width, int height) {
   return b;
 }
 
-GuiderSamples make_guider_samples(cl::Context& context, int width, int height) {
+GuiderSamples make_guider_samples(cl::Context& context, int width, int height,
+                                  cl_mem_flags host_flags) {
   const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags = CL_MEM_WRITE_ONLY;
+  const cl_mem_flags flags = CL_MEM_WRITE_ONLY | host_flags;
   GuiderSamples b;
   translate_cl_errors([&] { PG_SAMPLE_CHANNELS(RTPG_ALLOCATE) });
   return b;

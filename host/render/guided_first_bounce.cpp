@@ -28,16 +28,37 @@ constexpr std::size_t kSampleBytes = 0 PG_SAMPLE_CHANNELS(RTPG_ADD_BYTES);
 }  // namespace
 
 GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
-                                     const GuidingSettings& settings)
+                                     const GuidingSettings& settings, bool zero_copy)
     : runtime_(runtime),
       guider_(std::make_unique<Guider>(runtime, width, height, settings)),
       pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
   for (GuiderGBuffer& g : gbuffers_) g = make_guider_gbuffer(runtime.context(), width, height);
   vpls_ = make_guider_vpls(runtime.context(), width, height);
-  samples_ = make_guider_samples(runtime.context(), width, height);
+  zero_copy_ = zero_copy && runtime.info().host_unified_memory;
+  samples_ =
+      make_guider_samples(runtime.context(), width, height, zero_copy_ ? CL_MEM_ALLOC_HOST_PTR : 0);
 }
 
-GuidedFirstBounce::~GuidedFirstBounce() = default;
+GuidedFirstBounce::~GuidedFirstBounce() {
+  try {
+    unmap_samples();
+    runtime_.queue().finish();
+  } catch (...) {  // a failing queue at teardown has nothing left to corrupt
+  }
+}
+
+void GuidedFirstBounce::unmap_samples() {
+  if (!mapped_) return;
+  mapped_ = false;
+  translate_cl_errors([&] {
+    cl::CommandQueue& q = runtime_.queue();
+    q.enqueueUnmapMemObject(samples_.direction_pdf, const_cast<glm::vec4*>(view_.direction_pdf));
+    q.enqueueUnmapMemObject(samples_.strategy, const_cast<std::uint32_t*>(view_.strategy));
+    q.enqueueUnmapMemObject(samples_.mixture_a, const_cast<glm::vec4*>(view_.mixture_a));
+    q.enqueueUnmapMemObject(samples_.mixture_b, const_cast<glm::vec2*>(view_.mixture_b));
+  });
+  view_ = SampleView{};
+}
 
 void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& at) {
   auto t = Clock::now();
@@ -59,18 +80,38 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
 
 void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
                                std::vector<FirstBounceSample>& out) {
+  unmap_samples();  // the kernel overwrites them
   guider_->sample(gbuffers_[current_], at.seed, at.frame, at.sample, samples_);
   sample_ms_ += guider_->last_times().sample_ms;
   const std::size_t n = g.pixel_count();
-  host_samples_.direction_pdf.resize(n);
-  host_samples_.strategy.resize(n);
-  host_samples_.mixture_a.resize(n);
-  host_samples_.mixture_b.resize(n);
   const auto t = Clock::now();
-  enqueue_download(runtime_.queue(), samples_, host_samples_);
-  translate_cl_errors([&] { runtime_.queue().finish(); });
+  if (zero_copy_) {
+    translate_cl_errors([&] {
+      cl::CommandQueue& q = runtime_.queue();
+      auto map = [&](const cl::Buffer& b, std::size_t bytes) {
+        return q.enqueueMapBuffer(b, CL_FALSE, CL_MAP_READ, 0, n * bytes);
+      };
+      view_.direction_pdf = static_cast<const glm::vec4*>(map(samples_.direction_pdf, 16));
+      view_.strategy = static_cast<const std::uint32_t*>(map(samples_.strategy, 4));
+      view_.mixture_a = static_cast<const glm::vec4*>(map(samples_.mixture_a, 16));
+      view_.mixture_b = static_cast<const glm::vec2*>(map(samples_.mixture_b, 8));
+      mapped_ = true;
+      q.finish();
+    });
+  } else {
+    host_samples_.direction_pdf.resize(n);
+    host_samples_.strategy.resize(n);
+    host_samples_.mixture_a.resize(n);
+    host_samples_.mixture_b.resize(n);
+    enqueue_download(runtime_.queue(), samples_, host_samples_);
+    translate_cl_errors([&] { runtime_.queue().finish(); });
+    bytes_ += kSampleBytes * n;
+    view_.direction_pdf = host_samples_.direction_pdf.data();
+    view_.strategy = host_samples_.strategy.data();
+    view_.mixture_a = host_samples_.mixture_a.data();
+    view_.mixture_b = host_samples_.mixture_b.data();
+  }
   readback_ms_ += ms_since(t);
-  bytes_ += kSampleBytes * n;
   out.resize(n);
   // The directions for the path tracer and, as a by-product, the share of surface pixels
   // that sample a trained Gaussian and their mean pi (statistics only).
@@ -82,16 +123,16 @@ void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
       tbb::blocked_range<std::size_t>(0, n, 8192), Counts{},
       [&](const tbb::blocked_range<std::size_t>& r, Counts c) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const glm::vec4 d = host_samples_.direction_pdf[i];
+          const glm::vec4 d = view_.direction_pdf[i];
           out[i].direction = glm::vec3(d);
           out[i].pdf = d.w > 0.0f && std::isfinite(d.w) ? d.w : 0.0f;
-          const std::uint32_t s = host_samples_.strategy[i];
+          const std::uint32_t s = view_.strategy[i];
           out[i].strategy = s == PG_STRATEGY_GUIDE  ? kStrategyGuide
                             : s == PG_STRATEGY_BSDF ? kStrategyBsdf
                                                     : kStrategyNone;
           if (!g.has_surface(i)) continue;
           ++c.surfaces;
-          const glm::vec4 mixture = host_samples_.mixture_a[i];
+          const glm::vec4 mixture = view_.mixture_a[i];
           if (!(mixture.w > 0.0f)) continue;
           ++c.guided;
           c.pi_sum += mixture.x;
@@ -112,8 +153,8 @@ void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
 }
 
 shared::pg_pmm_model GuidedFirstBounce::model_at(std::size_t i) const {
-  const glm::vec4 a = host_samples_.mixture_a[i];
-  const glm::vec2 b = host_samples_.mixture_b[i];
+  const glm::vec4 a = view_.mixture_a[i];
+  const glm::vec2 b = view_.mixture_b[i];
   return shared::pg_pmm_model_from_mixture(shared::float4(a.x, a.y, a.z, a.w),
                                            shared::float2(b.x, b.y));
 }
@@ -124,7 +165,7 @@ float GuidedFirstBounce::pdf(const GBuffer&, std::size_t i, const shared::pg_lob
 }
 
 bool GuidedFirstBounce::pixel_guide(const GBuffer& g, std::size_t i, PixelGuide& out) const {
-  if (i >= host_samples_.mixture_a.size()) return false;
+  if (view_.mixture_a == nullptr || i >= pixels_) return false;
   out.model = model_at(i);
   if (!out.model.valid) return false;
   out.frame = gbuffer_frame(g, i);
@@ -157,6 +198,10 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   extra["guided_fraction"] = guided_fraction_;
   extra["trained_fraction"] = trained_fraction_;
   extra["mean_pi"] = mean_pi_;
+  // What the device ran (the settings' 0 = auto resolved) and whether samples were read in place.
+  extra["train_lanes"] = guider_->train_lanes();
+  extra["sample_lanes"] = guider_->sample_lanes();
+  extra["samples_zero_copy"] = zero_copy_ ? 1.0 : 0.0;
   extra["host_device_bytes_per_pixel"] =
       static_cast<double>(bytes_) / static_cast<double>(std::max<std::size_t>(pixels_, 1));
 }

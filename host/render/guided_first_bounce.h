@@ -16,7 +16,10 @@ class ClRuntime;
 
 class GuidedFirstBounce final : public FirstBounceSampler {
  public:
-  GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingSettings& settings);
+  // zero_copy: read the samples in place where the device shares host memory
+  // (DeviceInfo::host_unified_memory); false copies them as for any other device.
+  GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingSettings& settings,
+                    bool zero_copy = true);
   ~GuidedFirstBounce() override;
 
   void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) override;
@@ -47,12 +50,22 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   bool training_ = true;
   GuiderVpls vpls_;
   GuiderSamples samples_;
+  // Where the device shares host memory the samples are read in place (mapped from the time
+  // sample() returns until the next sample() or the end), else copied into host_samples_.
+  void unmap_samples();
+  bool zero_copy_ = false, mapped_ = false;
   struct HostSamples {  // PG_SAMPLE_CHANNELS on the host
     std::vector<glm::vec4> direction_pdf;
     std::vector<std::uint32_t> strategy;
     std::vector<glm::vec4> mixture_a;  // what pdf() evaluates
     std::vector<glm::vec2> mixture_b;
   } host_samples_;
+  struct SampleView {  // this frame's samples, in host_samples_ or mapped
+    const glm::vec4* direction_pdf = nullptr;
+    const std::uint32_t* strategy = nullptr;
+    const glm::vec4* mixture_a = nullptr;
+    const glm::vec2* mixture_b = nullptr;
+  } view_;
   std::size_t pixels_ = 0, surfaces_ = 0;
   std::size_t bytes_ = 0;  // copied between host and device this frame
   double upload_ms_ = 0.0, readback_ms_ = 0.0, sample_ms_ = 0.0;

@@ -28,6 +28,8 @@ struct DeviceInfo {
   std::size_t max_work_group_size = 0;
   std::uint64_t global_mem_size = 0;     // bytes
   std::uint32_t native_float_width = 1;  // CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT: SIMD lanes
+  bool host_unified_memory = false;      // CL_DEVICE_HOST_UNIFIED_MEMORY: the device works in
+                                         // host memory (CPUs, integrated GPUs)
 
   // "P:D", the index form of a device spec.
   std::string spec() const;

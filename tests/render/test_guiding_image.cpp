@@ -246,6 +246,35 @@ TEST(GuidingImage, RejectsAFivePercentPdfError) {
 // guiding is at most half that without (0.21 measured), against a 1024-spp reference rendered
 // here. At the scene's full depth (8 bounces) the equal-frame ratio is 0.97, not significant
 // (docs/results/equal-frame-2026-11-23/): that gain is not there to guard yet.
+// The guided first bounce reads the samples in place where the device shares host memory (as
+// PoCL's CPU device does) and copies them elsewhere: both give the same image to the bit, at 2
+// spp (the mapping is released and renewed between samples) along a moving camera.
+TEST(GuidingImage, SamplesReadInPlaceOrCopiedGiveTheSameImage) {
+  ClRuntime cl;
+  const Scene scene = load_scene(scene_file("cornell-box.json"));
+  RenderSettings settings;
+  settings.width = 37;
+  settings.height = 23;
+  settings.spp = 2;
+  settings.camera_path = scene.camera.paths.begin()->first;
+  std::vector<glm::vec3> images[2];
+  for (int in_place = 0; in_place < 2; ++in_place) {
+    Renderer renderer(scene, settings);
+    renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(
+        cl, settings.width, settings.height, GuidingSettings{}, in_place == 1));
+    for (int f = 0; f < 4; ++f) {
+      const FrameStats stats = renderer.render_frame(f);
+      EXPECT_EQ(stats.extra.at("samples_zero_copy"),
+                in_place == 1 && cl.info().host_unified_memory ? 1.0 : 0.0);
+    }
+    images[in_place] = renderer.image();
+  }
+  ASSERT_EQ(images[0].size(), images[1].size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < images[0].size(); ++i) differ += images[0][i] != images[1][i];
+  EXPECT_EQ(differ, 0u) << "of " << images[0].size() << " pixels";
+}
+
 TEST(GuidingImage, HalvesErrorOnCornellIndirect) {
   const Scene scene = load_scene(scene_file("cornell-indirect.json"));
   ClRuntime cl;
