@@ -66,10 +66,14 @@ PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float
 
 /* Amortised training (docs/guiding.md, "Cost"): a mature pixel's lobe (k at least a quarter
  * of k_max, where the step size is small) trains on every train_interval-th frame only, in a
- * pattern that rotates over the image; the other frames keep its state. */
+ * pattern that rotates over the image; the other frames keep its state. Aligned runs of
+ * PG_TRAIN_RUN pixels of a row decide together, so that the lanes of a work-item of
+ * train_wide.cl (at most 16, a divisor of the run) train together or not at all: a work-item
+ * with one training lane costs as much as one whose lanes all train. */
+#define PG_TRAIN_RUN 16u
 PG_FN int pg_train_this_frame(float k, int x, int y, uint frame, pg_kernel_settings p) {
   if (p.train_interval <= 1 || k < 0.25f * p.k_max) return 1;
-  return ((uint)x + 3u * (uint)y + frame) % (uint)p.train_interval == 0u;
+  return ((uint)x / PG_TRAIN_RUN + 3u * (uint)y + frame) % (uint)p.train_interval == 0u;
 }
 
 /* The window offset of the s-th neighbour of this frame's walk through the window. */
