@@ -607,9 +607,10 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
 // for bit with each other: the same arithmetic on the same VPLs), and train_wide.cl with 2, 4,
 // 8 and 16 pixels per work-item (kernels/wide/). Tolerance 1e-4 relative (of the value, plus of
 // S0 for the moments): the step size uses exp and log (3 ulp each in OpenCL), the E-step exp of
-// a quadratic form, and the device may contract a*b+c into fma. A pixel may differ beyond that
-// only where a decision flips on a few-ulp difference: a responsibility at the re-seeding
-// threshold (gamma = 1e-3) or a weight at max_weight. The bound allows 0.1% of the pixels. In
+// a quadratic form, and the device may contract a*b+c into fma. A pixel could differ beyond that
+// only where a decision flips on a few-ulp difference (a responsibility at the re-seeding
+// threshold, gamma = 1e-3, or a weight at max_weight); none does with these seeds, and any
+// mismatch fails the test. In
 // one case the lower half of the image is Lambert only, so that whole work-items of the wide
 // kernel skip the GGX lobe.
 TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
