@@ -30,10 +30,6 @@ enum {
   IN_FIELDS
 };
 
-static inline pg_float3w get3(__private float (*rows)[PG_LANES], int field) {
-  return pg_load_float3w(rows[field], rows[field + 1], rows[field + 2]);
-}
-
 __kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint width, uint height,
                           uint seed, uint frame, uint sample_index, pg_kernel_settings settings) {
   int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
@@ -57,15 +53,9 @@ __kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint 
       any_model |= state.s1.w > 0.0f;
     }
     any_specular |= !sky[l] && (ms.y > 0.0f || ms.x > 0.0f);
-    in[IN_NORMAL][l] = n.x;
-    in[IN_NORMAL + 1][l] = n.y;
-    in[IN_NORMAL + 2][l] = n.z;
-    in[IN_VIEW][l] = v.x;
-    in[IN_VIEW + 1][l] = v.y;
-    in[IN_VIEW + 2][l] = v.z;
-    in[IN_BASE_COLOR][l] = bcr.x;
-    in[IN_BASE_COLOR + 1][l] = bcr.y;
-    in[IN_BASE_COLOR + 2][l] = bcr.z;
+    pg_put3_rows(in, IN_NORMAL, l, n.xyz);
+    pg_put3_rows(in, IN_VIEW, l, v.xyz);
+    pg_put3_rows(in, IN_BASE_COLOR, l, bcr.xyz);
     in[IN_ROUGHNESS][l] = bcr.w;
     in[IN_METALLIC][l] = ms.x;
     in[IN_SPECULAR][l] = ms.y;
@@ -95,10 +85,10 @@ __kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint 
     s.sxy = pg_vloadw(0, in[IN_STATE + 6]);
     s.k = pg_vloadw(0, in[IN_STATE + 7]);
     pg_pmm_model_w m = pg_pmm_model_from_state_w(s, settings);
-    pg_frame_w frame_x = pg_frame_from_normal_w(get3(in, IN_NORMAL));
-    pg_float3w wo = pg_to_local_w(frame_x, get3(in, IN_VIEW));
+    pg_frame_w frame_x = pg_frame_from_normal_w(pg_get3_rows(in, IN_NORMAL));
+    pg_float3w wo = pg_to_local_w(frame_x, pg_get3_rows(in, IN_VIEW));
     pg_lobes_w lobes =
-        pg_make_lobes_w(get3(in, IN_BASE_COLOR), pg_vloadw(0, in[IN_ROUGHNESS]),
+        pg_make_lobes_w(pg_get3_rows(in, IN_BASE_COLOR), pg_vloadw(0, in[IN_ROUGHNESS]),
                         pg_vloadw(0, in[IN_METALLIC]), pg_vloadw(0, in[IN_SPECULAR]), wo);
     pg_intw guided;
     pg_floatw pdf;

@@ -29,15 +29,6 @@ enum {
   PX_P_SPECULAR,
   PX_FIELDS
 };
-static inline void put3(__private float (*rows)[PG_LANES], int field, int lane, float3 v) {
-  rows[field][lane] = v.x;
-  rows[field + 1][lane] = v.y;
-  rows[field + 2][lane] = v.z;
-}
-
-static inline pg_float3w get3(__private float (*rows)[PG_LANES], int field) {
-  return pg_load_float3w(rows[field], rows[field + 1], rows[field + 2]);
-}
 
 /* The state of every lane from and to eight rows (pg_pmm_state's s0 then s1). */
 static inline pg_pmm_state_w get_state(__private float (*rows)[PG_LANES]) {
@@ -107,13 +98,13 @@ __kernel void train_wide(
     pg_frame frame_l = pg_frame_from_normal(shading_normal[i].xyz);
     float3 wo = pg_to_local(frame_l, view_dir[i].xyz);
     pg_lobes lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), wo);
-    put3(pixel, PX_X, l, position_depth[i].xyz);
-    put3(pixel, PX_T, l, frame_l.t);
-    put3(pixel, PX_B, l, frame_l.b);
-    put3(pixel, PX_N, l, frame_l.n);
-    put3(pixel, PX_WO, l, wo);
-    put3(pixel, PX_DIFFUSE, l, lobes.diffuse);
-    put3(pixel, PX_F0, l, lobes.f0);
+    pg_put3_rows(pixel, PX_X, l, position_depth[i].xyz);
+    pg_put3_rows(pixel, PX_T, l, frame_l.t);
+    pg_put3_rows(pixel, PX_B, l, frame_l.b);
+    pg_put3_rows(pixel, PX_N, l, frame_l.n);
+    pg_put3_rows(pixel, PX_WO, l, wo);
+    pg_put3_rows(pixel, PX_DIFFUSE, l, lobes.diffuse);
+    pg_put3_rows(pixel, PX_F0, l, lobes.f0);
     pixel[PX_ALPHA][l] = lobes.alpha;
     pixel[PX_P_SPECULAR][l] = lobes.p_specular;
     any_specular |= lobes.p_specular > 0.0f;
@@ -126,13 +117,13 @@ __kernel void train_wide(
 
   if (any_active) {
     pg_train_pixels_w px;
-    px.x = get3(pixel, PX_X);
-    px.frame.t = get3(pixel, PX_T);
-    px.frame.b = get3(pixel, PX_B);
-    px.frame.n = get3(pixel, PX_N);
-    px.wo = get3(pixel, PX_WO);
-    px.lobes.diffuse = get3(pixel, PX_DIFFUSE);
-    px.lobes.f0 = get3(pixel, PX_F0);
+    px.x = pg_get3_rows(pixel, PX_X);
+    px.frame.t = pg_get3_rows(pixel, PX_T);
+    px.frame.b = pg_get3_rows(pixel, PX_B);
+    px.frame.n = pg_get3_rows(pixel, PX_N);
+    px.wo = pg_get3_rows(pixel, PX_WO);
+    px.lobes.diffuse = pg_get3_rows(pixel, PX_DIFFUSE);
+    px.lobes.f0 = pg_get3_rows(pixel, PX_F0);
     px.lobes.alpha = pg_vloadw(0, pixel[PX_ALPHA]);
     px.lobes.p_specular = pg_vloadw(0, pixel[PX_P_SPECULAR]);
 

@@ -44,6 +44,19 @@ static inline pg_float3w pg_load_float3w(__private const float* xs, __private co
   return pg_make_float3w(pg_vloadw(0, xs), pg_vloadw(0, ys), pg_vloadw(0, zs));
 }
 
+/* Per-lane values kept in a private array of rows (one row of PG_LANES floats per field), as the
+ * wide kernels gather them pixel by pixel: a 3-vector in rows field..field+2 at one lane, and
+ * the rows read back as one 3-vector per lane. */
+static inline void pg_put3_rows(__private float (*rows)[PG_LANES], int field, int lane, float3 v) {
+  rows[field][lane] = v.x;
+  rows[field + 1][lane] = v.y;
+  rows[field + 2][lane] = v.z;
+}
+
+static inline pg_float3w pg_get3_rows(__private float (*rows)[PG_LANES], int field) {
+  return pg_load_float3w(rows[field], rows[field + 1], rows[field + 2]);
+}
+
 static inline pg_floatw pg_dot3w(pg_float3w a, pg_float3w b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
