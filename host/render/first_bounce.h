@@ -52,6 +52,10 @@ class FirstBounceSampler {
   virtual void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls,
                          const SampleCoordinates& at) {}
   virtual bool wants_vpls() const { return false; }
+  // True when the sampler reads the G-buffer in place from begin_frame() until the next
+  // frame's end_frame() (its reprojection reads last frame's): the renderer then writes each
+  // frame into the other of two G-buffers, leaving last frame's untouched.
+  virtual bool reads_gbuffers_in_place() const { return false; }
   // Figures of the last frame: times (ms) by kernel name, and other figures by name.
   virtual void report(std::map<std::string, double>& time_ms,
                       std::map<std::string, double>& extra) {}

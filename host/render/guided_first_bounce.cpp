@@ -32,9 +32,12 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
     : runtime_(runtime),
       guider_(std::make_unique<Guider>(runtime, width, height, settings)),
       pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
-  for (GuiderGBuffer& g : gbuffers_) g = make_guider_gbuffer(runtime.context(), width, height);
-  vpls_ = make_guider_vpls(runtime.context(), width, height);
   zero_copy_ = zero_copy && runtime.info().host_unified_memory;
+  if (!zero_copy_) {
+    for (GuiderGBuffer& g : owned_gbuffers_)
+      g = make_guider_gbuffer(runtime.context(), width, height);
+    owned_vpls_ = make_guider_vpls(runtime.context(), width, height);
+  }
   samples_ =
       make_guider_samples(runtime.context(), width, height, zero_copy_ ? CL_MEM_ALLOC_HOST_PTR : 0);
 }
@@ -62,13 +65,27 @@ void GuidedFirstBounce::unmap_samples() {
 
 void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& at) {
   auto t = Clock::now();
-  current_ = 1 - current_;
-  enqueue_upload(runtime_.queue(), g, gbuffers_[current_]);
-  translate_cl_errors([&] { runtime_.queue().finish(); });
+  previous_gbuffer_ = current_gbuffer_;
+  bytes_ = 0;
+  if (zero_copy_) {
+    // The host wrote this G-buffer after last frame's buffers over it were released; had it
+    // written last frame's, there would be no previous G-buffer left to reproject from.
+    if (have_previous_ && g.position_depth.data() == current_host_)
+      throw GuiderError(
+          "guiding: the G-buffer is read in place, so each frame needs the other of two "
+          "G-buffers (FirstBounceSampler::reads_gbuffers_in_place)");
+    current_gbuffer_ = wrap_host_gbuffer(runtime_.context(), g);
+    current_host_ = g.position_depth.data();
+  } else {
+    owned_current_ = 1 - owned_current_;
+    current_gbuffer_ = owned_gbuffers_[owned_current_];
+    enqueue_upload(runtime_.queue(), g, current_gbuffer_);
+    translate_cl_errors([&] { runtime_.queue().finish(); });
+    bytes_ += kGBufferBytes * g.pixel_count();
+  }
   upload_ms_ = ms_since(t);
-  bytes_ = kGBufferBytes * g.pixel_count();
   if (have_previous_) {
-    guider_->reproject(gbuffers_[current_], gbuffers_[1 - current_]);
+    guider_->reproject(current_gbuffer_, previous_gbuffer_);
   } else {
     guider_->reset();
   }
@@ -81,7 +98,7 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
 void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
                                std::vector<FirstBounceSample>& out) {
   unmap_samples();  // the kernel overwrites them
-  guider_->sample(gbuffers_[current_], at.seed, at.frame, at.sample, samples_);
+  guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_);
   sample_ms_ += guider_->last_times().sample_ms;
   const std::size_t n = g.pixel_count();
   const auto t = Clock::now();
@@ -174,13 +191,21 @@ bool GuidedFirstBounce::pixel_guide(const GBuffer& g, std::size_t i, PixelGuide&
 
 void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
                                   const SampleCoordinates& at) {
+  // Last frame's G-buffer is done with (reproject read it): in place, the host writes that
+  // memory next frame, so its buffers are released first.
+  previous_gbuffer_ = GuiderGBuffer{};
   if (!training_) return;
   const auto t = Clock::now();
-  enqueue_upload(runtime_.queue(), vpls, vpls_);
-  translate_cl_errors([&] { runtime_.queue().finish(); });
+  GuiderVpls device_vpls = owned_vpls_;
+  if (zero_copy_) {
+    device_vpls = wrap_host_vpls(runtime_.context(), vpls);  // released when train is done
+  } else {
+    enqueue_upload(runtime_.queue(), vpls, device_vpls);
+    translate_cl_errors([&] { runtime_.queue().finish(); });
+    bytes_ += kVplBytes * g.pixel_count();
+  }
   upload_ms_ += ms_since(t);
-  bytes_ += kVplBytes * g.pixel_count();
-  guider_->train(gbuffers_[current_], vpls_, at.seed, at.frame);
+  guider_->train(current_gbuffer_, device_vpls, at.seed, at.frame);
   bytes_ += g.pixel_count();  // the trained flags count_trained reads
   trained_fraction_ =
       surfaces_ ? static_cast<double>(guider_->count_trained()) / static_cast<double>(surfaces_)
@@ -201,7 +226,7 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   // What the device ran (the settings' 0 = auto resolved) and whether samples were read in place.
   extra["train_lanes"] = guider_->train_lanes();
   extra["sample_lanes"] = guider_->sample_lanes();
-  extra["samples_zero_copy"] = zero_copy_ ? 1.0 : 0.0;
+  extra["zero_copy"] = zero_copy_ ? 1.0 : 0.0;
   extra["host_device_bytes_per_pixel"] =
       static_cast<double>(bytes_) / static_cast<double>(std::max<std::size_t>(pixels_, 1));
 }

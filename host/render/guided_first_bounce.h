@@ -1,6 +1,7 @@
-// The guided first bounce: the renderer's side of the guiding library. Uploads the host
+// The guided first bounce: the renderer's side of the guiding library. Hands the host
 // G-buffer and VPLs to the device, runs the guider's reproject / sample / train kernels and
-// brings the sampled directions back for the host path tracer.
+// brings the sampled directions back for the host path tracer. Where the device shares host
+// memory all three are read in place (no copies; docs/design.md, "One frame").
 #pragma once
 
 #include <memory>
@@ -16,8 +17,10 @@ class ClRuntime;
 
 class GuidedFirstBounce final : public FirstBounceSampler {
  public:
-  // zero_copy: read the samples in place where the device shares host memory
-  // (DeviceInfo::host_unified_memory); false copies them as for any other device.
+  // zero_copy: where the device shares host memory (DeviceInfo::host_unified_memory), the
+  // device reads the host's G-buffer and VPLs in place and the host reads the samples in
+  // place; the renderer must then alternate two G-buffers (reads_gbuffers_in_place()).
+  // false copies them as for any other device.
   GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingSettings& settings,
                     bool zero_copy = true);
   ~GuidedFirstBounce() override;
@@ -31,6 +34,7 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls,
                  const SampleCoordinates& at) override;
   bool wants_vpls() const override { return true; }
+  bool reads_gbuffers_in_place() const override { return zero_copy_; }
   void report(std::map<std::string, double>& time_ms,
               std::map<std::string, double>& extra) override;
 
@@ -44,11 +48,15 @@ class GuidedFirstBounce final : public FirstBounceSampler {
 
   ClRuntime& runtime_;
   std::unique_ptr<Guider> guider_;
-  GuiderGBuffer gbuffers_[2];
-  int current_ = 0;
+  // This frame's and last frame's G-buffer on the device: in place, the host's own memory
+  // (wrap_host_gbuffer; current_host_ is that memory), else copies in owned_gbuffers_.
+  GuiderGBuffer current_gbuffer_, previous_gbuffer_;
+  const void* current_host_ = nullptr;
+  GuiderGBuffer owned_gbuffers_[2];
+  int owned_current_ = 0;
   bool have_previous_ = false;
   bool training_ = true;
-  GuiderVpls vpls_;
+  GuiderVpls owned_vpls_;
   GuiderSamples samples_;
   // Where the device shares host memory the samples are read in place (mapped from the time
   // sample() returns until the next sample() or the end), else copied into host_samples_.

@@ -38,7 +38,7 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
     throw RenderSettingError("camera_path",
                              "scene has no camera path named '" + settings.camera_path + "'");
   try {
-    gbuffer_.resize(settings.width, settings.height);
+    gbuffers_[0].resize(settings.width, settings.height);
     image_.assign(pixels, glm::vec3(0.0f));
   } catch (const std::bad_alloc&) {
     throw RenderSettingError("resolution",
@@ -53,6 +53,15 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
 Renderer::~Renderer() = default;
 
 void Renderer::set_first_bounce_sampler(std::unique_ptr<FirstBounceSampler> sampler) {
+  if (sampler->reads_gbuffers_in_place() && gbuffers_[1].pixel_count() == 0) {
+    try {
+      gbuffers_[1].resize(settings_.width, settings_.height);
+    } catch (const std::bad_alloc&) {
+      throw RenderSettingError("resolution", "not enough memory for a second G-buffer of " +
+                                                 std::to_string(gbuffers_[0].pixel_count()) +
+                                                 " pixels");
+    }
+  }
   sampler_ = std::move(sampler);
 }
 
@@ -68,8 +77,10 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
   const float aspect = static_cast<float>(w) / static_cast<float>(h);
   const CameraFrame camera = make_camera_frame(camera_at(frame), aspect);
   const CameraFrame previous = make_camera_frame(camera_at(frame > 0 ? frame - 1 : 0), aspect);
-  const std::size_t n = gbuffer_.pixel_count();
-  gbuffer_.camera = camera;
+  if (sampler_->reads_gbuffers_in_place()) current_gbuffer_ = 1 - current_gbuffer_;
+  GBuffer& g = gbuffers_[current_gbuffer_];
+  const std::size_t n = g.pixel_count();
+  g.camera = camera;
   camera_rays_.resize(n);
   camera_hits_.resize(n);
 
@@ -97,7 +108,6 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
   stats.primary_rays += n;
 
   start = Clock::now();
-  GBuffer& g = gbuffer_;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const Ray& ray = camera_rays_[i];
@@ -105,8 +115,15 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
       const glm::vec3 dir = glm::normalize(ray.direction);
       g.motion[i] = glm::vec2(0.0f);
       if (!hit.valid()) {
+        // Every channel written, as GBuffer::resize leaves a sky pixel: nothing of an older
+        // frame stays behind (the frames may alternate between two G-buffers).
         g.flags[i] = PG_GBUF_SKY;
         g.position_depth[i] = glm::vec4(0.0f);
+        g.shading_normal[i] = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
+        g.geometric_normal[i] = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
+        g.base_color_roughness[i] = glm::vec4(0.0f);
+        g.metallic_specular[i] = glm::vec4(0.0f);
+        g.material[i] = 0;
         g.emission[i] = glm::vec4(lights_->escaped_radiance(dir), 0.0f);
         g.view_dir[i] = glm::vec4(-dir, 0.0f);
         continue;
@@ -148,22 +165,23 @@ FrameStats Renderer::render_frame(int index) {
   stats.index = index;
   const auto start = Clock::now();
   build_gbuffer(index, stats);
-  const std::size_t n = gbuffer_.pixel_count();
+  const GBuffer& gbuffer = gbuffers_[current_gbuffer_];
+  const std::size_t n = gbuffer.pixel_count();
   image_.assign(n, glm::vec3(0.0f));
   PassTimes times;
   RayCounts rays;
   const SampleCoordinates frame_at{settings_.seed, static_cast<std::uint32_t>(index), 0u};
   auto t = Clock::now();
-  sampler_->begin_frame(gbuffer_, frame_at);
+  sampler_->begin_frame(gbuffer, frame_at);
   stats.time_ms["guiding_begin"] = ms_since(t);
   for (int s = 0; s < settings_.spp; ++s) {
     SampleCoordinates at{settings_.seed, static_cast<std::uint32_t>(index),
                          static_cast<std::uint32_t>(s)};
     t = Clock::now();
-    sampler_->sample(gbuffer_, at, first_);
+    sampler_->sample(gbuffer, at, first_);
     stats.time_ms["first_bounce"] += ms_since(t);
     const bool keep_vpls = s == 0 && sampler_->wants_vpls();
-    path_tracer_->trace(gbuffer_, first_, *sampler_, at, pass_, keep_vpls ? &vpls_ : nullptr,
+    path_tracer_->trace(gbuffer, first_, *sampler_, at, pass_, keep_vpls ? &vpls_ : nullptr,
                         stats.nonfinite_samples, rays, times);
     t = Clock::now();
     const float weight = 1.0f / static_cast<float>(settings_.spp);
@@ -176,7 +194,7 @@ FrameStats Renderer::render_frame(int index) {
   // frame is drawn from one model, the one next-event MIS at the primary hit weighs against.
   if (sampler_->wants_vpls()) {
     t = Clock::now();
-    sampler_->end_frame(gbuffer_, vpls_, frame_at);
+    sampler_->end_frame(gbuffer, vpls_, frame_at);
     stats.time_ms["guiding_end"] = ms_since(t);
   }
   stats.time_ms["trace"] = times.trace_ms;

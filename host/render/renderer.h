@@ -70,7 +70,7 @@ class Renderer {
   FrameStats render_frame(int index);
 
   const std::vector<glm::vec3>& image() const { return image_; }
-  const GBuffer& gbuffer() const { return gbuffer_; }
+  const GBuffer& gbuffer() const { return gbuffers_[current_gbuffer_]; }  // the last frame's
   const VplBuffer& vpls() const { return vpls_; }
   const RenderSettings& settings() const { return settings_; }
   const EmbreeScene& tracer() const { return *tracer_; }
@@ -86,7 +86,11 @@ class Renderer {
   std::unique_ptr<Lights> lights_;
   std::unique_ptr<PathTracer> path_tracer_;
   std::unique_ptr<FirstBounceSampler> sampler_;
-  GBuffer gbuffer_;
+  // The frame's G-buffer is gbuffers_[current_gbuffer_]; the second is allocated only for a
+  // sampler that reads G-buffers in place (FirstBounceSampler::reads_gbuffers_in_place), and
+  // then the frames alternate between the two.
+  GBuffer gbuffers_[2];
+  int current_gbuffer_ = 0;
   VplBuffer vpls_;
   std::vector<glm::vec3> image_, pass_;
   std::vector<Ray> camera_rays_;

@@ -71,6 +71,19 @@ void enqueue_write(cl::CommandQueue& queue, const cl::Buffer& buffer, const Chan
   });
 }
 template <std::size_t Bytes, class Channel>
+cl::Buffer wrap_channel(cl::Context& context, const Channel& host, const char* name) {
+  static_assert(sizeof(typename Channel::value_type) == Bytes,
+                "a host channel's element size differs from include/rtpg/guiding_layout.h");
+  if (host.empty()) throw GuiderError(std::string("in-place buffer ") + name + " is empty");
+  cl::Buffer b;
+  // The kernels only read it (CL_MEM_READ_ONLY), so the const_cast writes nothing.
+  translate_cl_errors([&] {
+    b = cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, host.size() * Bytes,
+                   const_cast<typename Channel::value_type*>(host.data()));
+  });
+  return b;
+}
+template <std::size_t Bytes, class Channel>
 void enqueue_read(cl::CommandQueue& queue, const cl::Buffer& buffer, Channel& host) {
   static_assert(sizeof(typename Channel::value_type) == Bytes,
                 "a host channel's element size differs from include/rtpg/guiding_layout.h");
@@ -102,6 +115,32 @@ void enqueue_download(cl::CommandQueue& queue, const GuiderSamples& dev, HostSam
 #define RTPG_DOWNLOAD(name, type, bytes) detail::enqueue_read<bytes>(queue, dev.name, host.name);
   PG_SAMPLE_CHANNELS(RTPG_DOWNLOAD)
 #undef RTPG_DOWNLOAD
+}
+
+// Device buffers that read a host struct's channels in place (CL_MEM_USE_HOST_PTR) instead of
+// a copy: for devices that share host memory (DeviceInfo::host_unified_memory), where nothing
+// is copied; elsewhere the OpenCL implementation may copy at creation, which is correct but
+// saves nothing. The device may cache the host data when the buffers are created (OpenCL 1.2,
+// clCreateBuffer), so wrap the channels after the host has written them and release the
+// buffers before it writes them again (host/render/guided_first_bounce.cpp does, with two
+// G-buffers alternating so that last frame's stays for reproject()).
+template <class HostGBuffer>
+GuiderGBuffer wrap_host_gbuffer(cl::Context& context, const HostGBuffer& host) {
+  GuiderGBuffer dev;
+#define RTPG_WRAP(name, type, bytes) \
+  dev.name = detail::wrap_channel<bytes>(context, host.name, #name);
+  PG_GBUFFER_CHANNELS(RTPG_WRAP)
+#undef RTPG_WRAP
+  return dev;
+}
+template <class HostVpls>
+GuiderVpls wrap_host_vpls(cl::Context& context, const HostVpls& host) {
+  GuiderVpls dev;
+#define RTPG_WRAP(name, type, bytes) \
+  dev.name = detail::wrap_channel<bytes>(context, host.name, #name);
+  PG_VPL_CHANNELS(RTPG_WRAP)
+#undef RTPG_WRAP
+  return dev;
 }
 
 struct GuiderTimes {
