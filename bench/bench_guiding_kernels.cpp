@@ -26,6 +26,12 @@
 //                        not disturb
 //   lanes                pixels per work-item of the train kernel (1: train.cl, else
 //                        train_wide.cl)
+//   flops_per_pixel      floating-point operations along each pixel's path (count_flops, from
+//                        the hand counts beside the kernels), mean over the image
+//   peak_gflops          FmaPeak/float16's rate, launched in the same iterations
+//   roofline_ms          max(bytes / copy_bw, flops / peak): the time the kernel's memory
+//                        traffic or arithmetic needs at the machine's measured limits
+//   roofline_fraction    roofline_ms / kernel time (1: at the roof; 0.5: within 2x)
 // Bytes per pixel, counted from the inputs along each pixel's path through the kernel (each
 // buffer element counted once, at its full width; a pixel's neighbours' VPLs are the same
 // memory as its own, so the VPL buffers count 48 bytes per pixel):
@@ -84,6 +90,7 @@ struct Inputs {
   GuiderVpls d_vpls;
   GuiderSamples d_samples;
   double reproject_bytes = 0, sample_bytes = 0, train_bytes = 0;
+  double reproject_flops = 0, sample_flops = 0, train_flops = 0;
 };
 
 float3 tilt(std::mt19937& g, float3 n, float max_deg) {
@@ -280,6 +287,50 @@ void count_bytes(Inputs& in, const pg_kernel_settings& p) {
     }
 }
 
+// Floating-point operations along each pixel's path, from the hand counts written beside the
+// kernels (kernels/reproject.cl, sample_wide.cl, train_wide.cl; the rules and the breakdown by
+// function: docs/guiding.md, "Roofline"): what the pixel itself needs, not what masked lanes
+// of its work-item compute besides.
+void count_flops(Inputs& in, const pg_kernel_settings& p) {
+  const int w = in.w, h = in.h;
+  const int side = 2 * p.apron + 1;
+  in.reproject_flops = in.sample_flops = in.train_flops = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const bool applies =
+          sh::pg_guiding_applies(in.cur.flags[i], in.cur.base_color_roughness[i].w, p);
+      if (!applies) continue;
+      const float3 n = sh::pg_float4_xyz(in.cur.shading_normal[i]);
+      const sh::pg_frame frame = sh::pg_frame_from_normal(n);
+      const sh::pg_lobes lobes = sh::pg_make_lobes(
+          sh::pg_material_from_gbuffer(in.cur.base_color_roughness[i], in.cur.metallic_specular[i]),
+          sh::pg_to_local(frame, sh::pg_float4_xyz(in.cur.view_dir[i])));
+      const bool ggx = lobes.p_specular > 0.0f;
+      const float k = in.state[8 * i + 7];
+      // reproject: the tests and the frames (78), the reframe where the normals differ (399);
+      // a static camera here, so the previous pixel is this one's position in prev.
+      const float2 mv = in.cur.motion[i];
+      const int px = static_cast<int>(std::floor(x + 0.5f + mv.x)),
+                py = static_cast<int>(std::floor(y + 0.5f + mv.y));
+      if (px >= 0 && py >= 0 && px < w && py < h) {
+        const std::size_t j = static_cast<std::size_t>(py) * w + px;
+        const float3 m = sh::pg_float4_xyz(in.prev.shading_normal[j]);
+        in.reproject_flops += 78;
+        if (sh::pg_pmm_needs_reframe(sh::pg_frame_from_normal(m), frame)) in.reproject_flops += 399;
+      }
+      // sample: BSDF sampling and its density (232), the GGX lobe (181), a trained model's
+      // density (81) and the Gaussian's sampler (59, counted for every trained pixel).
+      in.sample_flops += 232 + (ggx ? 181 : 0) + (k > 0.0f ? 81 + 59 : 0);
+      // train: 162 + b N + 67 N P + 176 P (b = 137, 243 with GGX; P passes; N neighbours).
+      const int n_samples =
+          std::min(std::min(sh::pg_pmm_neighbour_count(k, p), side * side), PG_MAX_TRAIN_SAMPLES);
+      const int passes = k >= 0.25f * p.k_max ? 1 : p.em_passes;
+      in.train_flops +=
+          162.0 + (ggx ? 243.0 : 137.0) * n_samples + 67.0 * n_samples * passes + 176.0 * passes;
+    }
+}
+
 Inputs& inputs_for(int w, int h) {
   static std::map<std::pair<int, int>, std::unique_ptr<Inputs>> cache;
   auto& slot = cache[{w, h}];
@@ -295,6 +346,7 @@ Inputs& inputs_for(int w, int h) {
   make_vpls(in, g);
   make_states(in, g, static_cast<float>(settings.k_max));
   count_bytes(in, to_kernel_settings(settings));
+  count_flops(in, to_kernel_settings(settings));
   in.d_cur = testing::upload(runtime(), in.cur);
   in.d_prev = testing::upload(runtime(), in.prev);
   in.d_vpls = testing::upload(runtime(), in.vpls, w, h);
@@ -361,6 +413,11 @@ struct FmaPeak {
   double flops() const { return 2.0 * kItems * kRounds * kChains * width; }
   double run() { return run_1d(kernel, kItems); }
 };
+
+FmaPeak& fma_peak16() {  // the vector rate, the compute roof of the guiding kernels
+  static FmaPeak f(16);
+  return f;
+}
 
 void BM_FmaPeak(benchmark::State& state, int width) {
   FmaPeak f(width);
@@ -461,13 +518,15 @@ void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int 
     return;
   }
   Copy& c = copy();
-  double kernel_ms = 0.0, copy_ms = 0.0, ref_ms = 0.0;
+  FmaPeak& f = fma_peak16();
+  double kernel_ms = 0.0, copy_ms = 0.0, fma_ms = 0.0, ref_ms = 0.0;
   std::uint32_t frame = 1;
   for (auto _ : state) {
     const double ms = launch(*g, in, kernel, frame);
     state.SetIterationTime(ms * 1e-3);
     kernel_ms += ms;
     copy_ms += c.run();
+    fma_ms += f.run();
     ref_ms += g == ref ? ms : launch(*ref, in, kernel, frame);
     ++frame;
   }
@@ -483,6 +542,17 @@ void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int 
   state.counters["copy_bw"] =
       benchmark::Counter(copy_bw, benchmark::Counter::kDefaults, benchmark::Counter::kIs1024);
   state.counters["copy_fraction"] = kernel_bw / copy_bw;
+  // The roofline: the kernel's time against max(bytes / copy bandwidth, flops / vector
+  // multiply-add rate), both yardsticks launched in the same iterations as the kernel.
+  const double flops = kernel == Kernel::Reproject ? in.reproject_flops
+                       : kernel == Kernel::Sample  ? in.sample_flops
+                                                   : in.train_flops;
+  const double peak = f.flops() * it / (fma_ms * 1e-3);  // flop/s
+  const double bound_ms = 1e3 * std::max(bytes / copy_bw, flops / peak);
+  state.counters["flops_per_pixel"] = flops / static_cast<double>(in.n);
+  state.counters["peak_gflops"] = peak * 1e-9;
+  state.counters["roofline_ms"] = bound_ms;
+  state.counters["roofline_fraction"] = bound_ms / (kernel_ms / it);
   state.counters["vs_16x16_global"] = kernel_ms / ref_ms;
   if (kernel == Kernel::Train) {
     state.counters["local_tile"] = g->train_uses_local_memory() ? 1.0 : 0.0;
@@ -519,9 +589,8 @@ void tbb_train(const Inputs& in, const pg_kernel_settings& params, std::uint32_t
           const int apron = params.apron, side = 2 * apron + 1;
           const int n = std::min(std::min(sh::pg_pmm_neighbour_count(s1.w, params), side * side),
                                  PG_MAX_TRAIN_SAMPLES);
-          sh::pg_rng rng =
-              sh::pg_rng_make(seed, static_cast<sh::uint>(i), frame, 0u, PG_RNG_STREAM_TRAIN);
-          const sh::uint start = sh::pg_rng_next_uint(&rng) % static_cast<sh::uint>(side * side);
+          const sh::uint start =
+              sh::pg_train_walk_start(seed, x, y, static_cast<sh::uint>(w), frame, params);
           float4 samples[PG_MAX_TRAIN_SAMPLES];
           int kept = 0;
           for (int s = 0; s < n; ++s) {

@@ -54,8 +54,7 @@ __kernel void train(
     px.lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), px.wo);
     int side = 2 * apron + 1;
     int n = min(min(pg_pmm_neighbour_count(s1.w, settings), side * side), PG_MAX_TRAIN_SAMPLES);
-    pg_rng rng = pg_rng_make(seed, (uint)i, frame, 0u, PG_RNG_STREAM_TRAIN);
-    uint start = pg_rng_next_uint(&rng) % (uint)(side * side);
+    uint start = pg_train_walk_start(seed, x, y, width, frame, settings);
     float4 samples[PG_MAX_TRAIN_SAMPLES];
     int kept = 0;
     for (int s = 0; s < n; ++s) {

@@ -66,7 +66,7 @@ __kernel void train_wide(
    * start of its walk through the window, and what it knows about itself. */
   float pixel[PX_FIELDS][PG_LANES], state[8][PG_LANES];
   int active[PG_LANES], count[PG_LANES], passes[PG_LANES], changed[PG_LANES];
-  int start[PG_LANES], lane_index[PG_LANES];
+  int lane_index[PG_LANES];
   int any_active = 0, any_specular = 0, most_samples = 0;
   for (int l = 0; l < PG_LANES; ++l) {
     for (int f = 0; f < PX_FIELDS; ++f) pixel[f][l] = 0.0f;
@@ -75,7 +75,6 @@ __kernel void train_wide(
     changed[l] = 0;
     count[l] = 0;
     passes[l] = 0;
-    start[l] = 0;
     lane_index[l] = l;
     int x = x0 + l;
     if (x >= (int)width) continue;
@@ -111,8 +110,6 @@ __kernel void train_wide(
     count[l] = min(min(pg_pmm_neighbour_count(s1.w, settings), side * side), PG_MAX_TRAIN_SAMPLES);
     most_samples = max(most_samples, count[l]);
     passes[l] = s1.w >= 0.25f * settings.k_max ? 1 : settings.em_passes;
-    pg_rng rng = pg_rng_make(seed, (uint)i, frame, 0u, PG_RNG_STREAM_TRAIN);
-    start[l] = (int)(pg_rng_next_uint(&rng) % (uint)(side * side));
   }
 
   if (any_active) {
@@ -128,54 +125,67 @@ __kernel void train_wide(
     px.lobes.p_specular = pg_vloadw(0, pixel[PX_P_SPECULAR]);
 
     /* The s-th neighbour of every lane's walk (pg_train_window_index, stepped without
-     * integer division: w += stride modulo the window size; the row is w / side, exact in
-     * float for windows of at most 17 x 17 cells), turned into a training sample. */
+     * integer division per lane). The lanes lie in one run of PG_TRAIN_RUN pixels, whose walk
+     * starts in one cell (pg_train_walk_start), so their s-th neighbours are PG_LANES
+     * consecutive pixels of one row: loaded as vectors and transposed where the whole segment
+     * is inside the image, lane by lane at the left and right edges. Lanes not asked read no
+     * VPL (info 0), as train.cl skips them. */
     pg_train_samples_w samples[PG_MAX_TRAIN_SAMPLES];
     pg_intw lane = pg_vloadw(0, lane_index), counts = pg_vloadw(0, count);
-    pg_intw walk = pg_vloadw(0, start);
-    float inverse_side = 1.0f / (float)side;
+    int walk = (int)pg_train_walk_start(seed, x0, y, width, frame, settings);
     for (int s = 0; s < most_samples; ++s) {
       if (s > 0) {
         walk += settings.stride;
-        walk = select(walk, walk - side * side, walk >= side * side);
+        if (walk >= side * side) walk -= side * side;
       }
-      pg_intw dy = pg_convert_intw((pg_convert_floatw(walk) + 0.5f) * inverse_side);
-      pg_intw sx = x0 + lane + (walk - dy * side) - apron, sy = y + dy - apron;
-      pg_intw asked_w =
-          (s < counts) & (sx >= 0) & (sy >= 0) & (sx < (int)width) & (sy < (int)height);
-      int asked[PG_LANES], index[PG_LANES];
-      pg_vstorew(asked_w, 0, asked);
-      pg_vstorew(sy * (int)width + sx, 0, index);
-      float vpl[12][PG_LANES];
-      for (int l = 0; l < PG_LANES; ++l) {
-        float4 position_pdf = (float4)(0.0f), normal = (float4)(0.0f);
-        float4 radiance_info = (float4)(0.0f); /* info 0: not a VPL */
-        if (asked[l]) {
-          int j = index[l];
-          position_pdf = vpl_position[j];
-          normal = vpl_normal[j];
-          radiance_info = vpl_radiance_info[j];
+      int dy = walk / side, sy = y + dy - apron, sx0 = x0 + (walk - dy * side) - apron;
+      int row_inside = sy >= 0 && sy < (int)height;
+      pg_intw sx = sx0 + lane;
+      pg_intw asked_w = (s < counts) & (sx >= 0) & (sx < (int)width) & (pg_intw)(-row_inside);
+      pg_floatw row[12];
+      if (!row_inside) {
+        for (int f = 0; f < 12; ++f) row[f] = (pg_floatw)(0.0f);
+      } else if (sx0 >= 0 && sx0 + PG_LANES <= (int)width) {
+        int j = sy * (int)width + sx0;
+        pg_load_float4_rows(vpl_position + j, &row[0], &row[1], &row[2], &row[3]);
+        pg_load_float4_rows(vpl_normal + j, &row[4], &row[5], &row[6], &row[7]);
+        pg_load_float4_rows(vpl_radiance_info + j, &row[8], &row[9], &row[10], &row[11]);
+        for (int f = 0; f < 12; ++f) row[f] = select((pg_floatw)(0.0f), row[f], asked_w);
+      } else {
+        int asked[PG_LANES];
+        pg_vstorew(asked_w, 0, asked);
+        float vpl[12][PG_LANES];
+        for (int l = 0; l < PG_LANES; ++l) {
+          float4 position_pdf = (float4)(0.0f), normal = (float4)(0.0f);
+          float4 radiance_info = (float4)(0.0f); /* info 0: not a VPL */
+          if (asked[l]) {
+            int j = sy * (int)width + sx0 + l;
+            position_pdf = vpl_position[j];
+            normal = vpl_normal[j];
+            radiance_info = vpl_radiance_info[j];
+          }
+          vpl[0][l] = position_pdf.x;
+          vpl[1][l] = position_pdf.y;
+          vpl[2][l] = position_pdf.z;
+          vpl[3][l] = position_pdf.w;
+          vpl[4][l] = normal.x;
+          vpl[5][l] = normal.y;
+          vpl[6][l] = normal.z;
+          vpl[7][l] = normal.w;
+          vpl[8][l] = radiance_info.x;
+          vpl[9][l] = radiance_info.y;
+          vpl[10][l] = radiance_info.z;
+          vpl[11][l] = radiance_info.w;
         }
-        vpl[0][l] = position_pdf.x;
-        vpl[1][l] = position_pdf.y;
-        vpl[2][l] = position_pdf.z;
-        vpl[3][l] = position_pdf.w;
-        vpl[4][l] = normal.x;
-        vpl[5][l] = normal.y;
-        vpl[6][l] = normal.z;
-        vpl[7][l] = normal.w;
-        vpl[8][l] = radiance_info.x;
-        vpl[9][l] = radiance_info.y;
-        vpl[10][l] = radiance_info.z;
-        vpl[11][l] = radiance_info.w;
+        for (int f = 0; f < 12; ++f) row[f] = pg_vloadw(0, vpl[f]);
       }
       pg_vpls_w v;
-      v.position = pg_load_float3w(vpl[0], vpl[1], vpl[2]);
-      v.position_pdf = pg_vloadw(0, vpl[3]);
-      v.normal = pg_load_float3w(vpl[4], vpl[5], vpl[6]);
-      v.mixture_pdf = pg_vloadw(0, vpl[7]);
-      v.radiance = pg_load_float3w(vpl[8], vpl[9], vpl[10]);
-      v.info = pg_vloadw(0, vpl[11]);
+      v.position = pg_make_float3w(row[0], row[1], row[2]);
+      v.position_pdf = row[3];
+      v.normal = pg_make_float3w(row[4], row[5], row[6]);
+      v.mixture_pdf = row[7];
+      v.radiance = pg_make_float3w(row[8], row[9], row[10]);
+      v.info = row[11];
       samples[s] = pg_train_samples_from_vpls_w(px, v, asked_w, settings, any_specular);
     }
 
@@ -197,9 +207,11 @@ __kernel void train_wide(
       pg_pmm_state_w next = pg_pmm_update_w(base, b, settings, target, &step);
       updated = select(updated, step, live);
       result = pg_pmm_state_select_w(result, pg_pmm_state_select_w(original, next, step), live);
+      pg_intw last = (pass + 1 >= lane_passes);
+      if (all(~live | last)) break; /* no lane needs the next pass's model */
       pg_pmm_model_w next_model = pg_pmm_model_from_state_w(next, settings);
       m = pg_pmm_model_select_w(m, next_model, live & step);
-      done |= live & (~step | ~next_model.valid | (pass + 1 >= lane_passes));
+      done |= live & (~step | ~next_model.valid | last);
     }
     put_state(state, result);
     pg_vstorew(updated & 1, 0, changed);

@@ -76,6 +76,19 @@ PG_FN int pg_train_this_frame(float k, int x, int y, uint frame, pg_kernel_setti
   return ((uint)x / PG_TRAIN_RUN + 3u * (uint)y + frame) % (uint)p.train_interval == 0u;
 }
 
+/* Where this frame's walk through pixel (x, y)'s window starts: one random cell per aligned run
+ * of PG_TRAIN_RUN pixels of a row (the generator of the run's first pixel), so the s-th
+ * neighbours of the pixels of a run are consecutive pixels of one row, which train_wide.cl
+ * loads as vectors (docs/guiding.md, "Several pixels per work-item"). Each pixel's walk is as
+ * random as with a start of its own; neighbouring runs and frames draw independently. */
+PG_FN uint pg_train_walk_start(uint seed, int x, int y, uint width, uint frame,
+                               pg_kernel_settings p) {
+  uint run_first = (uint)y * width + ((uint)x & ~(PG_TRAIN_RUN - 1u));
+  pg_rng rng = pg_rng_make(seed, run_first, frame, 0u, PG_RNG_STREAM_TRAIN);
+  int side = 2 * p.apron + 1;
+  return pg_rng_next_uint(&rng) % (uint)(side * side);
+}
+
 /* The window offset of the s-th neighbour of this frame's walk through the window. */
 PG_FN int pg_train_window_index(uint start, int s, pg_kernel_settings p) {
   int side = 2 * p.apron + 1;

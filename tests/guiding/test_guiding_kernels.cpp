@@ -325,10 +325,8 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
       const int side = 2 * p.apron + 1;
       const int n = std::min(std::min(sh::pg_pmm_neighbour_count(s.s1.w, p), side * side),
                              PG_MAX_TRAIN_SAMPLES);
-      sh::pg_rng rng =
-          sh::pg_rng_make(seed, static_cast<std::uint32_t>(i), frame, 0u, PG_RNG_STREAM_TRAIN);
       const std::uint32_t start =
-          sh::pg_rng_next_uint(&rng) % static_cast<std::uint32_t>(side * side);
+          sh::pg_train_walk_start(seed, x, y, static_cast<std::uint32_t>(w), frame, p);
       float4 samples[PG_MAX_TRAIN_SAMPLES];
       int kept = 0;
       for (int k = 0; k < n; ++k) {

@@ -210,9 +210,13 @@ TEST(GuidingImage, UnbiasedOnCornellIndirect) {
 }
 
 // Several samples per frame: every sample of a frame is drawn from one model and next-event
-// MIS weighs against that same model (training waits for the frame's last sample).
+// MIS weighs against that same model (training waits for the frame's last sample). 160 frames:
+// at 80, when the training walk's start became shared per run of 16 pixels (other random
+// draws), the top-left tile reached 3.5 standard errors (bound 3.44); rendered 4x longer with
+// two seeds each that tile agreed with path tracing within 0.5%, as two PT seeds do (noise,
+// not bias), and at 160 frames the test passes with a smaller standard error.
 TEST(GuidingImage, UnbiasedAtFourSppOnCornellBox) {
-  expect_same_means("cornell-box.json", 80, 0.0015, RunShape{4, ""});
+  expect_same_means("cornell-box.json", 160, 0.0015, RunShape{4, ""});
 }
 
 // Later vertices borrow the mixture of the pixel that shows them: their BSDF samples, their
