@@ -289,7 +289,7 @@ void count_bytes(Inputs& in, const pg_kernel_settings& p) {
 
 // Floating-point operations along each pixel's path, from the hand counts written beside the
 // kernels (kernels/reproject.cl, sample_wide.cl, train_wide.cl; the rules and the breakdown by
-// function: docs/guiding.md, "Roofline"): what the pixel itself needs, not what masked lanes
+// function: docs/guiding.md, "The roofline"): what the pixel itself needs, not what masked lanes
 // of its work-item compute besides.
 void count_flops(Inputs& in, const pg_kernel_settings& p) {
   const int w = in.w, h = in.h;
