@@ -17,119 +17,85 @@
 #include "shared/kernel_args.h"
 #include "shared/pmm.h"
 #include "shared/rng.h"
+#include "wide/guiding_pixel_wide.h"
 #include "wide/pmm_wide.h"
-
-/* Per-lane inputs in private arrays, one row of PG_LANES per field. */
-enum {
-  IN_NORMAL,
-  IN_VIEW = IN_NORMAL + 3,
-  IN_BASE_COLOR = IN_VIEW + 3,
-  IN_ROUGHNESS = IN_BASE_COLOR + 3,
-  IN_METALLIC,
-  IN_SPECULAR,
-  IN_STATE, /* 8 rows: pg_pmm_state's s0 then s1 */
-  IN_XI = IN_STATE + 8,
-  IN_U1,
-  IN_U2,
-  IN_FIELDS
-};
+#include "wide/rng_wide.h"
 
 __kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint width, uint height,
                           uint seed, uint frame, uint sample_index, pg_kernel_settings settings) {
   int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
   if (x0 >= (int)width || y >= (int)height) return;
+  int w = (int)width, row_start = y * w;
 
-  float in[IN_FIELDS][PG_LANES];
-  int sky[PG_LANES];
-  int any_surface = 0, any_specular = 0, any_model = 0;
-  for (int l = 0; l < PG_LANES; ++l) {
-    /* A lane past the row's end computes on the row's last pixel and stores nothing. */
-    int x = min(x0 + l, (int)width - 1), i = y * (int)width + x;
-    uint f = flags[i];
-    float4 bcr = base_color_roughness[i], ms = metallic_specular[i];
-    float4 n = shading_normal[i], v = view_dir[i];
-    pg_pmm_state state = pg_pmm_initial_state();
-    sky[l] = (f & PG_GBUF_SKY) != 0u;
-    any_surface |= !sky[l];
-    if (pg_guiding_applies(f, bcr.w, settings)) {
-      state.s0 = in_state0[i];
-      state.s1 = in_state1[i];
-      any_model |= state.s1.w > 0.0f;
-    }
-    any_specular |= !sky[l] && (ms.y > 0.0f || ms.x > 0.0f);
-    pg_put3_rows(in, IN_NORMAL, l, n.xyz);
-    pg_put3_rows(in, IN_VIEW, l, v.xyz);
-    pg_put3_rows(in, IN_BASE_COLOR, l, bcr.xyz);
-    in[IN_ROUGHNESS][l] = bcr.w;
-    in[IN_METALLIC][l] = ms.x;
-    in[IN_SPECULAR][l] = ms.y;
-    in[IN_STATE][l] = state.s0.x;
-    in[IN_STATE + 1][l] = state.s0.y;
-    in[IN_STATE + 2][l] = state.s0.z;
-    in[IN_STATE + 3][l] = state.s0.w;
-    in[IN_STATE + 4][l] = state.s1.x;
-    in[IN_STATE + 5][l] = state.s1.y;
-    in[IN_STATE + 6][l] = state.s1.z;
-    in[IN_STATE + 7][l] = state.s1.w;
-    pg_rng rng = pg_rng_make(seed, (uint)i, frame, sample_index, PG_RNG_STREAM_FIRST_BOUNCE);
-    in[IN_XI][l] = pg_rng_next(&rng);
-    in[IN_U1][l] = pg_rng_next(&rng);
-    in[IN_U2][l] = pg_rng_next(&rng);
-  }
+  /* The lanes' inputs, loaded as vectors (kernels/wide/lanes.h). A lane past the row's end
+   * computes on its last pixel and stores nothing. Pixels guiding skips sample their BSDF
+   * (the initial state has no model). */
+  pg_uintw pixel_flags = pg_load_row_uints(flags + row_start, x0, w);
+  pg_float3w base_color, normal, view;
+  pg_floatw roughness, metallic, specular, unused;
+  pg_load_row_float4_rows(base_color_roughness + row_start, x0, w, &base_color.x, &base_color.y,
+                          &base_color.z, &roughness);
+  pg_load_row_float4_rows(metallic_specular + row_start, x0, w, &metallic, &specular, &unused,
+                          &unused);
+  pg_intw sky = (pixel_flags & PG_GBUF_SKY) != 0u;
+  pg_intw applies = pg_guiding_applies_w(pixel_flags, roughness, settings);
+  int any_surface = any(~sky), any_specular = any(~sky & ((specular > 0.0f) | (metallic > 0.0f)));
 
-  float out[11][PG_LANES]; /* direction, pdf, strategy, mixture_a, mixture_b */
+  pg_float3w direction = pg_make_float3w(0.0f, 0.0f, 1.0f);
+  pg_floatw zero = (pg_floatw)(0.0f), pdf = zero;
+  pg_uintw strategy_w = (pg_uintw)(PG_STRATEGY_NONE);
+  pg_pmm_model_w m;
+  m.valid = (pg_intw)(0);
+  m.pi = m.mx = m.my = m.l11 = m.l21 = m.l22 = zero;
   if (any_surface) {
     pg_pmm_state_w s;
-    s.w = pg_vloadw(0, in[IN_STATE]);
-    s.s0 = pg_vloadw(0, in[IN_STATE + 1]);
-    s.sx = pg_vloadw(0, in[IN_STATE + 2]);
-    s.sy = pg_vloadw(0, in[IN_STATE + 3]);
-    s.sxx = pg_vloadw(0, in[IN_STATE + 4]);
-    s.syy = pg_vloadw(0, in[IN_STATE + 5]);
-    s.sxy = pg_vloadw(0, in[IN_STATE + 6]);
-    s.k = pg_vloadw(0, in[IN_STATE + 7]);
-    pg_pmm_model_w m = pg_pmm_model_from_state_w(s, settings);
-    pg_frame_w frame_x = pg_frame_from_normal_w(pg_get3_rows(in, IN_NORMAL));
-    pg_float3w wo = pg_to_local_w(frame_x, pg_get3_rows(in, IN_VIEW));
-    pg_lobes_w lobes =
-        pg_make_lobes_w(pg_get3_rows(in, IN_BASE_COLOR), pg_vloadw(0, in[IN_ROUGHNESS]),
-                        pg_vloadw(0, in[IN_METALLIC]), pg_vloadw(0, in[IN_SPECULAR]), wo);
+    pg_load_row_float4_rows(in_state0 + row_start, x0, w, &s.w, &s.s0, &s.sx, &s.sy);
+    pg_load_row_float4_rows(in_state1 + row_start, x0, w, &s.sxx, &s.syy, &s.sxy, &s.k);
+    s = pg_pmm_state_select_w(pg_pmm_initial_state_w(), s, applies);
+    int any_model = any(applies & (s.k > 0.0f));
+    pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
+                            &unused);
+    pg_load_row_float4_rows(view_dir + row_start, x0, w, &view.x, &view.y, &view.z, &unused);
+    pg_intw lane_x = min(x0 + pg_lane_numbers(), (pg_intw)(w - 1));
+    pg_uintw rng = pg_rng_make_w(seed, pg_convert_uintw(row_start + lane_x), frame, sample_index,
+                                 PG_RNG_STREAM_FIRST_BOUNCE);
+    pg_floatw xi = pg_rng_next_w(&rng), u1 = pg_rng_next_w(&rng), u2 = pg_rng_next_w(&rng);
+
+    m = pg_pmm_model_from_state_w(s, settings);
+    pg_frame_w frame_x = pg_frame_from_normal_w(normal);
+    pg_float3w wo = pg_to_local_w(frame_x, view);
+    pg_lobes_w lobes = pg_make_lobes_w(base_color, roughness, metallic, specular, wo);
     pg_intw guided;
-    pg_floatw pdf;
     pg_float3w wi =
-        pg_pmm_sample_w(m, lobes, wo, pg_vloadw(0, in[IN_XI]), pg_vloadw(0, in[IN_U1]),
-                        pg_vloadw(0, in[IN_U2]), any_specular, any_model, &guided, &pdf);
-    pg_float3w w = pg_to_world_w(frame_x, wi);
-    pg_floatw zero = (pg_floatw)(0.0f);
-    pg_vstorew(w.x, 0, out[0]);
-    pg_vstorew(w.y, 0, out[1]);
-    pg_vstorew(w.z, 0, out[2]);
-    pg_vstorew(pdf, 0, out[3]);
-    pg_vstorew(select((pg_floatw)(PG_STRATEGY_BSDF), (pg_floatw)(PG_STRATEGY_GUIDE), guided), 0,
-               out[4]);
-    /* pg_pmm_mixture_a and _b: an invalid model is all zeros. */
-    pg_vstorew(select(zero, m.pi, m.valid), 0, out[5]);
-    pg_vstorew(select(zero, m.mx, m.valid), 0, out[6]);
-    pg_vstorew(select(zero, m.my, m.valid), 0, out[7]);
-    pg_vstorew(select(zero, m.l11, m.valid), 0, out[8]);
-    pg_vstorew(select(zero, m.l21, m.valid), 0, out[9]);
-    pg_vstorew(select(zero, m.l22, m.valid), 0, out[10]);
+        pg_pmm_sample_w(m, lobes, wo, xi, u1, u2, any_specular, any_model, &guided, &pdf);
+    direction = pg_select3w(pg_to_world_w(frame_x, wi), direction, sky);
+    pdf = select(pdf, zero, sky);
+    strategy_w = select(select((pg_uintw)(PG_STRATEGY_BSDF), (pg_uintw)(PG_STRATEGY_GUIDE), guided),
+                        strategy_w, sky);
+    m.valid &= ~sky;
   }
 
+  /* pg_pmm_mixture_a and _b: an invalid model (and a sky pixel) is all zeros. */
+  float out[10][PG_LANES];
+  uint strategy_lanes[PG_LANES];
+  pg_vstorew(direction.x, 0, out[0]);
+  pg_vstorew(direction.y, 0, out[1]);
+  pg_vstorew(direction.z, 0, out[2]);
+  pg_vstorew(pdf, 0, out[3]);
+  pg_vstorew(select(zero, m.pi, m.valid), 0, out[4]);
+  pg_vstorew(select(zero, m.mx, m.valid), 0, out[5]);
+  pg_vstorew(select(zero, m.my, m.valid), 0, out[6]);
+  pg_vstorew(select(zero, m.l11, m.valid), 0, out[7]);
+  pg_vstorew(select(zero, m.l21, m.valid), 0, out[8]);
+  pg_vstorew(select(zero, m.l22, m.valid), 0, out[9]);
+  pg_vstorew(strategy_w, 0, strategy_lanes);
   for (int l = 0; l < PG_LANES; ++l) {
     int x = x0 + l;
-    if (x >= (int)width) break;
-    int i = y * (int)width + x;
-    if (sky[l]) {
-      direction_pdf[i] = (float4)(0.0f, 0.0f, 1.0f, 0.0f);
-      strategy[i] = PG_STRATEGY_NONE;
-      mixture_a[i] = (float4)(0.0f);
-      mixture_b[i] = (float2)(0.0f);
-      continue;
-    }
+    if (x >= w) break;
+    int i = row_start + x;
     direction_pdf[i] = (float4)(out[0][l], out[1][l], out[2][l], out[3][l]);
-    strategy[i] = (uint)out[4][l];
-    mixture_a[i] = (float4)(out[5][l], out[6][l], out[7][l], out[8][l]);
-    mixture_b[i] = (float2)(out[9][l], out[10][l]);
+    strategy[i] = strategy_lanes[l];
+    mixture_a[i] = (float4)(out[4][l], out[5][l], out[6][l], out[7][l]);
+    mixture_b[i] = (float2)(out[8][l], out[9][l]);
   }
 }

@@ -19,45 +19,23 @@
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
 #include "shared/pmm_train.h"
+#include "wide/guiding_pixel_wide.h"
 #include "wide/pmm_train_wide.h"
 
-/* Per-lane values in private arrays, one row of PG_LANES per field. */
-enum {
-  PX_X,
-  PX_T = PX_X + 3,
-  PX_B = PX_T + 3,
-  PX_N = PX_B + 3,
-  PX_WO = PX_N + 3,
-  PX_DIFFUSE = PX_WO + 3,
-  PX_F0 = PX_DIFFUSE + 3,
-  PX_ALPHA = PX_F0 + 3,
-  PX_P_SPECULAR,
-  PX_FIELDS
-};
-
-/* The state of every lane from and to eight rows (pg_pmm_state's s0 then s1). */
-static inline pg_pmm_state_w get_state(__private float (*rows)[PG_LANES]) {
+/* A state (pg_pmm_state: s0 then s1) per lane from its two channels' rows. */
+static inline pg_pmm_state_w state_from_rows(pg_floatw w, pg_floatw s0, pg_floatw sx, pg_floatw sy,
+                                             pg_floatw sxx, pg_floatw syy, pg_floatw sxy,
+                                             pg_floatw k) {
   pg_pmm_state_w s;
-  s.w = pg_vloadw(0, rows[0]);
-  s.s0 = pg_vloadw(0, rows[1]);
-  s.sx = pg_vloadw(0, rows[2]);
-  s.sy = pg_vloadw(0, rows[3]);
-  s.sxx = pg_vloadw(0, rows[4]);
-  s.syy = pg_vloadw(0, rows[5]);
-  s.sxy = pg_vloadw(0, rows[6]);
-  s.k = pg_vloadw(0, rows[7]);
+  s.w = w;
+  s.s0 = s0;
+  s.sx = sx;
+  s.sy = sy;
+  s.sxx = sxx;
+  s.syy = syy;
+  s.sxy = sxy;
+  s.k = k;
   return s;
-}
-
-static inline void put_state(__private float (*rows)[PG_LANES], pg_pmm_state_w s) {
-  pg_vstorew(s.w, 0, rows[0]);
-  pg_vstorew(s.s0, 0, rows[1]);
-  pg_vstorew(s.sx, 0, rows[2]);
-  pg_vstorew(s.sy, 0, rows[3]);
-  pg_vstorew(s.sxx, 0, rows[4]);
-  pg_vstorew(s.syy, 0, rows[5]);
-  pg_vstorew(s.sxy, 0, rows[6]);
-  pg_vstorew(s.k, 0, rows[7]);
 }
 
 __kernel void train_wide(
@@ -65,69 +43,55 @@ __kernel void train_wide(
     uint width, uint height, uint seed, uint frame, pg_kernel_settings settings) {
   int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
   if (x0 >= (int)width || y >= (int)height) return;
-  int apron = settings.apron, side = 2 * apron + 1;
+  int w = (int)width, row_start = y * w, apron = settings.apron, side = 2 * apron + 1;
 
-  /* Per lane, as train.cl per work-item: the state, whether the pixel trains, its N, the
-   * start of its walk through the window, and what it knows about itself. */
-  float pixel[PX_FIELDS][PG_LANES], state[8][PG_LANES];
-  int active[PG_LANES], count[PG_LANES], passes[PG_LANES], changed[PG_LANES];
-  int lane_index[PG_LANES];
-  int any_active = 0, any_specular = 0, most_samples = 0;
-  for (int l = 0; l < PG_LANES; ++l) {
-    for (int f = 0; f < PX_FIELDS; ++f) pixel[f][l] = 0.0f;
-    for (int f = 0; f < 8; ++f) state[f][l] = 0.0f;
-    active[l] = 0;
-    changed[l] = 0;
-    count[l] = 0;
-    passes[l] = 0;
-    lane_index[l] = l;
-    int x = x0 + l;
-    if (x >= (int)width) continue;
-    int i = y * (int)width + x;
-    float4 s0 = in_state0[i], s1 = in_state1[i];
-    state[0][l] = s0.x;
-    state[1][l] = s0.y;
-    state[2][l] = s0.z;
-    state[3][l] = s0.w;
-    state[4][l] = s1.x;
-    state[5][l] = s1.y;
-    state[6][l] = s1.z;
-    state[7][l] = s1.w;
-    float4 bcr = base_color_roughness[i];
-    if (!pg_guiding_applies(flags[i], bcr.w, settings) ||
-        !pg_train_this_frame(s1.w, x, y, frame, settings))
-      continue;
-    active[l] = 1;
-    any_active = 1;
-    pg_frame frame_l = pg_frame_from_normal(shading_normal[i].xyz);
-    float3 wo = pg_to_local(frame_l, view_dir[i].xyz);
-    pg_lobes lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), wo);
-    pg_put3_rows(pixel, PX_X, l, position_depth[i].xyz);
-    pg_put3_rows(pixel, PX_T, l, frame_l.t);
-    pg_put3_rows(pixel, PX_B, l, frame_l.b);
-    pg_put3_rows(pixel, PX_N, l, frame_l.n);
-    pg_put3_rows(pixel, PX_WO, l, wo);
-    pg_put3_rows(pixel, PX_DIFFUSE, l, lobes.diffuse);
-    pg_put3_rows(pixel, PX_F0, l, lobes.f0);
-    pixel[PX_ALPHA][l] = lobes.alpha;
-    pixel[PX_P_SPECULAR][l] = lobes.p_specular;
-    any_specular |= lobes.p_specular > 0.0f;
-    count[l] = min(min(pg_pmm_neighbour_count(s1.w, settings), side * side), PG_MAX_TRAIN_SAMPLES);
-    most_samples = max(most_samples, count[l]);
-    passes[l] = s1.w >= 0.25f * settings.k_max ? 1 : settings.em_passes;
-  }
+  /* Per lane, as train.cl per work-item, loaded as vectors (kernels/wide/lanes.h): the state,
+   * whether the pixel trains, its N and passes, and what it knows about itself. A lane past
+   * the row's end computes on its last pixel, trains nothing and stores nothing. */
+  pg_floatw a0, a1, a2, a3, b0, b1, b2, b3;
+  pg_load_row_float4_rows(in_state0 + row_start, x0, w, &a0, &a1, &a2, &a3);
+  pg_load_row_float4_rows(in_state1 + row_start, x0, w, &b0, &b1, &b2, &b3);
+  pg_pmm_state_w original = state_from_rows(a0, a1, a2, a3, b0, b1, b2, b3);
+  pg_floatw k = original.k;
+  pg_float3w base_color;
+  pg_floatw roughness;
+  pg_load_row_float4_rows(base_color_roughness + row_start, x0, w, &base_color.x, &base_color.y,
+                          &base_color.z, &roughness);
+  pg_uintw pixel_flags = pg_load_row_uints(flags + row_start, x0, w);
+  pg_intw lane = pg_lane_numbers();
+  /* pg_guiding_applies and pg_train_this_frame per lane; the lanes share one run of
+   * PG_TRAIN_RUN pixels, so the frame's rotation decides for all of them at once. */
+  pg_intw active = (x0 + lane < w) & pg_guiding_applies_w(pixel_flags, roughness, settings);
+  int run_trains =
+      settings.train_interval <= 1 ||
+      ((uint)x0 / PG_TRAIN_RUN + 3u * (uint)y + frame) % (uint)settings.train_interval == 0u;
+  pg_intw mature = k >= 0.25f * settings.k_max;
+  if (!run_trains) active &= ~mature;
+  /* pg_pmm_neighbour_count, bounded by the window and the sample array. */
+  pg_floatw t = clamp(1.0f - k / settings.k_max, 0.0f, 1.0f);
+  pg_intw n = pg_convert_intw(t * (settings.n_max - settings.n_min) + settings.n_min + 0.5f);
+  pg_intw counts =
+      select((pg_intw)(0), min(n, (pg_intw)(min(side * side, PG_MAX_TRAIN_SAMPLES))), active);
+  pg_intw lane_passes = select((pg_intw)(settings.em_passes), (pg_intw)(1), mature);
+  int most_samples = pg_max_lane(counts);
+  pg_intw done = ~active, updated = (pg_intw)(0);
+  pg_pmm_state_w result = original;
 
-  if (any_active) {
+  if (any(active)) {
     pg_train_pixels_w px;
-    px.x = pg_get3_rows(pixel, PX_X);
-    px.frame.t = pg_get3_rows(pixel, PX_T);
-    px.frame.b = pg_get3_rows(pixel, PX_B);
-    px.frame.n = pg_get3_rows(pixel, PX_N);
-    px.wo = pg_get3_rows(pixel, PX_WO);
-    px.lobes.diffuse = pg_get3_rows(pixel, PX_DIFFUSE);
-    px.lobes.f0 = pg_get3_rows(pixel, PX_F0);
-    px.lobes.alpha = pg_vloadw(0, pixel[PX_ALPHA]);
-    px.lobes.p_specular = pg_vloadw(0, pixel[PX_P_SPECULAR]);
+    pg_floatw depth, nw, vw, metallic, specular, unused;
+    pg_load_row_float4_rows(position_depth + row_start, x0, w, &px.x.x, &px.x.y, &px.x.z, &depth);
+    pg_float3w normal, view;
+    pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
+                            &nw);
+    pg_load_row_float4_rows(view_dir + row_start, x0, w, &view.x, &view.y, &view.z, &vw);
+    pg_load_row_float4_rows(metallic_specular + row_start, x0, w, &metallic, &specular, &unused,
+                            &unused);
+    px.frame = pg_frame_from_normal_w(normal);
+    px.wo = pg_to_local_w(px.frame, view);
+    px.lobes = pg_make_lobes_w(base_color, roughness, metallic, specular, px.wo);
+    int any_specular = any(active & (px.lobes.p_specular > 0.0f));
+    pg_pmm_model_w m = pg_pmm_model_from_state_w(original, settings);
 
     /* The s-th neighbour of every lane's walk (pg_train_window_index, stepped without
      * integer division per lane). The lanes lie in one run of PG_TRAIN_RUN pixels, whose walk
@@ -136,7 +100,6 @@ __kernel void train_wide(
      * is inside the image, lane by lane at the left and right edges. Lanes not asked read no
      * VPL (info 0), as train.cl skips them. */
     pg_train_samples_w samples[PG_MAX_TRAIN_SAMPLES];
-    pg_intw lane = pg_vloadw(0, lane_index), counts = pg_vloadw(0, count);
     int walk = (int)pg_train_walk_start(seed, x0, y, width, frame, settings);
     for (int s = 0; s < most_samples; ++s) {
       if (s > 0) {
@@ -191,16 +154,15 @@ __kernel void train_wide(
       v.mixture_pdf = row[7];
       v.radiance = pg_make_float3w(row[8], row[9], row[10]);
       v.info = row[11];
-      samples[s] = pg_train_samples_from_vpls_w(px, v, asked_w, settings, any_specular);
+      pg_train_samples_w sample =
+          pg_train_samples_from_vpls_w(px, v, asked_w, settings, any_specular);
+      samples[s] = sample;
     }
 
     /* pg_pmm_train in the lanes: E-step passes over the samples, each followed by the
      * M-step and the next pass's model. A lane that pg_pmm_train would have left (no update,
      * an invalid model, its last pass) is done and keeps its result. */
-    pg_pmm_state_w original = get_state(state), base = original, result = original;
-    pg_pmm_model_w m = pg_pmm_model_from_state_w(original, settings);
-    pg_intw lane_passes = pg_vloadw(0, passes);
-    pg_intw done = pg_vloadw(0, active) == 0, updated = (pg_intw)(0);
+    pg_pmm_state_w base = original;
     pg_floatw target = pg_convert_floatw(counts);
     for (int pass = 0; !all(done); ++pass) {
       pg_pmm_batch_w b = pg_pmm_batch_empty_w();
@@ -218,16 +180,25 @@ __kernel void train_wide(
       m = pg_pmm_model_select_w(m, next_model, live & step);
       done |= live & (~step | ~next_model.valid | last);
     }
-    put_state(state, result);
-    pg_vstorew(updated & 1, 0, changed);
   }
 
+  float st[8][PG_LANES];
+  int changed[PG_LANES];
+  pg_vstorew(result.w, 0, st[0]);
+  pg_vstorew(result.s0, 0, st[1]);
+  pg_vstorew(result.sx, 0, st[2]);
+  pg_vstorew(result.sy, 0, st[3]);
+  pg_vstorew(result.sxx, 0, st[4]);
+  pg_vstorew(result.syy, 0, st[5]);
+  pg_vstorew(result.sxy, 0, st[6]);
+  pg_vstorew(result.k, 0, st[7]);
+  pg_vstorew(updated & 1, 0, changed);
   for (int l = 0; l < PG_LANES; ++l) {
     int x = x0 + l;
-    if (x >= (int)width) break;
-    int i = y * (int)width + x;
-    out_state0[i] = (float4)(state[0][l], state[1][l], state[2][l], state[3][l]);
-    out_state1[i] = (float4)(state[4][l], state[5][l], state[6][l], state[7][l]);
+    if (x >= w) break;
+    int i = row_start + x;
+    out_state0[i] = (float4)(st[0][l], st[1][l], st[2][l], st[3][l]);
+    out_state1[i] = (float4)(st[4][l], st[5][l], st[6][l], st[7][l]);
     trained[i] = (uchar)changed[l];
   }
 }

@@ -5,8 +5,9 @@
  *
  * Conventions: a comparison gives an intN mask (-1 true, 0 false), select(a, b, mask) takes b
  * where the mask is set, and a lane whose work is done or absent is masked, never branched
- * around. What a pixel computes once before its loops (its frame, its lobes, the start of its
- * walk) stays scalar code per lane and moves into the lanes through private arrays. */
+ * around. A work-item's lanes are consecutive pixels of a row, so their G-buffer and state
+ * channels load as vectors (pg_load_row_float4_rows), lane by lane only at the row's right end;
+ * the kernels store results lane by lane from private rows. */
 #ifndef RTPG_WIDE_LANES_H
 #define RTPG_WIDE_LANES_H
 
@@ -92,6 +93,59 @@ static inline void pg_load_float4_rows(__global const float4* p, pg_floatw* x, p
   *w = (float2)(a.s3, a.s7);
 #else
 #error "PG_LANES must be 2, 4, 8 or 16"
+#endif
+}
+
+/* A float4 channel of the pixels x0 .. x0 + PG_LANES - 1 of one row (row: its first pixel) as
+ * four rows: vector loads where every lane lies inside the row; at its right end lane by lane,
+ * a lane past the end reading the row's last pixel (callers mask it). */
+static inline void pg_load_row_float4_rows(__global const float4* row, int x0, int width,
+                                           pg_floatw* x, pg_floatw* y, pg_floatw* z, pg_floatw* w) {
+  if (x0 + PG_LANES <= width) {
+    pg_load_float4_rows(row + x0, x, y, z, w);
+    return;
+  }
+  float v[4][PG_LANES];
+  for (int l = 0; l < PG_LANES; ++l) {
+    float4 p = row[min(x0 + l, width - 1)];
+    v[0][l] = p.x;
+    v[1][l] = p.y;
+    v[2][l] = p.z;
+    v[3][l] = p.w;
+  }
+  *x = pg_vloadw(0, v[0]);
+  *y = pg_vloadw(0, v[1]);
+  *z = pg_vloadw(0, v[2]);
+  *w = pg_vloadw(0, v[3]);
+}
+
+/* A uint channel of the same pixels (pg_load_row_float4_rows' rule at the row's end). */
+static inline pg_uintw pg_load_row_uints(__global const uint* row, int x0, int width) {
+  if (x0 + PG_LANES <= width) return pg_vloadw(0, row + x0);
+  uint v[PG_LANES];
+  for (int l = 0; l < PG_LANES; ++l) v[l] = row[min(x0 + l, width - 1)];
+  return pg_vloadw(0, v);
+}
+
+/* The largest lane of an int vector. */
+static inline int pg_max_lane(pg_intw v) {
+  int a[PG_LANES];
+  pg_vstorew(v, 0, a);
+  int m = a[0];
+  for (int l = 1; l < PG_LANES; ++l) m = max(m, a[l]);
+  return m;
+}
+
+/* The lane numbers 0 .. PG_LANES - 1. */
+static inline pg_intw pg_lane_numbers(void) {
+#if PG_LANES == 16
+  return (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+#elif PG_LANES == 8
+  return (int8)(0, 1, 2, 3, 4, 5, 6, 7);
+#elif PG_LANES == 4
+  return (int4)(0, 1, 2, 3);
+#else
+  return (int2)(0, 1);
 #endif
 }
 
