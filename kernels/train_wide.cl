@@ -22,22 +22,6 @@
 #include "wide/guiding_pixel_wide.h"
 #include "wide/pmm_train_wide.h"
 
-/* A state (pg_pmm_state: s0 then s1) per lane from its two channels' rows. */
-static inline pg_pmm_state_w state_from_rows(pg_floatw w, pg_floatw s0, pg_floatw sx, pg_floatw sy,
-                                             pg_floatw sxx, pg_floatw syy, pg_floatw sxy,
-                                             pg_floatw k) {
-  pg_pmm_state_w s;
-  s.w = w;
-  s.s0 = s0;
-  s.sx = sx;
-  s.sy = sy;
-  s.sxx = sxx;
-  s.syy = syy;
-  s.sxy = sxy;
-  s.k = k;
-  return s;
-}
-
 __kernel void train_wide(
     PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_IN_STATE PG_ARGS_OUT_STATE __global uchar* trained,
     uint width, uint height, uint seed, uint frame, pg_kernel_settings settings) {
@@ -48,10 +32,11 @@ __kernel void train_wide(
   /* Per lane, as train.cl per work-item, loaded as vectors (kernels/wide/lanes.h): the state,
    * whether the pixel trains, its N and passes, and what it knows about itself. A lane past
    * the row's end computes on its last pixel, trains nothing and stores nothing. */
-  pg_floatw a0, a1, a2, a3, b0, b1, b2, b3;
-  pg_load_row_float4_rows(in_state0 + row_start, x0, w, &a0, &a1, &a2, &a3);
-  pg_load_row_float4_rows(in_state1 + row_start, x0, w, &b0, &b1, &b2, &b3);
-  pg_pmm_state_w original = state_from_rows(a0, a1, a2, a3, b0, b1, b2, b3);
+  pg_pmm_state_w original;
+  pg_load_row_float4_rows(in_state0 + row_start, x0, w, &original.w, &original.s0, &original.sx,
+                          &original.sy);
+  pg_load_row_float4_rows(in_state1 + row_start, x0, w, &original.sxx, &original.syy, &original.sxy,
+                          &original.k);
   pg_floatw k = original.k;
   pg_float3w base_color;
   pg_floatw roughness;
@@ -79,12 +64,12 @@ __kernel void train_wide(
 
   if (any(active)) {
     pg_train_pixels_w px;
-    pg_floatw depth, nw, vw, metallic, specular, unused;
-    pg_load_row_float4_rows(position_depth + row_start, x0, w, &px.x.x, &px.x.y, &px.x.z, &depth);
+    pg_floatw metallic, specular, unused;
+    pg_load_row_float4_rows(position_depth + row_start, x0, w, &px.x.x, &px.x.y, &px.x.z, &unused);
     pg_float3w normal, view;
     pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
-                            &nw);
-    pg_load_row_float4_rows(view_dir + row_start, x0, w, &view.x, &view.y, &view.z, &vw);
+                            &unused);
+    pg_load_row_float4_rows(view_dir + row_start, x0, w, &view.x, &view.y, &view.z, &unused);
     pg_load_row_float4_rows(metallic_specular + row_start, x0, w, &metallic, &specular, &unused,
                             &unused);
     px.frame = pg_frame_from_normal_w(normal);
