@@ -77,6 +77,15 @@ def median_frame_ms(stats, key="total"):
     return statistics.median(f["time_ms"].get(key, 0.0) for f in frames)
 
 
+def final_frame_metrics(stats, img, ref, T):
+    """What equal-frame and denoised report of one method's run: the relMSE and LDR-FLIP of frame
+    T, the mean relMSE of frames T-7..T with its standard error, and median times per stage."""
+    mean, sem = mean_sem(f["relmse"] for f in stats["frames"][T - LAST:T])
+    return {"relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
+            "flip_ldr": metrics.flip_ldr(img, ref),
+            "time_ms": {k: median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}}
+
+
 def crop_box(err_map, size):
     """A square crop centred on the region where PT's error is largest (smoothed)."""
     h, w = err_map.shape
@@ -149,13 +158,9 @@ def equal_frame(ctx, scene):
         stats, frames = static_run(ctx, scene, method)
         img = metrics.load_exr(frames[T])
         images[method] = img
-        window = [f["relmse"] for f in stats["frames"][T - LAST:T]]
-        mean, sem = mean_sem(window)
         result["methods"][method] = {
-            "relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
-            "flip_ldr": metrics.flip_ldr(img, ref), "flip_hdr": metrics.flip_hdr(img, ref),
+            **final_frame_metrics(stats, img, ref, T), "flip_hdr": metrics.flip_hdr(img, ref),
             "frame_ms": median_frame_ms(stats), "nonfinite": sum(f["nonfinite_samples"] for f in stats["frames"]),
-            "time_ms": {k: median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]},
         }
         for key in ("guided_fraction", "trained_fraction", "mean_pi"):
             if key in stats["frames"][T - 1]:
@@ -284,13 +289,9 @@ def denoised(ctx, scene):
                                      extra=["--denoise", "svgf", "--noisy-output", noisy_path])
         img, noisy = metrics.load_exr(image), metrics.load_exr(noisy_path)
         images[method] = img
-        window = [f["relmse"] for f in stats["frames"][T - LAST:T]]
-        mean, sem = mean_sem(window)
         result["static"][method] = {
-            "relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
-            "flip_ldr": metrics.flip_ldr(img, ref), "relmse_noisy": metrics.relmse(noisy, ref),
+            **final_frame_metrics(stats, img, ref, T), "relmse_noisy": metrics.relmse(noisy, ref),
             "flip_ldr_noisy": metrics.flip_ldr(noisy, ref),
-            "time_ms": {k: median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]},
         }
     # SVGF's cost against the path-traced frame it filters (the renderer's part of "total").
     for res, method_stats in ((m["res"], result["static"]["off"]["time_ms"]), (m["svgf_large_res"], None)):

@@ -117,18 +117,9 @@ __kernel void train_wide(
             normal = vpl_normal[j];
             radiance_info = vpl_radiance_info[j];
           }
-          vpl[0][l] = position_pdf.x;
-          vpl[1][l] = position_pdf.y;
-          vpl[2][l] = position_pdf.z;
-          vpl[3][l] = position_pdf.w;
-          vpl[4][l] = normal.x;
-          vpl[5][l] = normal.y;
-          vpl[6][l] = normal.z;
-          vpl[7][l] = normal.w;
-          vpl[8][l] = radiance_info.x;
-          vpl[9][l] = radiance_info.y;
-          vpl[10][l] = radiance_info.z;
-          vpl[11][l] = radiance_info.w;
+          pg_put4_rows(vpl, 0, l, position_pdf);
+          pg_put4_rows(vpl, 4, l, normal);
+          pg_put4_rows(vpl, 8, l, radiance_info);
         }
         for (int f = 0; f < 12; ++f) row[f] = pg_vloadw(0, vpl[f]);
       }
@@ -139,9 +130,7 @@ __kernel void train_wide(
       v.mixture_pdf = row[7];
       v.radiance = pg_make_float3w(row[8], row[9], row[10]);
       v.info = row[11];
-      pg_train_samples_w sample =
-          pg_train_samples_from_vpls_w(px, v, asked_w, settings, any_specular);
-      samples[s] = sample;
+      samples[s] = pg_train_samples_from_vpls_w(px, v, asked_w, settings, any_specular);
     }
 
     /* pg_pmm_train in the lanes: E-step passes over the samples, each followed by the

@@ -39,6 +39,13 @@ def verdict(pt_mean, pt_sem, pg_mean, pg_sem):
     return "no significant difference"
 
 
+def _relmse_cells(pt, pg):
+    """The table cells 'relMSE PT (± s.e.) | relMSE PG (± s.e.) | verdict' of two methods' figures."""
+    return (f"| {pt['relmse_last8']:.4g} ± {pt['relmse_last8_sem']:.2g} "
+            f"| {pg['relmse_last8']:.4g} ± {pg['relmse_last8_sem']:.2g} "
+            f"| {verdict(pt['relmse_last8'], pt['relmse_last8_sem'], pg['relmse_last8'], pg['relmse_last8_sem'])} ")
+
+
 def _equal_frame(ex, report_dir):
     lines = ["## Equal frame: 1 spp after T frames (paper, figure 3)", "",
              "| scene | PT FLIP | PG FLIP | ratio | relMSE ratio | frame time PT | frame time PG | guiding overhead |",
@@ -57,9 +64,7 @@ def _equal_frame(ex, report_dir):
     for scene, r in ex.items():
         pt, pg = r["methods"]["off"], r["methods"]["pmm"]
         lines.append(f"| {scene} | {pt['flip_hdr']:.3f} | {pg['flip_hdr']:.3f} "
-                     f"| {pt['relmse_last8']:.4g} ± {pt['relmse_last8_sem']:.2g} "
-                     f"| {pg['relmse_last8']:.4g} ± {pg['relmse_last8_sem']:.2g} "
-                     f"| {verdict(pt['relmse_last8'], pt['relmse_last8_sem'], pg['relmse_last8'], pg['relmse_last8_sem'])} "
+                     f"{_relmse_cells(pt, pg)}"
                      f"| {pg.get('guided_fraction', float('nan')):.2f} | {pg.get('mean_pi', float('nan')):.2f} |")
     lines += ["", "Verdict: the difference of the relMSE means against three combined standard errors (the 8 "
               "frames have independent noise). Guided pixels: share of surface pixels that sampled a trained "
@@ -152,9 +157,7 @@ def _denoised(ex, report_dir, settings):
     for scene, r in ex.items():
         pt, pg = r["static"]["off"], r["static"]["pmm"]
         lines.append(f"| {scene} | {pt['flip_ldr']:.3f} | {pg['flip_ldr']:.3f} | {pg['flip_ldr'] / max(pt['flip_ldr'], 1e-9):.2f} "
-                     f"| {pt['relmse_last8']:.4g} ± {pt['relmse_last8_sem']:.2g} "
-                     f"| {pg['relmse_last8']:.4g} ± {pg['relmse_last8_sem']:.2g} "
-                     f"| {verdict(pt['relmse_last8'], pt['relmse_last8_sem'], pg['relmse_last8'], pg['relmse_last8_sem'])} "
+                     f"{_relmse_cells(pt, pg)}"
                      f"| {pt['flip_ldr_noisy']:.3f} / {pg['flip_ldr_noisy']:.3f} |")
     lines += ["", f"Along the camera path ({settings['path_res']}, frames {settings['path_frames']}, per-frame references "
               f"of {settings['path_ref_spp']} spp): LDR-FLIP PG/PT per checkpoint, and the flicker of the denoised "

@@ -39,23 +39,13 @@ static inline pg_float3w pg_make_float3w(pg_floatw x, pg_floatw y, pg_floatw z) 
   return v;
 }
 
-/* One point or direction per lane from three private arrays of PG_LANES floats. */
-static inline pg_float3w pg_load_float3w(__private const float* xs, __private const float* ys,
-                                         __private const float* zs) {
-  return pg_make_float3w(pg_vloadw(0, xs), pg_vloadw(0, ys), pg_vloadw(0, zs));
-}
-
-/* Per-lane values kept in a private array of rows (one row of PG_LANES floats per field), as the
- * wide kernels gather them pixel by pixel: a 3-vector in rows field..field+2 at one lane, and
- * the rows read back as one 3-vector per lane. */
-static inline void pg_put3_rows(__private float (*rows)[PG_LANES], int field, int lane, float3 v) {
+/* One float4 of one lane into four private rows (rows field..field+3), as the wide kernels'
+ * lane-by-lane paths gather them before loading the rows as vectors. */
+static inline void pg_put4_rows(__private float (*rows)[PG_LANES], int field, int lane, float4 v) {
   rows[field][lane] = v.x;
   rows[field + 1][lane] = v.y;
   rows[field + 2][lane] = v.z;
-}
-
-static inline pg_float3w pg_get3_rows(__private float (*rows)[PG_LANES], int field) {
-  return pg_load_float3w(rows[field], rows[field + 1], rows[field + 2]);
+  rows[field + 3][lane] = v.w;
 }
 
 /* PG_LANES consecutive float4 (one per lane, as a channel of consecutive pixels) turned into
@@ -106,13 +96,7 @@ static inline void pg_load_row_float4_rows(__global const float4* row, int x0, i
     return;
   }
   float v[4][PG_LANES];
-  for (int l = 0; l < PG_LANES; ++l) {
-    float4 p = row[min(x0 + l, width - 1)];
-    v[0][l] = p.x;
-    v[1][l] = p.y;
-    v[2][l] = p.z;
-    v[3][l] = p.w;
-  }
+  for (int l = 0; l < PG_LANES; ++l) pg_put4_rows(v, 0, l, row[min(x0 + l, width - 1)]);
   *x = pg_vloadw(0, v[0]);
   *y = pg_vloadw(0, v[1]);
   *z = pg_vloadw(0, v[2]);
