@@ -142,6 +142,13 @@ const SelectedDevice* find(const std::vector<SelectedDevice>& all, const std::st
 
 }  // namespace
 
+int DeviceInfo::simd_lanes() const {
+  int lanes = 1;
+  if (type == "cpu")
+    while (lanes < 16 && 2 * lanes <= static_cast<int>(native_float_width)) lanes *= 2;
+  return lanes;
+}
+
 std::string DeviceInfo::spec() const {
   return std::to_string(platform_index) + ":" + std::to_string(device_index);
 }

@@ -36,7 +36,10 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
   kernel_settings_ = to_kernel_settings(settings);
   temporal_ = runtime.kernel("svgf_temporal.cl", "svgf_temporal");
   variance_ = runtime.kernel("svgf_variance.cl", "svgf_variance");
-  atrous_ = runtime.kernel("svgf_atrous.cl", "svgf_atrous");
+  atrous_lanes_ = settings.atrous_lanes != 0 ? settings.atrous_lanes : runtime.info().simd_lanes();
+  atrous_ = atrous_lanes_ > 1 ? runtime.kernel("svgf_atrous_wide.cl", "svgf_atrous_wide",
+                                               "-DPG_LANES=" + std::to_string(atrous_lanes_))
+                              : runtime.kernel("svgf_atrous.cl", "svgf_atrous");
   remodulate_ = runtime.kernel("svgf_remodulate.cl", "svgf_remodulate");
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   translate_cl_errors([&] {
@@ -76,12 +79,13 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
   output_host_.resize(n);
 }
 
-double SvgfDenoiser::run(cl::Kernel& kernel) {
+double SvgfDenoiser::run(cl::Kernel& kernel, int lanes) {
   auto round_up = [](int v, int m) { return static_cast<std::size_t>((v + m - 1) / m * m); };
   cl::Event done;
   runtime_.queue().enqueueNDRangeKernel(
       kernel, cl::NullRange,
-      cl::NDRange(round_up(width_, settings_.local_x), round_up(height_, settings_.local_y)),
+      cl::NDRange(round_up((width_ + lanes - 1) / lanes, settings_.local_x),
+                  round_up(height_, settings_.local_y)),
       cl::NDRange(settings_.local_x, settings_.local_y), nullptr, &done);
   done.wait();
   return ClRuntime::event_ms(done);
@@ -148,7 +152,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
       atrous_.setArg(5, h);
       atrous_.setArg(6, static_cast<cl_int>(1 << k));
       atrous_.setArg(7, kernel_settings_);
-      atrous_ms += run(atrous_);
+      atrous_ms += run(atrous_, atrous_lanes_);
       in = out;
     }
     filtered_ = in;

@@ -46,9 +46,12 @@ class SvgfDenoiser {
   int width() const { return width_; }
   int height() const { return height_; }
   const SvgfSettings& settings() const { return settings_; }
+  // Pixels per work-item of the a-trous kernel (settings().atrous_lanes, 0 resolved per device).
+  int atrous_lanes() const { return atrous_lanes_; }
 
  private:
-  double run(cl::Kernel& kernel);
+  // Runs kernel over the image, each work-item covering `lanes` pixels of a row; blocking.
+  double run(cl::Kernel& kernel, int lanes = 1);
   // The G-buffer channels the kernels read, this frame's and last frame's (ping-pong).
   struct Surfaces {
     cl::Buffer position_depth, shading_normal, material;
@@ -57,6 +60,7 @@ class SvgfDenoiser {
   ClRuntime& runtime_;
   int width_, height_;
   SvgfSettings settings_;
+  int atrous_lanes_ = 1;
   shared::pg_svgf_settings kernel_settings_;
   cl::Kernel temporal_, variance_, atrous_, remodulate_;
   std::array<Surfaces, 2> surfaces_;

@@ -70,13 +70,8 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
       local_tile_ = !cpu;
       break;
   }
-  // On a CPU device as many pixels per work-item as its SIMD registers hold floats (its
-  // compiler turns the lanes into SIMD code); a GPU runs a pixel per work-item and keeps the
-  // VPL tile (docs/guiding.md, "Several pixels per work-item").
-  int simd_lanes = 1;
-  if (cpu)
-    while (simd_lanes < 16 && 2 * simd_lanes <= static_cast<int>(info.native_float_width))
-      simd_lanes *= 2;
+  // A GPU keeps the VPL tile and a pixel per work-item (DeviceInfo::simd_lanes).
+  const int simd_lanes = info.simd_lanes();
   train_lanes_ = settings.train_lanes != 0 ? settings.train_lanes : local_tile_ ? 1 : simd_lanes;
   sample_lanes_ = settings.sample_lanes != 0 ? settings.sample_lanes : simd_lanes;
   if (train_lanes_ > 1 && local_tile_)

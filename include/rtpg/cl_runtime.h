@@ -35,6 +35,11 @@ struct DeviceInfo {
   std::string spec() const;
   // One line for listings and error messages: "0:0 <name> (cpu, <platform>, <OpenCL C>)".
   std::string summary() const;
+  // Pixels per work-item for the kernels that run several in vector lanes (kernels/wide/): on a
+  // CPU device as many as its SIMD registers hold floats (a power of two, at most 16), since its
+  // compiler turns the lanes into SIMD code; 1 on GPUs, whose work-items are SIMD lanes already
+  // (docs/guiding.md, "Several pixels per work-item").
+  int simd_lanes() const;
 };
 
 struct SelectedDevice;

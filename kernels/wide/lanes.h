@@ -87,27 +87,36 @@ static inline void pg_load_float4_rows(__global const float4* p, pg_floatw* x, p
 }
 
 /* A float4 channel of the pixels x0 .. x0 + PG_LANES - 1 of one row (row: its first pixel) as
- * four rows: vector loads where every lane lies inside the row; at its right end lane by lane,
- * a lane past the end reading the row's last pixel (callers mask it). */
+ * four rows: vector loads where every lane lies inside the row; at either end of the row lane
+ * by lane, a lane outside it reading the nearest pixel of the row (callers mask it). x0 may be
+ * negative (the a-trous filter's taps left of the image). */
 static inline void pg_load_row_float4_rows(__global const float4* row, int x0, int width,
                                            pg_floatw* x, pg_floatw* y, pg_floatw* z, pg_floatw* w) {
-  if (x0 + PG_LANES <= width) {
+  if (x0 >= 0 && x0 + PG_LANES <= width) {
     pg_load_float4_rows(row + x0, x, y, z, w);
     return;
   }
   float v[4][PG_LANES];
-  for (int l = 0; l < PG_LANES; ++l) pg_put4_rows(v, 0, l, row[min(x0 + l, width - 1)]);
+  for (int l = 0; l < PG_LANES; ++l) pg_put4_rows(v, 0, l, row[clamp(x0 + l, 0, width - 1)]);
   *x = pg_vloadw(0, v[0]);
   *y = pg_vloadw(0, v[1]);
   *z = pg_vloadw(0, v[2]);
   *w = pg_vloadw(0, v[3]);
 }
 
-/* A uint channel of the same pixels (pg_load_row_float4_rows' rule at the row's end). */
+/* A uint channel of the same pixels (pg_load_row_float4_rows' rule at the row's ends). */
 static inline pg_uintw pg_load_row_uints(__global const uint* row, int x0, int width) {
-  if (x0 + PG_LANES <= width) return pg_vloadw(0, row + x0);
+  if (x0 >= 0 && x0 + PG_LANES <= width) return pg_vloadw(0, row + x0);
   uint v[PG_LANES];
-  for (int l = 0; l < PG_LANES; ++l) v[l] = row[min(x0 + l, width - 1)];
+  for (int l = 0; l < PG_LANES; ++l) v[l] = row[clamp(x0 + l, 0, width - 1)];
+  return pg_vloadw(0, v);
+}
+
+/* A float channel of the same pixels (the same rule). */
+static inline pg_floatw pg_load_row_floats(__global const float* row, int x0, int width) {
+  if (x0 >= 0 && x0 + PG_LANES <= width) return pg_vloadw(0, row + x0);
+  float v[PG_LANES];
+  for (int l = 0; l < PG_LANES; ++l) v[l] = row[clamp(x0 + l, 0, width - 1)];
   return pg_vloadw(0, v);
 }
 

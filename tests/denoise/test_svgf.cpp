@@ -110,20 +110,29 @@ void expect_close(const std::vector<glm::vec4>& device, const std::vector<glm::v
 }
 
 struct Case {
-  int width, height, local_x, local_y;
+  int width, height, local_x, local_y, atrous_lanes;
 };
 
-// Every stage of three frames of a panning camera, device against host.
+// Every stage of three frames of a panning camera, device against host, with the a-trous
+// kernel one pixel per work-item and in vector lanes (widths that are not a multiple of the
+// lanes, images narrower than one work-item's lanes).
 TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
   ClRuntime rt;
-  std::vector<Case> cases = {{37, 23, 16, 16}, {17, 13, 1, 1}, {40, 9, 7, 3}, {1, 1, 8, 8}};
-  if (!simulated(rt)) cases.push_back({130, 71, 16, 8});
+  std::vector<Case> cases = {{37, 23, 16, 16, 1}, {37, 23, 4, 4, 16}, {17, 13, 1, 1, 1},
+                             {17, 13, 1, 1, 4},   {40, 9, 7, 3, 8},   {40, 9, 2, 5, 2},
+                             {1, 1, 8, 8, 1},     {1, 1, 8, 8, 16},   {37, 23, 16, 16, 0}};
+  if (!simulated(rt)) {
+    cases.push_back({130, 71, 16, 8, 1});
+    cases.push_back({130, 71, 16, 8, 16});
+  }
   for (const Case& c : cases) {
     SCOPED_TRACE(std::to_string(c.width) + "x" + std::to_string(c.height) + ", local " +
-                 std::to_string(c.local_x) + "x" + std::to_string(c.local_y));
+                 std::to_string(c.local_x) + "x" + std::to_string(c.local_y) + ", a-trous lanes " +
+                 std::to_string(c.atrous_lanes));
     SvgfSettings s;
     s.local_x = c.local_x;
     s.local_y = c.local_y;
+    s.atrous_lanes = c.atrous_lanes;
     s.history_iteration = 1;
     SvgfDenoiser device(rt, c.width, c.height, s);
     SvgfReference host(c.width, c.height, s);
@@ -319,6 +328,14 @@ TEST(SvgfKernels, BadInputIsAClearError) {
     EXPECT_NE(std::string(e.what()).find("history_iteration"), std::string::npos) << e.what();
   }
   EXPECT_THROW(SvgfDenoiser(rt, 0, 8), InputError);
+  SvgfSettings three_lanes;
+  three_lanes.atrous_lanes = 3;
+  try {
+    SvgfDenoiser d(rt, 8, 8, three_lanes);
+    ADD_FAILURE() << "atrous_lanes 3 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("atrous_lanes = 3"), std::string::npos) << e.what();
+  }
   SvgfSettings nan;
   nan.phi_luminance = std::nanf("");
   EXPECT_THROW(SvgfReference(8, 8, nan), InputError);

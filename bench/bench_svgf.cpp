@@ -1,0 +1,230 @@
+// SVGF's kernels (kernels/svgf_*.cl through SvgfDenoiser; docs/denoising.md) on real frames: the
+// Cornell box and Crytek Sponza path-traced at 1 spp (guiding off, static camera, no jitter, so
+// one G-buffer serves every frame), denoised frame after frame once the history is full (the
+// steady state of a real-time sequence: variance from the temporal moments, no disocclusions).
+//
+//   bench_svgf                  960x540 and 1920x1080, the a-trous kernel one pixel per
+//                               work-item (lanes:1) and in the device's SIMD lanes (lanes:auto)
+//   bench_svgf --benchmark_filter='cornell/960'
+//
+// Time is the sum of the kernels' OpenCL profiling-event times of one denoise() (manual time).
+// Counters (means over the iterations of a repetition; the aggregates give their medians):
+//   <stage>_ms           temporal, variance, atrous (all iterations), remodulate, and upload and
+//                        download (host <-> device copies, wall time)
+//   svgf_ms              every stage, copies included: what a frame pays for the denoiser
+//   pt_frame_ms          the path-traced frame (median of the frames rendered for the inputs)
+//   frame_fraction       svgf_ms / pt_frame_ms (issue 11's target: at most 0.1 at 960x540)
+//   <kernel>_flops_px, <kernel>_bytes_px   per pixel per launch (atrous: per iteration),
+//                        counted along each pixel's path from the hand counts beside the kernels
+//                        (bench_roofline.h's rules: docs/guiding.md, "The roofline")
+//   <kernel>_roofline    the kernel's roofline bound / its time (1: at the roof), the copy
+//                        and multiply-add yardsticks launched in the same iterations
+//   lanes                pixels per work-item of the a-trous kernel
+#include "bench_common.h"
+#include "bench_roofline.h"
+
+#include <map>
+#include <tuple>
+
+#include "denoise/svgf_denoiser.h"
+#include "render/renderer.h"
+#include "shared/svgf.h"
+
+namespace rtpg::bench {
+namespace {
+
+namespace sh = rtpg::shared;
+
+constexpr int kFrames = 4;  // noisy frames cycled through (different seeds, same camera)
+
+struct Frames {
+  GBuffer gbuffer;
+  std::vector<std::vector<glm::vec4>> colour;
+  double pt_frame_ms = 0.0;
+};
+
+Frames* frames_for(const std::string& scene_name, int w, int h, std::string* why) {
+  static std::map<std::tuple<std::string, int, int>, std::unique_ptr<Frames>> cache;
+  const auto key = std::make_tuple(scene_name, w, h);
+  if (auto it = cache.find(key); it != cache.end()) return it->second.get();
+  const Scene* scene = scene_by_name(scene_name, why);
+  if (!scene) return nullptr;
+  RenderSettings settings;
+  settings.width = w;
+  settings.height = h;
+  settings.jitter = false;
+  settings.path_tracer.max_bounces = scene->max_bounces > 0 ? scene->max_bounces : 8;
+  Renderer renderer(*scene, settings);
+  auto f = std::make_unique<Frames>();
+  std::vector<double> times;
+  for (int k = 0; k < kFrames; ++k) {
+    times.push_back(renderer.render_frame(k).time_ms.at("total"));
+    std::vector<glm::vec4> c(renderer.image().size());
+    for (std::size_t i = 0; i < c.size(); ++i) c[i] = glm::vec4(renderer.image()[i], 1.0f);
+    f->colour.push_back(std::move(c));
+  }
+  f->gbuffer = renderer.gbuffer();
+  std::sort(times.begin(), times.end());
+  f->pt_frame_ms = times[times.size() / 2];
+  return (cache[key] = std::move(f)).get();
+}
+
+// Flops and bytes per launch of each kernel along each pixel's path, from the counts beside the
+// kernels (kernels/svgf_temporal.cl, svgf_variance.cl, svgf_atrous.cl, svgf_remodulate.cl), for
+// the state the denoiser is in after the frame (history lengths, depths).
+struct Counts {
+  double temporal_flops = 0, variance_flops = 0, atrous_flops = 0, remodulate_flops = 0;
+  double temporal_bytes = 0, variance_bytes = 0, atrous_bytes = 0, remodulate_bytes = 0;
+};
+
+// x^n by repeated squaring (pg_svgf_power): one squaring per bit of n, one multiply per set bit.
+double power_flops(int n) {
+  int bits = 0, ones = 0;
+  for (; n != 0; n >>= 1) {
+    ++bits;
+    ones += n & 1;
+  }
+  return bits + ones;
+}
+
+Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const SvgfSettings& s) {
+  const int w = g.width, h = g.height;
+  const double power = power_flops(s.phi_normal);
+  const double atrous_tap = 42 + power, variance_tap = 40 + power;
+  auto taps_inside = [&](int x, int y, int radius, int step) {
+    int nx = 0, ny = 0;
+    for (int d = -radius; d <= radius; ++d) {
+      nx += x + d * step >= 0 && x + d * step < w;
+      ny += y + d * step >= 0 && y + d * step < h;
+    }
+    return static_cast<double>(nx) * ny;
+  };
+  Counts c;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (!g.has_surface(i)) {
+        c.temporal_bytes += 4 + 52;
+        c.variance_bytes += 16 + 16;
+        c.variance_flops += 1;
+        c.atrous_bytes += s.iterations * 48.0;
+        c.atrous_flops += s.iterations * 1.0;
+        c.remodulate_bytes += 4 + 16 + 16;
+        continue;
+      }
+      // temporal, static camera: one bilinear tap of weight 1 (the others have weight 0),
+      // tested and accepted.
+      c.temporal_bytes += 96 + 68 + 52;
+      c.temporal_flops += 41 + 4 * 8 + 19 + 15 + 30;
+      const bool spatial = moments[i].z < static_cast<float>(s.min_history);
+      c.variance_bytes += 16 + 16 + 16 + 16 + (spatial ? 4 : 0);
+      c.variance_flops += spatial ? 15 + variance_tap * taps_inside(x, y, 3, 1) : 5;
+      for (int k = 0; k < s.iterations; ++k)
+        c.atrous_flops +=
+            11 + 3 * taps_inside(x, y, 1, 1) + atrous_tap * taps_inside(x, y, 2, 1 << k) + 5;
+      c.atrous_bytes += s.iterations * 52.0;
+      c.remodulate_bytes += 4 + 16 + 16 + 16 + 16;
+      c.remodulate_flops += 9;
+    }
+  return c;
+}
+
+struct Setup {
+  std::unique_ptr<SvgfDenoiser> denoiser;
+  Counts counts;
+  int next = 0;
+};
+
+Setup* setup_for(const std::string& scene_name, int w, int h, int lanes, std::string* why) {
+  static std::map<std::tuple<std::string, int, int, int>, std::unique_ptr<Setup>> cache;
+  const auto key = std::make_tuple(scene_name, w, h, lanes);
+  if (auto it = cache.find(key); it != cache.end()) return it->second.get();
+  Frames* f = frames_for(scene_name, w, h, why);
+  if (!f) return nullptr;
+  auto s = std::make_unique<Setup>();
+  SvgfSettings settings;
+  settings.atrous_lanes = lanes;
+  s->denoiser = std::make_unique<SvgfDenoiser>(runtime(), w, h, settings);
+  // Two passes over the frames: the history is past min_history everywhere (steady state).
+  for (int k = 0; k < 2 * kFrames; ++k) s->denoiser->denoise(f->colour[k % kFrames], f->gbuffer);
+  s->counts = count(f->gbuffer, s->denoiser->read(SvgfStage::Moments), settings);
+  return (cache[key] = std::move(s)).get();
+}
+
+void BM_Svgf(benchmark::State& state, const std::string& scene_name, int w, int h, int lanes) {
+  std::string why;
+  Setup* s = nullptr;
+  try {
+    s = setup_for(scene_name, w, h, lanes, &why);
+  } catch (const std::exception& e) {
+    why = e.what();
+  }
+  if (!s) {
+    state.SkipWithError(why.c_str());
+    return;
+  }
+  Frames& f = *frames_for(scene_name, w, h, &why);
+  Copy& copy_kernel = copy();
+  FmaPeak& fma = fma_peak16();
+  std::map<std::string, double> sum;
+  double copy_ms = 0.0, fma_ms = 0.0;
+  const char* kernels[] = {"temporal", "variance", "atrous", "remodulate"};
+  for (auto _ : state) {
+    s->denoiser->denoise(f.colour[s->next++ % kFrames], f.gbuffer);
+    const std::map<std::string, double>& t = s->denoiser->times_ms();
+    double kernel_ms = 0.0;
+    for (const char* k : kernels) {
+      const double ms = t.at(std::string("svgf_") + k);
+      sum[k] += ms;
+      kernel_ms += ms;
+    }
+    sum["upload"] += t.at("svgf_upload");
+    sum["download"] += t.at("svgf_download");
+    sum["svgf"] += t.at("svgf_total");
+    state.SetIterationTime(kernel_ms * 1e-3);
+    copy_ms += copy_kernel.run();
+    fma_ms += fma.run();
+  }
+  const double it = static_cast<double>(state.iterations());
+  const double n = static_cast<double>(w) * h;
+  const Counts& c = s->counts;
+  const double flops[] = {c.temporal_flops, c.variance_flops, c.atrous_flops, c.remodulate_flops};
+  const double bytes[] = {c.temporal_bytes, c.variance_bytes, c.atrous_bytes, c.remodulate_bytes};
+  for (int k = 0; k < 4; ++k) {
+    const std::string name = kernels[k];
+    const double ms = sum[name] / it;
+    state.counters[name + "_ms"] = ms;
+    state.counters[name + "_flops_px"] = flops[k] / n;
+    state.counters[name + "_bytes_px"] = bytes[k] / n;
+    state.counters[name + "_roofline"] = roofline_ms(bytes[k], flops[k], copy_ms, fma_ms, it) / ms;
+  }
+  state.counters["upload_ms"] = sum["upload"] / it;
+  state.counters["download_ms"] = sum["download"] / it;
+  state.counters["svgf_ms"] = sum["svgf"] / it;
+  state.counters["pt_frame_ms"] = f.pt_frame_ms;
+  state.counters["frame_fraction"] = sum["svgf"] / it / f.pt_frame_ms;
+  state.counters["lanes"] = s->denoiser->atrous_lanes();
+  state.SetItemsProcessed(static_cast<std::int64_t>(n) * state.iterations());
+}
+
+void register_all(bool /*full*/) {
+  benchmark::AddCustomContext("opencl_device", runtime().info().device_name);
+  for (const char* scene : {"cornell", "sponza"})
+    for (auto [w, h] : {std::pair{960, 540}, std::pair{1920, 1080}})
+      for (int lanes : {1, 0}) {
+        const std::string name =
+            std::string(scene) + "/" + std::to_string(w) + "x" + std::to_string(h) +
+            "/lanes:" + (lanes == 0 ? std::string("auto") : std::to_string(lanes));
+        benchmark::RegisterBenchmark(name.c_str(), BM_Svgf, std::string(scene), w, h, lanes)
+            ->UseManualTime()
+            ->Unit(benchmark::kMillisecond)
+            ->MinTime(0.5);
+      }
+}
+
+}  // namespace
+}  // namespace rtpg::bench
+
+int main(int argc, char** argv) {
+  return rtpg::bench::bench_main(argc, argv, rtpg::bench::register_all);
+}

@@ -1,0 +1,34 @@
+/* SVGF's a-trous edge-stopping weight (kernels/shared/svgf.h, pg_svgf_edge_weight) for
+ * PG_LANES pixels of a row in vector lanes (kernels/wide/lanes.h): the same operations in the
+ * same order, so each lane equals the scalar function. OpenCL C only. */
+#ifndef RTPG_WIDE_SVGF_WIDE_H
+#define RTPG_WIDE_SVGF_WIDE_H
+
+#include "shared/svgf.h"
+#include "wide/lanes.h"
+
+/* x^n by repeated squaring, as pg_svgf_power (n is the same for every lane). */
+static inline pg_floatw pg_svgf_power_w(pg_floatw x, uint n) {
+  pg_floatw r = (pg_floatw)(1.0f);
+  for (; n != 0u; n >>= 1) {
+    if ((n & 1u) != 0u) r *= x;
+    x *= x;
+  }
+  return r;
+}
+
+/* pg_svgf_edge_weight in the lanes: the centre's normal n_c and depth z_c, its depth slope and
+ * luminance, a tap's normal n_q, depth z_q and luminance, the tap's distance in pixels (the same
+ * for every lane) and the centre's inverse_phi_l. A tap without a surface gets 0. */
+static inline pg_floatw pg_svgf_edge_weight_w(pg_float3w n_c, pg_floatw z_c, pg_floatw slope_c,
+                                              pg_floatw luminance_c, pg_float3w n_q, pg_floatw z_q,
+                                              pg_floatw luminance_q, float distance,
+                                              pg_floatw inverse_phi_l, pg_svgf_settings s) {
+  pg_floatw cos_n = fmin(fmax(pg_dot3w(n_c, n_q), 0.0f), 1.0f);
+  pg_floatw phi_z = s.phi_depth * slope_c * distance + PG_SVGF_DEPTH_EPSILON * z_c;
+  pg_floatw e = fabs(z_c - z_q) / phi_z + fabs(luminance_c - luminance_q) * inverse_phi_l;
+  pg_floatw w = pg_svgf_power_w(cos_n, s.phi_normal) * exp(-e);
+  return select((pg_floatw)(0.0f), w, z_q > 0.0f);
+}
+
+#endif
