@@ -6,20 +6,21 @@
  * "Cost"), since its work-item loops are not vectorised either way. */
 #pragma OPENCL FP_CONTRACT OFF
 
+#include "shared/planar.h"
 #include "shared/svgf.h"
 
 /* clang-format off */
-__kernel void svgf_atrous(__global const float4* in, __global float4* out,
-                          __global const float4* surface, __global const float* depth_slope,
+__kernel void svgf_atrous(__global const float* in, __global float* out,
+                          __global const float* surface, __global const float* depth_slope,
                           uint width, uint height, int step, pg_svgf_settings settings) {
   /* clang-format on */
   uint x = get_global_id(0), y = get_global_id(1);
   if (x >= width || y >= height) return;
-  uint i = y * width + x;
-  float4 sc = surface[i];
-  float4 c = in[i];
+  uint i = y * width + x, n = width * height;
+  float4 sc = pg_planar_get(surface, n, i);
+  float4 c = pg_planar_get(in, n, i);
   if (sc.w <= 0.0f) {
-    out[i] = c;
+    pg_planar_set(out, n, i, c);
     return;
   }
   /* The centre's variance through a 3x3 Gaussian (taps inside the image, renormalised). */
@@ -31,7 +32,7 @@ __kernel void svgf_atrous(__global const float4* in, __global float4* out,
       int qx = (int)x + dx;
       if (qx < 0 || qx >= (int)width) continue;
       float g = pg_svgf_gauss3(dx, dy);
-      sum_gv += g * in[(uint)qy * width + (uint)qx].w;
+      sum_gv += g * in[3u * n + (uint)qy * width + (uint)qx];
       sum_g += g;
     }
   }
@@ -47,16 +48,16 @@ __kernel void svgf_atrous(__global const float4* in, __global float4* out,
       int qx = (int)x + dx * step;
       if (qx < 0 || qx >= (int)width) continue;
       uint j = (uint)qy * width + (uint)qx;
-      float4 q = in[j];
+      float4 q = pg_planar_get(in, n, j);
       float distance = (float)step * sqrt((float)(dx * dx + dy * dy));
       float w = pg_svgf_b3(dx) * pg_svgf_b3(dy) *
-                pg_svgf_edge_weight(sc, slope, lc, surface[j], pg_luminance(q.xyz), distance,
-                                    inverse_phi_l, settings);
+                pg_svgf_edge_weight(sc, slope, lc, pg_planar_get(surface, n, j),
+                                    pg_luminance(q.xyz), distance, inverse_phi_l, settings);
       sum_c += w * q.xyz;
       sum_v += w * w * q.w;
       sum_w += w;
     }
   }
   /* sum_w >= 9/64: the centre's weight is b3(0)^2 exp(0). */
-  out[i] = (float4)(sum_c / sum_w, sum_v / (sum_w * sum_w));
+  pg_planar_set(out, n, i, (float4)(sum_c / sum_w, sum_v / (sum_w * sum_w)));
 }

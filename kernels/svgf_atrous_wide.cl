@@ -1,45 +1,45 @@
 /* svgf_atrous.cl with PG_LANES (a build option, kernels/wide/lanes.h) consecutive pixels of a
  * row per work-item in vector lanes (docs/denoising.md, "Cost"): every tap of the 5x5 kernel
- * loads the PG_LANES tap pixels of a row as vectors, so a CPU device's compiler emits SIMD code
- * for the 25 edge-stopping weights, which it does not for one pixel per work-item. The same
+ * loads each channel of the PG_LANES tap pixels as one vector from the planar images, so a CPU
+ * device's compiler emits SIMD code for the 25 edge-stopping weights, which it does not for one
+ * pixel per work-item. The same
  * operations in the same order as svgf_atrous.cl: a tap outside the image adds a zero weight
  * where the scalar kernel skips it, which leaves every sum the same. */
 #pragma OPENCL FP_CONTRACT OFF
 
+#include "shared/planar.h"
 #include "shared/svgf.h"
 #include "wide/lanes.h"
 #include "wide/svgf_wide.h"
 
 /* clang-format off */
-__kernel void svgf_atrous_wide(__global const float4* in, __global float4* out,
-                               __global const float4* surface, __global const float* depth_slope,
+__kernel void svgf_atrous_wide(__global const float* in, __global float* out,
+                               __global const float* surface, __global const float* depth_slope,
                                uint width, uint height, int step, pg_svgf_settings settings) {
   /* clang-format on */
   int w = (int)width, h = (int)height;
   int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
   if (x0 >= w || y >= h) return;
-  int row_start = y * w;
+  int row_start = y * w, n = w * h;
   pg_intw lane_x = x0 + pg_lane_numbers();
 
   pg_float3w c, n_c;
   pg_floatw variance_c, z_c;
-  pg_load_row_float4_rows(in + row_start, x0, w, &c.x, &c.y, &c.z, &variance_c);
-  pg_load_row_float4_rows(surface + row_start, x0, w, &n_c.x, &n_c.y, &n_c.z, &z_c);
+  pg_load_planar_row(in, n, row_start, x0, w, &c, &variance_c);
+  pg_load_planar_row(surface, n, row_start, x0, w, &n_c, &z_c);
   /* As svgf_atrous.cl's test (a NaN depth is filtered there too). */
   pg_intw filtered = ~(z_c <= 0.0f);
 
   pg_float3w sum_c = pg_make_float3w(0.0f, 0.0f, 0.0f);
   pg_floatw sum_v = 0.0f, sum_w = 0.0f;
-  if (pg_max_lane(filtered) != 0) {
+  if (any(filtered)) {
     /* The centre's variance through a 3x3 Gaussian (taps inside the image, renormalised). */
     pg_floatw sum_g = 0.0f, sum_gv = 0.0f;
     for (int dy = -1; dy <= 1; ++dy) {
       int qy = y + dy;
       if (qy < 0 || qy >= h) continue;
       for (int dx = -1; dx <= 1; ++dx) {
-        pg_floatw unused_r, unused_g, unused_b, variance_q;
-        pg_load_row_float4_rows(in + qy * w, x0 + dx, w, &unused_r, &unused_g, &unused_b,
-                                &variance_q);
+        pg_floatw variance_q = pg_load_row_floats(in + 3 * n + qy * w, x0 + dx, w);
         pg_intw inside = (lane_x + dx >= 0) & (lane_x + dx < w);
         float g = pg_svgf_gauss3(dx, dy);
         sum_gv += select((pg_floatw)(0.0f), g * variance_q, inside);
@@ -57,8 +57,8 @@ __kernel void svgf_atrous_wide(__global const float4* in, __global float4* out,
         int offset = dx * step;
         pg_float3w q, n_q;
         pg_floatw variance_q, z_q;
-        pg_load_row_float4_rows(in + qy * w, x0 + offset, w, &q.x, &q.y, &q.z, &variance_q);
-        pg_load_row_float4_rows(surface + qy * w, x0 + offset, w, &n_q.x, &n_q.y, &n_q.z, &z_q);
+        pg_load_planar_row(in, n, qy * w, x0 + offset, w, &q, &variance_q);
+        pg_load_planar_row(surface, n, qy * w, x0 + offset, w, &n_q, &z_q);
         pg_intw inside = (lane_x + offset >= 0) & (lane_x + offset < w);
         float distance = (float)step * sqrt((float)(dx * dx + dy * dy));
         pg_floatw weight =
@@ -79,11 +79,8 @@ __kernel void svgf_atrous_wide(__global const float4* in, __global float4* out,
   pg_float3w result = pg_select3w(c, mean_c, filtered);
   pg_floatw result_v = select(variance_c, sum_v / (safe_w * safe_w), filtered);
 
-  float rows[4][PG_LANES];
-  pg_vstorew(result.x, 0, rows[0]);
-  pg_vstorew(result.y, 0, rows[1]);
-  pg_vstorew(result.z, 0, rows[2]);
-  pg_vstorew(result_v, 0, rows[3]);
-  for (int l = 0; l < PG_LANES && x0 + l < w; ++l)
-    out[row_start + x0 + l] = (float4)(rows[0][l], rows[1][l], rows[2][l], rows[3][l]);
+  pg_store_row_floats(out + row_start, x0, w, result.x);
+  pg_store_row_floats(out + n + row_start, x0, w, result.y);
+  pg_store_row_floats(out + 2 * n + row_start, x0, w, result.z);
+  pg_store_row_floats(out + 3 * n + row_start, x0, w, result_v);
 }

@@ -2,10 +2,11 @@
  * Pixels without a surface keep their input colour (the sky is not filtered). */
 #pragma OPENCL FP_CONTRACT OFF
 
+#include "shared/planar.h"
 #include "shared/svgf.h"
 
 /* clang-format off */
-__kernel void svgf_remodulate(__global const float4* illumination, __global const float4* colour,
+__kernel void svgf_remodulate(__global const float* illumination, __global const float4* colour,
                               __global const float4* emission,
                               __global const float4* base_color_roughness,
                               __global const uint* flags, __global float4* out, uint width,
@@ -13,11 +14,13 @@ __kernel void svgf_remodulate(__global const float4* illumination, __global cons
   /* clang-format on */
   uint x = get_global_id(0), y = get_global_id(1);
   if (x >= width || y >= height) return;
-  uint i = y * width + x;
+  uint i = y * width + x, n = width * height;
   if (!pg_svgf_has_surface(flags[i])) {
     out[i] = colour[i];
     return;
   }
   float3 albedo = pg_svgf_albedo(base_color_roughness[i], settings.albedo_floor);
-  out[i] = (float4)(pg_svgf_remodulate(illumination[i].xyz, emission[i].xyz, albedo), 1.0f);
+  out[i] =
+      (float4)(pg_svgf_remodulate(pg_planar_get(illumination, n, i).xyz, emission[i].xyz, albedo),
+               1.0f);
 }

@@ -6,6 +6,7 @@
 /* Each operation rounded on its own, as in the host reference. */
 #pragma OPENCL FP_CONTRACT OFF
 
+#include "shared/planar.h"
 #include "shared/svgf.h"
 
 /* clang-format off */
@@ -18,26 +19,26 @@ __kernel void svgf_temporal(__global const float4* colour, __global const float4
                             __global const float4* prev_position_depth,
                             __global const float4* prev_shading_normal,
                             __global const uint* prev_material,
-                            __global const float4* prev_history,
-                            __global const float4* prev_moments,
-                            __global float4* surface, __global float* depth_slope,
-                            __global float4* integrated, __global float4* moments,
+                            __global const float* prev_history,
+                            __global const float* prev_moments,
+                            __global float* surface, __global float* depth_slope,
+                            __global float* integrated, __global float* moments,
                             uint width, uint height, uint has_history,
                             pg_svgf_settings settings) {
   /* clang-format on */
   uint x = get_global_id(0), y = get_global_id(1);
   if (x >= width || y >= height) return;
-  uint i = y * width + x;
+  uint i = y * width + x, n = width * height;
   if (!pg_svgf_has_surface(flags[i])) {
-    surface[i] = (float4)(0.0f, 0.0f, 1.0f, 0.0f);
+    pg_planar_set(surface, n, i, (float4)(0.0f, 0.0f, 1.0f, 0.0f));
     depth_slope[i] = 0.0f;
-    integrated[i] = (float4)(0.0f);
-    moments[i] = (float4)(0.0f);
+    pg_planar_set(integrated, n, i, (float4)(0.0f));
+    pg_planar_set(moments, n, i, (float4)(0.0f));
     return;
   }
   float4 pd = position_depth[i];
-  float3 n = shading_normal[i].xyz;
-  surface[i] = (float4)(n, pd.w);
+  float3 normal = shading_normal[i].xyz;
+  pg_planar_set(surface, n, i, (float4)(normal, pd.w));
   float z_left = x > 0u ? position_depth[i - 1u].w : 0.0f;
   float z_right = x + 1u < width ? position_depth[i + 1u].w : 0.0f;
   float z_down = y > 0u ? position_depth[i - width].w : 0.0f;
@@ -59,12 +60,12 @@ __kernel void svgf_temporal(__global const float4* colour, __global const float4
       float w = pg_svgf_bilinear_tap(position, t, &px, &py);
       if (w <= 0.0f || px < 0 || py < 0 || px >= (int)width || py >= (int)height) continue;
       uint j = (uint)py * width + (uint)px;
-      if (!pg_same_surface(pd, n, m, prev_position_depth[j], prev_shading_normal[j].xyz,
+      if (!pg_same_surface(pd, normal, m, prev_position_depth[j], prev_shading_normal[j].xyz,
                            prev_material[j], settings.reproject_position,
                            settings.reproject_normal))
         continue;
-      sum_history += w * prev_history[j].xyz;
-      sum_moments += w * prev_moments[j];
+      sum_history += w * pg_planar_get(prev_history, n, j).xyz;
+      sum_moments += w * pg_planar_get(prev_moments, n, j);
       sum_weight += w;
     }
   }
@@ -80,6 +81,6 @@ __kernel void svgf_temporal(__global const float4* colour, __global const float4
     mo = (float2)(pg_svgf_blend(history_moments.x, mo.x, wm),
                   pg_svgf_blend(history_moments.y, mo.y, wm));
   }
-  integrated[i] = (float4)(c, 0.0f);
-  moments[i] = (float4)(mo.x, mo.y, length, 0.0f);
+  pg_planar_set(integrated, n, i, (float4)(c, 0.0f));
+  pg_planar_set(moments, n, i, (float4)(mo.x, mo.y, length, 0.0f));
 }

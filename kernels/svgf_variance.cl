@@ -5,27 +5,28 @@
  * a-trous iteration. */
 #pragma OPENCL FP_CONTRACT OFF
 
+#include "shared/planar.h"
 #include "shared/svgf.h"
 
 /* clang-format off */
-__kernel void svgf_variance(__global const float4* integrated, __global const float4* moments,
-                            __global const float4* surface, __global const float* depth_slope,
-                            __global float4* illumination, uint width, uint height,
+__kernel void svgf_variance(__global const float* integrated, __global const float* moments,
+                            __global const float* surface, __global const float* depth_slope,
+                            __global float* illumination, uint width, uint height,
                             pg_svgf_settings settings) {
   /* clang-format on */
   uint x = get_global_id(0), y = get_global_id(1);
   if (x >= width || y >= height) return;
-  uint i = y * width + x;
-  float4 sc = surface[i];
+  uint i = y * width + x, n = width * height;
+  float4 sc = pg_planar_get(surface, n, i);
   if (sc.w <= 0.0f) {
-    illumination[i] = (float4)(0.0f);
+    pg_planar_set(illumination, n, i, (float4)(0.0f));
     return;
   }
-  float4 mc = moments[i];
-  float4 ic = integrated[i];
+  float4 mc = pg_planar_get(moments, n, i);
+  float4 ic = pg_planar_get(integrated, n, i);
   if (mc.z >= settings.min_history) {
     float v = pg_svgf_variance(mc.x, mc.y, mc.z, settings.min_history);
-    illumination[i] = (float4)(ic.xyz, v);
+    pg_planar_set(illumination, n, i, (float4)(ic.xyz, v));
     return;
   }
   float slope = depth_slope[i];
@@ -39,11 +40,11 @@ __kernel void svgf_variance(__global const float4* integrated, __global const fl
       int qx = (int)x + dx;
       if (qx < 0 || qx >= (int)width) continue;
       uint j = (uint)qy * width + (uint)qx;
-      float4 iq = integrated[j];
+      float4 iq = pg_planar_get(integrated, n, j);
       float distance = sqrt((float)(dx * dx + dy * dy));
-      float w = pg_svgf_edge_weight(sc, slope, lc, surface[j], pg_luminance(iq.xyz), distance, 0.0f,
-                                    settings);
-      float4 mq = moments[j];
+      float w = pg_svgf_edge_weight(sc, slope, lc, pg_planar_get(surface, n, j),
+                                    pg_luminance(iq.xyz), distance, 0.0f, settings);
+      float4 mq = pg_planar_get(moments, n, j);
       sum_c += w * iq.xyz;
       sum_m1 += w * mq.x;
       sum_m2 += w * mq.y;
@@ -52,5 +53,5 @@ __kernel void svgf_variance(__global const float4* integrated, __global const fl
   }
   /* sum_w >= 1: the centre's own weight is exp(0). */
   float v = pg_svgf_variance(sum_m1 / sum_w, sum_m2 / sum_w, mc.z, settings.min_history);
-  illumination[i] = (float4)(sum_c / sum_w, v);
+  pg_planar_set(illumination, n, i, (float4)(sum_c / sum_w, v));
 }

@@ -1,6 +1,7 @@
 #include "denoise/svgf_denoiser.h"
 
 #include <chrono>
+#include <cstring>
 #include <initializer_list>
 
 #include "denoise/svgf_reference.h"
@@ -210,9 +211,18 @@ std::vector<glm::vec4> SvgfDenoiser::read(SvgfStage stage) {
     case SvgfStage::Output:
       break;
   }
-  std::vector<glm::vec4> out(static_cast<std::size_t>(width_) * height_);
+  const std::size_t n = static_cast<std::size_t>(width_) * height_;
+  std::vector<float> floats(4 * n);
   translate_cl_errors(
-      [&] { runtime_.queue().enqueueReadBuffer(*b, CL_TRUE, 0, out.size() * 16, out.data()); });
+      [&] { runtime_.queue().enqueueReadBuffer(*b, CL_TRUE, 0, n * 16, floats.data()); });
+  std::vector<glm::vec4> out(n);
+  if (stage == SvgfStage::Output) {  // one float4 per pixel
+    std::memcpy(out.data(), floats.data(), n * 16);
+    return out;
+  }
+  // The denoiser's own images are planar (kernels/shared/svgf.h).
+  for (std::size_t i = 0; i < n; ++i)
+    out[i] = glm::vec4(floats[i], floats[n + i], floats[2 * n + i], floats[3 * n + i]);
   return out;
 }
 

@@ -2,20 +2,24 @@
  * the per-pixel math of kernels/svgf_*.cl, shared with the host reference
  * (host/denoise/svgf_reference.cpp) so that tests compare the two pixel by pixel.
  *
- * The denoiser's buffers, the one description of their layout (one entry per pixel, row-major,
- * pixel i = y * width + x):
- *   surface       float4  xyz shading normal, w linear depth of the primary hit (0: no surface)
+ * The denoiser's buffers, the one description of their layout (row-major, pixel i = y * width +
+ * x, n = width * height pixels). Its own float4 images are planar: channel c (0..3, x..w) of
+ * pixel i at float [c * n + i] (kernels/shared/planar.h), so that a work-item filtering several
+ * consecutive pixels loads each channel of them as one vector (svgf_atrous_wide.cl) and
+ * neighbouring work-items of a GPU read neighbouring floats:
+ *   surface       planar  xyz shading normal, w linear depth of the primary hit (0: no surface)
  *   depth_slope   float   max(|dz/dx|, |dz/dy|) in depth units per pixel (pg_svgf_depth_slope)
- *   integrated    float4  rgb demodulated illumination after temporal accumulation, w 0
- *   moments       float4  x first, y second moment of its luminance (temporal), z history
+ *   integrated    planar  rgb demodulated illumination after temporal accumulation, w 0
+ *   moments       planar  x first, y second moment of its luminance (temporal), z history
  *                         length in frames (0: no surface), w 0
- *   illumination  float4  rgb demodulated illumination, w its variance (the a-trous ping-pong)
- *   history       float4  rgb the filtered illumination kept for the next frame (the output of
- *                         a-trous iteration `history_iteration`), w 0
+ *   illumination  planar  rgb demodulated illumination, w its variance (the a-trous ping-pong)
+ *   history       planar  rgb the filtered illumination kept for the next frame (the output of
+ *                         a-trous iteration `history_iteration`), w its variance (not read)
  * The inputs are the noisy colour (float4, rgb) and the G-buffer channels of
  * include/rtpg/guiding_layout.h (position_depth, shading_normal, base_color_roughness, flags,
- * material, motion) with the primary hit's emission (float4, rgb): colour = albedo *
- * illumination + emission, so the filter never blurs texture or emitters. */
+ * material, motion) with the primary hit's emission (float4, rgb), one float4 per pixel, as is
+ * the denoised colour: colour = albedo * illumination + emission, so the filter never blurs
+ * texture or emitters. */
 #ifndef RTPG_SHARED_SVGF_H
 #define RTPG_SHARED_SVGF_H
 

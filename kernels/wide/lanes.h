@@ -39,6 +39,19 @@ static inline pg_float3w pg_make_float3w(pg_floatw x, pg_floatw y, pg_floatw z) 
   return v;
 }
 
+/* The lane numbers 0 .. PG_LANES - 1. */
+static inline pg_intw pg_lane_numbers(void) {
+#if PG_LANES == 16
+  return (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+#elif PG_LANES == 8
+  return (int8)(0, 1, 2, 3, 4, 5, 6, 7);
+#elif PG_LANES == 4
+  return (int4)(0, 1, 2, 3);
+#else
+  return (int2)(0, 1);
+#endif
+}
+
 /* One float4 of one lane into four private rows (rows field..field+3), as the wide kernels'
  * lane-by-lane paths gather them before loading the rows as vectors. */
 static inline void pg_put4_rows(__private float (*rows)[PG_LANES], int field, int lane, float4 v) {
@@ -112,12 +125,39 @@ static inline pg_uintw pg_load_row_uints(__global const uint* row, int x0, int w
   return pg_vloadw(0, v);
 }
 
-/* A float channel of the same pixels (the same rule). */
+/* A float channel of the same pixels (the same rule). At a row's end (and a row of at least
+ * PG_LANES pixels) one vector load from inside the row, placed in a private row of 2 PG_LANES
+ * floats beside copies of the end pixel, and one load from there at the lanes' offset, instead
+ * of lane-by-lane loads: the a-trous filter's wide taps cross the ends often. */
 static inline pg_floatw pg_load_row_floats(__global const float* row, int x0, int width) {
   if (x0 >= 0 && x0 + PG_LANES <= width) return pg_vloadw(0, row + x0);
+  if (width >= PG_LANES) {
+    float padded[2 * PG_LANES];
+    if (x0 < 0) { /* [pixel 0 repeated | pixels 0 .. PG_LANES - 1] */
+      pg_vstorew((pg_floatw)(row[0]), 0, padded);
+      pg_vstorew(pg_vloadw(0, row), 1, padded);
+      return pg_vloadw(0, padded + PG_LANES + max(x0, -PG_LANES));
+    }
+    /* [the last PG_LANES pixels | the last pixel repeated] */
+    pg_vstorew(pg_vloadw(0, row + width - PG_LANES), 0, padded);
+    pg_vstorew((pg_floatw)(row[width - 1]), 1, padded);
+    return pg_vloadw(0, padded + min(x0 - (width - PG_LANES), PG_LANES));
+  }
   float v[PG_LANES];
   for (int l = 0; l < PG_LANES; ++l) v[l] = row[clamp(x0 + l, 0, width - 1)];
   return pg_vloadw(0, v);
+}
+
+/* Stores v to the pixels x0 .. x0 + PG_LANES - 1 of a float row (x0 >= 0): one vector store
+ * where every lane lies inside the row, lane by lane up to its end otherwise. */
+static inline void pg_store_row_floats(__global float* row, int x0, int width, pg_floatw v) {
+  if (x0 + PG_LANES <= width) {
+    pg_vstorew(v, 0, row + x0);
+    return;
+  }
+  float lanes[PG_LANES];
+  pg_vstorew(v, 0, lanes);
+  for (int l = 0; x0 + l < width; ++l) row[x0 + l] = lanes[l];
 }
 
 /* The largest lane of an int vector. */
@@ -127,19 +167,6 @@ static inline int pg_max_lane(pg_intw v) {
   int m = a[0];
   for (int l = 1; l < PG_LANES; ++l) m = max(m, a[l]);
   return m;
-}
-
-/* The lane numbers 0 .. PG_LANES - 1. */
-static inline pg_intw pg_lane_numbers(void) {
-#if PG_LANES == 16
-  return (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-#elif PG_LANES == 8
-  return (int8)(0, 1, 2, 3, 4, 5, 6, 7);
-#elif PG_LANES == 4
-  return (int4)(0, 1, 2, 3);
-#else
-  return (int2)(0, 1);
-#endif
 }
 
 static inline pg_floatw pg_dot3w(pg_float3w a, pg_float3w b) {

@@ -1,11 +1,31 @@
-/* SVGF's a-trous edge-stopping weight (kernels/shared/svgf.h, pg_svgf_edge_weight) for
- * PG_LANES pixels of a row in vector lanes (kernels/wide/lanes.h): the same operations in the
- * same order, so each lane equals the scalar function. OpenCL C only. */
+/* SVGF in vector lanes (kernels/wide/lanes.h): PG_LANES pixels of a row read from the
+ * denoiser's planar images, and the a-trous edge-stopping weight (kernels/shared/svgf.h,
+ * pg_svgf_edge_weight) with the same operations in the same order, so each lane equals the
+ * scalar function. OpenCL C only. */
 #ifndef RTPG_WIDE_SVGF_WIDE_H
 #define RTPG_WIDE_SVGF_WIDE_H
 
 #include "shared/svgf.h"
 #include "wide/lanes.h"
+
+/* The four channels of the pixels x0 .. x0 + PG_LANES - 1 of the row starting at pixel row_start
+ * of a planar image of n pixels (kernels/shared/svgf.h): rgb or xyz, and w (the row loaders'
+ * rule at the row's ends: kernels/wide/lanes.h). */
+static inline void pg_load_planar_row(__global const float* image, int n, int row_start, int x0,
+                                      int width, pg_float3w* xyz, pg_floatw* w) {
+  __global const float* p = image + row_start;
+  if (x0 >= 0 && x0 + PG_LANES <= width) { /* one test for the four channels */
+    xyz->x = pg_vloadw(0, p + x0);
+    xyz->y = pg_vloadw(0, p + n + x0);
+    xyz->z = pg_vloadw(0, p + 2 * n + x0);
+    *w = pg_vloadw(0, p + 3 * n + x0);
+    return;
+  }
+  xyz->x = pg_load_row_floats(p, x0, width);
+  xyz->y = pg_load_row_floats(p + n, x0, width);
+  xyz->z = pg_load_row_floats(p + 2 * n, x0, width);
+  *w = pg_load_row_floats(p + 3 * n, x0, width);
+}
 
 /* x^n by repeated squaring, as pg_svgf_power (n is the same for every lane). */
 static inline pg_floatw pg_svgf_power_w(pg_floatw x, uint n) {

@@ -23,8 +23,8 @@ bool simulated(const ClRuntime& rt) {
 
 // A G-buffer of a few surfaces the camera sees, as a renderer fills it: a floor plane whose
 // depth grows with y (a slope), two boxes at other depths with their own normals and materials,
-// a sky band, an emitter, textured albedo. The boxes have moved shift_x pixels right since
-// frame 0 and the floor has not, with the motion vectors saying so: the boxes' trailing edges
+// sky (a band and a patch), an emitter, textured albedo. The boxes have moved shift_x pixels right
+// since frame 0 and the floor has not, with the motion vectors saying so: the boxes' trailing edges
 // uncover floor.
 GBuffer scene_gbuffer(int w, int h, float shift_x, std::mt19937& rng) {
   GBuffer g;
@@ -36,7 +36,9 @@ GBuffer scene_gbuffer(int w, int h, float shift_x, std::mt19937& rng) {
       const float bx = static_cast<float>(x) - shift_x;  // a box point's x in frame 0
       const float jitter = 0.5f * (unit(rng) - 0.5f);
       g.motion[i] = glm::vec2(0.0f);
-      if (y < h / 6) {  // sky
+      // Sky: a band across the top, and a patch on the left whose edge splits rows, so that a
+      // work-item of the wide a-trous kernel holds pixels with and without a surface.
+      if (y < h / 6 || (x < w / 5 + 3 && y < h / 2)) {
         g.flags[i] = PG_GBUF_SKY;
         g.emission[i] = glm::vec4(0.3f, 0.5f, 0.9f, 0.0f);
         continue;
