@@ -3,7 +3,12 @@
  * of depth, normal and luminance (the luminance scaled by the prefiltered standard deviation);
  * the variance is filtered with the squared weights. Taps outside the image are skipped: on
  * PoCL's CPU device this is 2x faster than clamped reads with zero weights (docs/denoising.md,
- * "Cost"), since its work-item loops are not vectorised either way. */
+ * "Cost"), since its work-item loops are not vectorised either way (svgf_atrous_wide.cl runs
+ * several pixels per work-item in vector lanes).
+ * Per pixel and iteration (hand count, as svgf_temporal.cl): 11 + 3 per tap of the 3x3
+ * prefilter + (42 + P) per tap of the 5x5 kernel inside the image + 5 flops, P the normal
+ * weight's power (9 for phi_normal 128): 1318 inside the image; 52 bytes. No surface: 1 flop,
+ * 48 bytes. */
 #pragma OPENCL FP_CONTRACT OFF
 
 #include "shared/planar.h"

@@ -1,5 +1,6 @@
 /* SVGF's last step (docs/denoising.md): colour = albedo * filtered illumination + emission.
- * Pixels without a surface keep their input colour (the sky is not filtered). */
+ * Pixels without a surface keep their input colour (the sky is not filtered).
+ * Per pixel (hand count, as svgf_temporal.cl): 9 flops, 68 bytes; no surface: 36 bytes. */
 #pragma OPENCL FP_CONTRACT OFF
 
 #include "shared/planar.h"

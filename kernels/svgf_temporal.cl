@@ -2,7 +2,11 @@
  * colour by the primary hit's albedo, reprojects last frame's filtered illumination and
  * luminance moments through the motion vector (2x2 bilinear taps, each kept only where
  * pg_same_surface holds: the test guiding's reprojection uses), and blends them with this
- * frame's. Also writes the surface and depth slope the later passes read. */
+ * frame's. Also writes the surface and depth slope the later passes read.
+ * Per pixel (hand count; the rules: docs/guiding.md, "The roofline"; bench/bench_svgf.cpp counts
+ * with it): 41 flops without history; with it 8 per bilinear tap, 34 per tap tested for the same
+ * surface and summed, 30 for the blend. Bytes: 96 read and 52 written, 68 more read where a tap
+ * of last frame is tested; a pixel without a surface reads 4 and writes 52. */
 /* Each operation rounded on its own, as in the host reference. */
 #pragma OPENCL FP_CONTRACT OFF
 
