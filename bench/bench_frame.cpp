@@ -22,6 +22,7 @@
 // The renderers are built and warmed up (kernel compiles, a few frames of training) once per
 // scene and resolution, outside the timed loops.
 #include "bench_common.h"
+#include "bench_roofline.h"
 
 #include <map>
 #include <tuple>
@@ -32,11 +33,6 @@
 
 namespace rtpg::bench {
 namespace {
-
-ClRuntime& runtime() {
-  static ClRuntime rt;
-  return rt;
-}
 
 struct FrameSetup {
   std::unique_ptr<Renderer> off, pmm;
