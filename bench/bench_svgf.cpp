@@ -1,10 +1,14 @@
 // SVGF's kernels (kernels/svgf_*.cl through SvgfDenoiser; docs/denoising.md) on real frames: the
 // Cornell box and Crytek Sponza path-traced at 1 spp (guiding off, static camera, no jitter, so
-// one G-buffer serves every frame), denoised frame after frame once the history is full (the
-// steady state of a real-time sequence: variance from the temporal moments, no disocclusions).
+// one G-buffer serves every frame), denoised frame after frame, in two states:
+//   history:full   the history is full (the steady state of a still camera: variance from the
+//                  temporal moments, no disocclusions);
+//   history:none   every frame starts without history (a camera cut, the first frames, and the
+//                  price of every disoccluded pixel: the 7x7 spatial variance everywhere).
 //
-//   bench_svgf                  960x540 and 1920x1080, the a-trous kernel one pixel per
-//                               work-item (lanes:1) and in the device's SIMD lanes (lanes:auto)
+//   bench_svgf                  960x540 and 1920x1080, the variance and a-trous kernels one
+//                               pixel per work-item (lanes:1) and in the device's SIMD lanes
+//                               (lanes:auto)
 //   bench_svgf --benchmark_filter='cornell/960'
 //
 // Time is the sum of the kernels' OpenCL profiling-event times of one denoise() (manual time).
@@ -19,7 +23,7 @@
 //                        (bench_roofline.h's rules: docs/guiding.md, "The roofline")
 //   <kernel>_roofline    the kernel's roofline bound / its time (1: at the roof), the copy
 //                        and multiply-add yardsticks launched in the same iterations
-//   lanes                pixels per work-item of the a-trous kernel
+//   lanes                pixels per work-item of the variance and a-trous kernels
 #include "bench_common.h"
 #include "bench_roofline.h"
 
@@ -135,27 +139,34 @@ struct Setup {
   int next = 0;
 };
 
-Setup* setup_for(const std::string& scene_name, int w, int h, int lanes, std::string* why) {
-  static std::map<std::tuple<std::string, int, int, int>, std::unique_ptr<Setup>> cache;
-  const auto key = std::make_tuple(scene_name, w, h, lanes);
+// young: every frame starts without history (a camera cut, the first frame; what disoccluded
+// pixels cost), so every pixel takes the variance pass's 7x7 spatial estimate.
+Setup* setup_for(const std::string& scene_name, int w, int h, int lanes, bool young,
+                 std::string* why) {
+  static std::map<std::tuple<std::string, int, int, int, bool>, std::unique_ptr<Setup>> cache;
+  const auto key = std::make_tuple(scene_name, w, h, lanes, young);
   if (auto it = cache.find(key); it != cache.end()) return it->second.get();
   Frames* f = frames_for(scene_name, w, h, why);
   if (!f) return nullptr;
   auto s = std::make_unique<Setup>();
   SvgfSettings settings;
-  settings.atrous_lanes = lanes;
+  settings.lanes = lanes;
   s->denoiser = std::make_unique<SvgfDenoiser>(runtime(), w, h, settings);
   // Two passes over the frames: the history is past min_history everywhere (steady state).
-  for (int k = 0; k < 2 * kFrames; ++k) s->denoiser->denoise(f->colour[k % kFrames], f->gbuffer);
+  for (int k = 0; k < 2 * kFrames; ++k) {
+    if (young) s->denoiser->reset();
+    s->denoiser->denoise(f->colour[k % kFrames], f->gbuffer);
+  }
   s->counts = count(f->gbuffer, s->denoiser->read(SvgfStage::Moments), settings);
   return (cache[key] = std::move(s)).get();
 }
 
-void BM_Svgf(benchmark::State& state, const std::string& scene_name, int w, int h, int lanes) {
+void BM_Svgf(benchmark::State& state, const std::string& scene_name, int w, int h, int lanes,
+             bool young) {
   std::string why;
   Setup* s = nullptr;
   try {
-    s = setup_for(scene_name, w, h, lanes, &why);
+    s = setup_for(scene_name, w, h, lanes, young, &why);
   } catch (const std::exception& e) {
     why = e.what();
   }
@@ -170,6 +181,7 @@ void BM_Svgf(benchmark::State& state, const std::string& scene_name, int w, int 
   double copy_ms = 0.0, fma_ms = 0.0;
   const char* kernels[] = {"temporal", "variance", "atrous", "remodulate"};
   for (auto _ : state) {
+    if (young) s->denoiser->reset();
     s->denoiser->denoise(f.colour[s->next++ % kFrames], f.gbuffer);
     const std::map<std::string, double>& t = s->denoiser->times_ms();
     double kernel_ms = 0.0;
@@ -203,7 +215,7 @@ void BM_Svgf(benchmark::State& state, const std::string& scene_name, int w, int 
   state.counters["svgf_ms"] = sum["svgf"] / it;
   state.counters["pt_frame_ms"] = f.pt_frame_ms;
   state.counters["frame_fraction"] = sum["svgf"] / it / f.pt_frame_ms;
-  state.counters["lanes"] = s->denoiser->atrous_lanes();
+  state.counters["lanes"] = s->denoiser->lanes();
   state.SetItemsProcessed(static_cast<std::int64_t>(n) * state.iterations());
 }
 
@@ -211,15 +223,18 @@ void register_all(bool /*full*/) {
   benchmark::AddCustomContext("opencl_device", runtime().info().device_name);
   for (const char* scene : {"cornell", "sponza"})
     for (auto [w, h] : {std::pair{960, 540}, std::pair{1920, 1080}})
-      for (int lanes : {1, 0}) {
-        const std::string name =
-            std::string(scene) + "/" + std::to_string(w) + "x" + std::to_string(h) +
-            "/lanes:" + (lanes == 0 ? std::string("auto") : std::to_string(lanes));
-        benchmark::RegisterBenchmark(name.c_str(), BM_Svgf, std::string(scene), w, h, lanes)
-            ->UseManualTime()
-            ->Unit(benchmark::kMillisecond)
-            ->MinTime(0.5);
-      }
+      for (int lanes : {1, 0})
+        for (bool young : {false, true}) {
+          const std::string name =
+              std::string(scene) + "/" + std::to_string(w) + "x" + std::to_string(h) +
+              "/lanes:" + (lanes == 0 ? std::string("auto") : std::to_string(lanes)) +
+              "/history:" + (young ? "none" : "full");
+          benchmark::RegisterBenchmark(name.c_str(), BM_Svgf, std::string(scene), w, h, lanes,
+                                       young)
+              ->UseManualTime()
+              ->Unit(benchmark::kMillisecond)
+              ->MinTime(0.5);
+        }
 }
 
 }  // namespace

@@ -36,11 +36,13 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
                                  std::to_string(height));
   kernel_settings_ = to_kernel_settings(settings);
   temporal_ = runtime.kernel("svgf_temporal.cl", "svgf_temporal");
-  variance_ = runtime.kernel("svgf_variance.cl", "svgf_variance");
-  atrous_lanes_ = settings.atrous_lanes != 0 ? settings.atrous_lanes : runtime.info().simd_lanes();
-  atrous_ = atrous_lanes_ > 1 ? runtime.kernel("svgf_atrous_wide.cl", "svgf_atrous_wide",
-                                               "-DPG_LANES=" + std::to_string(atrous_lanes_))
-                              : runtime.kernel("svgf_atrous.cl", "svgf_atrous");
+  lanes_ = settings.lanes != 0 ? settings.lanes : runtime.info().simd_lanes();
+  const std::string lanes_option = "-DPG_LANES=" + std::to_string(lanes_);
+  variance_ = lanes_ > 1
+                  ? runtime.kernel("svgf_variance_wide.cl", "svgf_variance_wide", lanes_option)
+                  : runtime.kernel("svgf_variance.cl", "svgf_variance");
+  atrous_ = lanes_ > 1 ? runtime.kernel("svgf_atrous_wide.cl", "svgf_atrous_wide", lanes_option)
+                       : runtime.kernel("svgf_atrous.cl", "svgf_atrous");
   remodulate_ = runtime.kernel("svgf_remodulate.cl", "svgf_remodulate");
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   translate_cl_errors([&] {
@@ -136,7 +138,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     variance_.setArg(a++, w);
     variance_.setArg(a++, h);
     variance_.setArg(a++, kernel_settings_);
-    times_["svgf_variance"] = run(variance_);
+    times_["svgf_variance"] = run(variance_, lanes_);
 
     double atrous_ms = 0.0;
     // Iteration k reads the variance pass's output (k = 0) or iteration k - 1's, and writes
@@ -153,7 +155,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
       atrous_.setArg(5, h);
       atrous_.setArg(6, static_cast<cl_int>(1 << k));
       atrous_.setArg(7, kernel_settings_);
-      atrous_ms += run(atrous_, atrous_lanes_);
+      atrous_ms += run(atrous_, lanes_);
       in = out;
     }
     filtered_ = in;

@@ -46,8 +46,9 @@ class SvgfDenoiser {
   int width() const { return width_; }
   int height() const { return height_; }
   const SvgfSettings& settings() const { return settings_; }
-  // Pixels per work-item of the a-trous kernel (settings().atrous_lanes, 0 resolved per device).
-  int atrous_lanes() const { return atrous_lanes_; }
+  // Pixels per work-item of the variance and a-trous kernels (settings().lanes, 0 resolved
+  // per device).
+  int lanes() const { return lanes_; }
 
  private:
   // Runs kernel over the image, each work-item covering `lanes` pixels of a row; blocking.
@@ -60,7 +61,7 @@ class SvgfDenoiser {
   ClRuntime& runtime_;
   int width_, height_;
   SvgfSettings settings_;
-  int atrous_lanes_ = 1;
+  int lanes_ = 1;
   shared::pg_svgf_settings kernel_settings_;
   cl::Kernel temporal_, variance_, atrous_, remodulate_;
   std::array<Surfaces, 2> surfaces_;

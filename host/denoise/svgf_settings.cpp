@@ -40,9 +40,9 @@ const std::vector<SvgfSettingInfo>& svgf_settings_table() {
               "The a-trous iteration (from 0) whose output is the next frame's history"),
       integer("local_x", &S::local_x, 1, 65536, "Work-group width of the kernels"),
       integer("local_y", &S::local_y, 1, 65536, "Work-group height of the kernels"),
-      integer("atrous_lanes", &S::atrous_lanes, 0, 16,
-              "Pixels per work-item of the a-trous kernel: 1, 2, 4, 8 or 16 (0: the SIMD width "
-              "on CPUs, else 1)"),
+      integer("lanes", &S::lanes, 0, 16,
+              "Pixels per work-item of the variance and a-trous kernels: 1, 2, 4, 8 or 16 (0: the "
+              "SIMD width on CPUs, else 1)"),
   };
   return table;
 }
@@ -58,8 +58,8 @@ void validate(const SvgfSettings& s) {
     throw InputError("svgf settings", "history_iteration (" + std::to_string(s.history_iteration) +
                                           ") must be below iterations (" +
                                           std::to_string(s.iterations) + ")");
-  if (s.atrous_lanes & (s.atrous_lanes - 1))
-    throw InputError("svgf settings", "atrous_lanes = " + std::to_string(s.atrous_lanes) +
+  if (s.lanes & (s.lanes - 1))
+    throw InputError("svgf settings", "lanes = " + std::to_string(s.lanes) +
                                           " must be 0 (auto) or a power of two: 1, 2, 4, 8 or 16");
 }
 

@@ -26,9 +26,11 @@ struct SvgfSettings {
   int iterations = 5;                // a-trous iterations (steps 1, 2, 4, ...)
   int history_iteration = 0;         // the iteration whose output is next frame's history
   int local_x = 16, local_y = 16;    // work-group size of the kernels
-  int atrous_lanes = 0;  // pixels per work-item of the a-trous kernel: 1 (svgf_atrous.cl), or 2,
-                         // 4, 8, 16 in vector lanes (svgf_atrous_wide.cl); 0 = the device's
-                         // SIMD width on CPUs, 1 elsewhere (DeviceInfo::simd_lanes)
+  // Pixels per work-item of the variance and a-trous kernels: 1 (svgf_variance.cl,
+  // svgf_atrous.cl), or 2, 4, 8, 16 in vector lanes (svgf_variance_wide.cl,
+  // svgf_atrous_wide.cl); 0 = the device's SIMD width on CPUs, 1 elsewhere
+  // (DeviceInfo::simd_lanes).
+  int lanes = 0;
 };
 
 using SvgfSettingInfo = SettingInfo<SvgfSettings>;
@@ -37,7 +39,7 @@ using SvgfSettingInfo = SettingInfo<SvgfSettings>;
 const std::vector<SvgfSettingInfo>& svgf_settings_table();
 
 // Throws InputError ("svgf settings", "<name> = <value> is outside <range>") for a value outside
-// its row's range, a history iteration beyond the last iteration, or atrous_lanes not 0 or a
+// its row's range, a history iteration beyond the last iteration, or lanes not 0 or a
 // power of two.
 void validate(const SvgfSettings& settings);
 
