@@ -8,19 +8,24 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCE_DIRS = ("host", "kernels", "include")
+# Sources that only the denoiser builds from: `rtpg reference` never runs SVGF (host/app/commands.cpp,
+# run_reference), so a change to them leaves every reference valid (docs/denoising.md).
+DENOISER_ONLY = ("host/denoise/", "kernels/svgf_", "kernels/wide/svgf_wide.h", "kernels/shared/svgf.h",
+                 "kernels/shared/planar.h")
 
 
 def rtpg_binary():
     return Path(os.environ.get("RTPG_BINARY", ROOT / "build" / "rtpg"))
 
 
-def renderer_source_hash():
-    """Hash of every source file of the renderer: a reference made by other code is stale."""
+def renderer_source_hash(root=ROOT):
+    """Hash of every source file a reference depends on: a reference made by other code is stale."""
     h = hashlib.sha256()
     for d in SOURCE_DIRS:
-        for p in sorted((ROOT / d).rglob("*")):
-            if p.is_file() and p.suffix in (".h", ".hpp", ".cpp", ".cl"):
-                h.update(str(p.relative_to(ROOT)).encode())
+        for p in sorted((Path(root) / d).rglob("*")):
+            rel = p.relative_to(root).as_posix()
+            if p.is_file() and p.suffix in (".h", ".hpp", ".cpp", ".cl") and not rel.startswith(DENOISER_ONLY):
+                h.update(rel.encode())
                 h.update(p.read_bytes())
     return h.hexdigest()[:16]
 

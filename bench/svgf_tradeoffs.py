@@ -1,0 +1,68 @@
+#!/usr/bin/env python3
+"""SVGF's time against its error: PT+SVGF at 1 spp after T frames (static camera) for variants of
+the denoiser's settings, LDR-FLIP and relMSE of the last frame against the suite's reference, and
+the denoiser's median time per frame (docs/denoising.md, "Cost").
+
+    python3 bench/svgf_tradeoffs.py                                  # cornell-box and sponza, 960x540
+    python3 bench/svgf_tradeoffs.py --scenes cornell-box --frames 16
+
+References come from the suite's cache (bench/experiments.py --out, default build/bench-results):
+a full run of the suite leaves them there; a missing one is rendered (1024 spp, minutes).
+"""
+import argparse
+import json
+import statistics
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from suite import metrics, runner  # noqa: E402
+
+VARIANTS = {
+    "defaults (5 iterations)": [],
+    "4 iterations": ["--svgf-iterations", 4],
+    "3 iterations": ["--svgf-iterations", 3],
+    "2 iterations": ["--svgf-iterations", 2],
+    "one pixel per work-item": ["--svgf-lanes", 1],
+}
+
+
+def median_ms(stats, key):
+    frames = stats["frames"][1:] or stats["frames"]
+    return statistics.median(f["time_ms"].get(key, 0.0) for f in frames)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scenes", nargs="*", default=["cornell-box", "sponza"])
+    ap.add_argument("--res", default="960x540")
+    ap.add_argument("--frames", type=int, default=32)
+    ap.add_argument("--ref-spp", type=int, default=1024)
+    ap.add_argument("--out", default=str(runner.ROOT / "build" / "bench-results"))
+    args = ap.parse_args()
+    out = Path(args.out)
+    refs = runner.ReferenceCache(out / "references")
+    results = {"machine": runner.machine_info(), "res": args.res, "frames": args.frames, "scenes": {}}
+    lines = ["| scene | variant | SVGF ms | a-trous ms | PT frame ms | SVGF / PT | LDR-FLIP | relMSE |",
+             "|---|---|---|---|---|---|---|---|"]
+    for scene in args.scenes:
+        ref = metrics.load_exr(refs.get(scene, args.res, args.ref_spp))
+        rows = {}
+        for k, (name, flags) in enumerate(VARIANTS.items()):
+            stats, image = runner.render(scene, args.res, args.frames, "off", out / "svgf-tradeoffs" / scene,
+                                         f"v{k}", extra=["--denoise", "svgf", *flags])
+            img = metrics.load_exr(image)
+            svgf, pt = median_ms(stats, "svgf_total"), median_ms(stats, "total") - median_ms(stats, "svgf_total")
+            rows[name] = {"flags": [str(f) for f in flags], "svgf_ms": svgf, "atrous_ms": median_ms(stats, "svgf_atrous"),
+                          "pt_frame_ms": pt, "flip_ldr": metrics.flip_ldr(img, ref), "relmse": metrics.relmse(img, ref)}
+            r = rows[name]
+            lines.append(f"| {scene} | {name} | {r['svgf_ms']:.1f} | {r['atrous_ms']:.1f} | {pt:.0f} "
+                         f"| {svgf / pt:.2f} | {r['flip_ldr']:.4f} | {r['relmse']:.4g} |")
+            print(lines[-1], flush=True)
+        results["scenes"][scene] = rows
+    (out / "svgf-tradeoffs.json").write_text(json.dumps(results, indent=2))
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
