@@ -26,10 +26,29 @@ void upload(ClRuntime& rt, const cl::Buffer& b, const std::vector<T>& v) {
   rt.queue().enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
 }
 
+// A buffer the kernels read in place from host memory (zero copy); the kernels only read it
+// (CL_MEM_READ_ONLY), so the const_cast writes nothing.
+template <class T>
+cl::Buffer in_place(ClRuntime& rt, const std::vector<T>& v) {
+  return cl::Buffer(rt.context(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, v.size() * sizeof(T),
+                    const_cast<T*>(v.data()));
+}
+
+template <class T>
+void copy_on_device(ClRuntime& rt, const cl::Buffer& from, const cl::Buffer& to,
+                    const std::vector<T>& v) {
+  rt.queue().enqueueCopyBuffer(from, to, 0, 0, v.size() * sizeof(T));
+}
+
 }  // namespace
 
-SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings)
-    : runtime_(runtime), width_(width), height_(height), settings_(settings) {
+SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings,
+                           bool zero_copy)
+    : runtime_(runtime),
+      width_(width),
+      height_(height),
+      settings_(settings),
+      zero_copy_(zero_copy && runtime.info().host_unified_memory) {
   validate(settings);
   if (width <= 0 || height <= 0)
     throw InputError("svgf", "image size must be positive, got " + std::to_string(width) + "x" +
@@ -68,11 +87,13 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
     }
     for (cl::Buffer& b : moments_) b = buffer(16);
     for (cl::Buffer& b : illumination_) b = buffer(16);
-    colour_ = buffer(16);
-    emission_ = buffer(16);
-    base_color_roughness_ = buffer(16);
-    flags_ = buffer(4);
-    motion_ = buffer(8);
+    if (!zero_copy_) {  // else denoise() reads these in place
+      colour_ = buffer(16);
+      emission_ = buffer(16);
+      base_color_roughness_ = buffer(16);
+      flags_ = buffer(4);
+      motion_ = buffer(8);
+    }
     surface_ = buffer(16);
     depth_slope_ = buffer(4);
     integrated_ = buffer(16);
@@ -105,25 +126,43 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
   const cl_uint w = static_cast<cl_uint>(width_), h = static_cast<cl_uint>(height_);
   const Surfaces& cur = surfaces_[current_];
   const Surfaces& prev = surfaces_[1 - current_];
+  // The inputs the kernels read: the owned buffers the host copies into, or the host's memory.
+  cl::Buffer colour_in = colour_, emission_in = emission_,
+             base_color_roughness_in = base_color_roughness_, flags_in = flags_,
+             motion_in = motion_;
   translate_cl_errors([&] {
     const auto start = Clock::now();
-    upload(runtime_, colour_, colour);
-    upload(runtime_, emission_, g.emission);
-    upload(runtime_, cur.position_depth, g.position_depth);
-    upload(runtime_, cur.shading_normal, g.shading_normal);
-    upload(runtime_, base_color_roughness_, g.base_color_roughness);
-    upload(runtime_, flags_, g.flags);
-    upload(runtime_, cur.material, g.material);
-    upload(runtime_, motion_, g.motion);
+    if (zero_copy_) {
+      colour_in = in_place(runtime_, colour);
+      emission_in = in_place(runtime_, g.emission);
+      base_color_roughness_in = in_place(runtime_, g.base_color_roughness);
+      flags_in = in_place(runtime_, g.flags);
+      motion_in = in_place(runtime_, g.motion);
+      // Next frame's history test compares with these, after the host has moved on.
+      copy_on_device(runtime_, in_place(runtime_, g.position_depth), cur.position_depth,
+                     g.position_depth);
+      copy_on_device(runtime_, in_place(runtime_, g.shading_normal), cur.shading_normal,
+                     g.shading_normal);
+      copy_on_device(runtime_, in_place(runtime_, g.material), cur.material, g.material);
+    } else {
+      upload(runtime_, colour_, colour);
+      upload(runtime_, emission_, g.emission);
+      upload(runtime_, cur.position_depth, g.position_depth);
+      upload(runtime_, cur.shading_normal, g.shading_normal);
+      upload(runtime_, base_color_roughness_, g.base_color_roughness);
+      upload(runtime_, flags_, g.flags);
+      upload(runtime_, cur.material, g.material);
+      upload(runtime_, motion_, g.motion);
+    }
     runtime_.queue().finish();  // the host vectors may change once denoise() returns
     times_["svgf_upload"] = ms_since(start);
 
     int a = 0;
-    for (const cl::Buffer* b :
-         BufferList{&colour_, &emission_, &cur.position_depth, &cur.shading_normal,
-                    &base_color_roughness_, &flags_, &cur.material, &motion_, &prev.position_depth,
-                    &prev.shading_normal, &prev.material, &history_, &moments_[1 - current_],
-                    &surface_, &depth_slope_, &integrated_, &moments_[current_]})
+    for (const cl::Buffer* b : BufferList{
+             &colour_in, &emission_in, &cur.position_depth, &cur.shading_normal,
+             &base_color_roughness_in, &flags_in, &cur.material, &motion_in, &prev.position_depth,
+             &prev.shading_normal, &prev.material, &history_, &moments_[1 - current_], &surface_,
+             &depth_slope_, &integrated_, &moments_[current_]})
       temporal_.setArg(a++, *b);
     temporal_.setArg(a++, w);
     temporal_.setArg(a++, h);
@@ -162,8 +201,8 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     times_["svgf_atrous"] = atrous_ms;
 
     a = 0;
-    for (const cl::Buffer* b :
-         BufferList{filtered_, &colour_, &emission_, &base_color_roughness_, &flags_, &output_})
+    for (const cl::Buffer* b : BufferList{filtered_, &colour_in, &emission_in,
+                                          &base_color_roughness_in, &flags_in, &output_})
       remodulate_.setArg(a++, *b);
     remodulate_.setArg(a++, w);
     remodulate_.setArg(a++, h);
@@ -184,7 +223,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
 }
 
 double SvgfDenoiser::host_device_bytes_per_pixel() const {
-  return kUploadBytesPerPixel + kDownloadBytesPerPixel;
+  return (zero_copy_ ? 0.0 : kUploadBytesPerPixel) + kDownloadBytesPerPixel;
 }
 
 std::vector<glm::vec4> SvgfDenoiser::read(SvgfStage stage) {

@@ -1,7 +1,8 @@
 // SVGF on the OpenCL device (docs/denoising.md): per frame, the noisy colour and the G-buffer go
-// up, four kernels run (kernels/svgf_temporal.cl, svgf_variance.cl, svgf_atrous.cl once per
-// iteration, svgf_remodulate.cl) and the denoised colour comes back. The history (filtered
-// illumination, moments, last frame's surfaces) stays on the device between frames.
+// up (or are read in place where the device shares host memory), four kernels run
+// (kernels/svgf_temporal.cl, svgf_variance.cl, svgf_atrous.cl once per iteration,
+// svgf_remodulate.cl) and the denoised colour comes back. The history (filtered illumination,
+// moments, last frame's surfaces) stays on the device between frames.
 #pragma once
 
 #include <array>
@@ -21,8 +22,12 @@ namespace rtpg {
 class SvgfDenoiser {
  public:
   // Throws InputError for settings out of range, a size below 1x1 or a work-group size the
-  // device refuses.
-  SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings = {});
+  // device refuses. zero_copy: where the device shares host memory
+  // (DeviceInfo::host_unified_memory), denoise() reads the noisy colour and the G-buffer in
+  // place (CL_MEM_USE_HOST_PTR) instead of copying them, and keeps the channels the next frame's
+  // history test needs by a copy on the device.
+  SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings = {},
+               bool zero_copy = true);
   SvgfDenoiser(const SvgfDenoiser&) = delete;
   SvgfDenoiser& operator=(const SvgfDenoiser&) = delete;
 
@@ -38,6 +43,9 @@ class SvgfDenoiser {
   const std::map<std::string, double>& times_ms() const { return times_; }
   // Bytes copied between host and device per pixel by denoise().
   double host_device_bytes_per_pixel() const;
+  // Whether denoise() reads its inputs in place (the constructor's zero_copy on a device that
+  // shares host memory).
+  bool zero_copy() const { return zero_copy_; }
 
   // Downloads an intermediate image of the last frame (tests compare it with SvgfReference).
   std::vector<glm::vec4> read(SvgfStage stage);
@@ -62,6 +70,7 @@ class SvgfDenoiser {
   int width_, height_;
   SvgfSettings settings_;
   int lanes_ = 1;
+  bool zero_copy_ = false;
   shared::pg_svgf_settings kernel_settings_;
   cl::Kernel temporal_, variance_, atrous_, remodulate_;
   std::array<Surfaces, 2> surfaces_;

@@ -282,6 +282,35 @@ TEST(SvgfKernels, TemporalAccumulationConvergesToTheMean) {
   }
 }
 
+// Reading the inputs in place (zero copy, where the device shares host memory) gives the same
+// frames bit for bit as copying them, with the host rewriting one G-buffer and one colour buffer
+// every frame as the renderer does: last frame's surfaces must have been kept on the device.
+TEST(SvgfKernels, ZeroCopyEqualsCopying) {
+  ClRuntime rt;
+  const int w = simulated(rt) ? 19 : 61, h = simulated(rt) ? 11 : 29;
+  SvgfDenoiser copying(rt, w, h, SvgfSettings{}, false);
+  SvgfDenoiser in_place(rt, w, h, SvgfSettings{}, true);
+  EXPECT_FALSE(copying.zero_copy());
+  EXPECT_EQ(in_place.zero_copy(), rt.info().host_unified_memory);
+  EXPECT_EQ(copying.host_device_bytes_per_pixel(), 112.0);
+  EXPECT_EQ(in_place.host_device_bytes_per_pixel(), in_place.zero_copy() ? 16.0 : 112.0);
+  std::mt19937 rng(11);
+  GBuffer g = scene_gbuffer(w, h, 0.0f, rng);
+  std::vector<glm::vec4> colour = noisy_colour(g, rng);
+  for (int f = 0; f < 6; ++f) {
+    const GBuffer next = scene_gbuffer(w, h, 2.3f * static_cast<float>(f), rng);
+    const std::vector<glm::vec4> next_colour = noisy_colour(next, rng);
+    g = next;  // copy assignment: the same host memory, rewritten
+    colour = next_colour;
+    const std::vector<glm::vec4> a = copying.denoise(colour, g);
+    const std::vector<glm::vec4> b = in_place.denoise(colour, g);
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
+    EXPECT_EQ(differ, 0u) << "frame " << f << ", of " << a.size() << " pixels";
+  }
+}
+
 // Boxes that moved 3 pixels over a still floor: history is kept where last frame showed the
 // same surface at the back-projected position (length 2 after two frames) and dropped where it
 // did not (floor the boxes uncovered, box pixels that came in across the image border: 1).
