@@ -77,12 +77,13 @@ def median_frame_ms(stats, key="total"):
     return statistics.median(f["time_ms"].get(key, 0.0) for f in frames)
 
 
-def final_frame_metrics(stats, img, ref, T):
-    """What equal-frame and denoised report of one method's run: the relMSE and LDR-FLIP of frame
-    T, the mean relMSE of frames T-7..T with its standard error, and median times per stage."""
+def final_frame_metrics(stats, img, ref, T, exposure):
+    """What equal-frame and denoised report of one method's run: the relMSE and LDR-FLIP (at the
+    scene's exposure) of frame T, the mean relMSE of frames T-7..T with its standard error, and
+    median times per stage."""
     mean, sem = mean_sem(f["relmse"] for f in stats["frames"][T - LAST:T])
     return {"relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
-            "flip_ldr": metrics.flip_ldr(img, ref),
+            "flip_ldr": metrics.flip_ldr(img, ref, exposure),
             "time_ms": {k: median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}}
 
 
@@ -108,14 +109,14 @@ def saved_frame(image_path, frame):
     return Path(image_path).with_name(f"{Path(image_path).stem}-f{frame:04d}{Path(image_path).suffix}")
 
 
-def comparison_figure(ref, images, titles, suptitle, path):
-    """Reference, PT and PG (images["off"], images["pmm"]) side by side, each with a zoomed crop
-    where PT's error is largest; titles: the reference's, PT's and PG's."""
+def comparison_figure(ref, images, titles, suptitle, path, exposure):
+    """Reference, PT and PG (images["off"], images["pmm"]) side by side at the scene's exposure,
+    each with a zoomed crop where PT's error is largest; titles: the reference's, PT's and PG's."""
     err = np.mean((images["off"] - ref) ** 2 / (ref ** 2 + 0.01), axis=2)
     y0, x0, s = crop_box(err, max(16, min(ref.shape[:2]) // 3))
     fig, axes = plt.subplots(2, 3, figsize=(12, 8) if ref.shape[1] > 400 else (9, 6))
     for col, (title, img) in enumerate(zip(titles, (ref, images["off"], images["pmm"]))):
-        tm = metrics.tonemap_srgb(img)
+        tm = metrics.tonemap_srgb(img, exposure)
         axes[0, col].imshow(tm)
         axes[0, col].add_patch(plt.Rectangle((x0, y0), s, s, fill=False, color="cyan"))
         axes[0, col].set_title(title, fontsize=9)
@@ -153,13 +154,14 @@ def equal_frame(ctx, scene):
     out = ctx.out / "equal_frame" / scene
     out.mkdir(parents=True, exist_ok=True)
     result = {"scene": scene, "reference": str(ctx.reference(scene, m["res"])), "T": T, "methods": {}, "sweep": {}}
+    exposure = result["exposure"] = runner.scene_exposure(scene)
     images = {}
     for method in METHODS:
         stats, frames = static_run(ctx, scene, method)
         img = metrics.load_exr(frames[T])
         images[method] = img
         result["methods"][method] = {
-            **final_frame_metrics(stats, img, ref, T), "flip_hdr": metrics.flip_hdr(img, ref),
+            **final_frame_metrics(stats, img, ref, T, exposure), "flip_hdr": metrics.flip_hdr(img, ref),
             "frame_ms": median_frame_ms(stats), "nonfinite": sum(f["nonfinite_samples"] for f in stats["frames"]),
         }
         for key in ("guided_fraction", "trained_fraction", "mean_pi"):
@@ -169,12 +171,12 @@ def equal_frame(ctx, scene):
         row = {}
         for method in METHODS:
             img = metrics.load_exr(static_run(ctx, scene, method)[1][t])
-            row[method] = {"relmse": metrics.relmse(img, ref), "flip_ldr": metrics.flip_ldr(img, ref)}
+            row[method] = {"relmse": metrics.relmse(img, ref), "flip_ldr": metrics.flip_ldr(img, ref, exposure)}
         result["sweep"][str(t)] = row
     flips = {k: result["methods"][k]["flip_ldr"] for k in METHODS}
     result["figure"] = comparison_figure(
         ref, images, ("Reference", f"PT 1 spp  FLIP {flips['off']:.3f}", f"PG 1 spp  FLIP {flips['pmm']:.3f}"),
-        f"{scene}: 1 spp after {T} frames ({m['res']})", out / "comparison.png")
+        f"{scene}: 1 spp after {T} frames ({m['res']})", out / "comparison.png", exposure)
     return result
 
 
@@ -237,6 +239,7 @@ def convergence(ctx, scene):
     m = ctx.mode
     out = ctx.out / "convergence" / scene
     result = {"scene": scene, "static": {}, "path": {}, "res": m["res"], "path_res": m["path_res"]}
+    exposure = result["exposure"] = runner.scene_exposure(scene)
     for method in METHODS:
         result["static"][method] = [f["relmse"] for f in static_run(ctx, scene, method)[0]["frames"]]
     paths = json.loads(Path(runner.scene_path(scene)).read_text()).get("camera_paths", {})
@@ -251,7 +254,8 @@ def convergence(ctx, scene):
             imgs = {f: metrics.load_exr(saved_frame(image, f)) for f in m["path_frames"]}
             result["path"][method] = {"frames": m["path_frames"],
                                       "relmse": [metrics.relmse(imgs[f], refs[f]) for f in m["path_frames"]],
-                                      "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f]) for f in m["path_frames"]]}
+                                      "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f], exposure)
+                                                   for f in m["path_frames"]]}
     fig, axes = plt.subplots(1, 2 if paths else 1, figsize=(10 if paths else 5, 4), squeeze=False)
     for method, e in result["static"].items():
         axes[0, 0].semilogy(e, label=LABEL[method])
@@ -282,6 +286,7 @@ def denoised(ctx, scene):
     out = ctx.out / "denoised" / scene
     out.mkdir(parents=True, exist_ok=True)
     result = {"scene": scene, "T": T, "static": {}, "path": {}, "cost": {}}
+    exposure = result["exposure"] = runner.scene_exposure(scene)
     images = {}
     for method in METHODS:
         noisy_path = out / f"{method}-noisy.exr"
@@ -290,8 +295,8 @@ def denoised(ctx, scene):
         img, noisy = metrics.load_exr(image), metrics.load_exr(noisy_path)
         images[method] = img
         result["static"][method] = {
-            **final_frame_metrics(stats, img, ref, T), "relmse_noisy": metrics.relmse(noisy, ref),
-            "flip_ldr_noisy": metrics.flip_ldr(noisy, ref),
+            **final_frame_metrics(stats, img, ref, T, exposure), "relmse_noisy": metrics.relmse(noisy, ref),
+            "flip_ldr_noisy": metrics.flip_ldr(noisy, ref, exposure),
         }
     # SVGF's cost against the path-traced frame it filters (the renderer's part of "total").
     for res, method_stats in ((m["res"], result["static"]["off"]["time_ms"]), (m["svgf_large_res"], None)):
@@ -318,13 +323,13 @@ def denoised(ctx, scene):
             fm, fs = mean_sem(flicker)
             result["path"][method] = {"frames": frames,
                                       "relmse": [metrics.relmse(imgs[f], refs[f]) for f in frames],
-                                      "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f]) for f in frames],
+                                      "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f], exposure) for f in frames],
                                       "flicker_mse": fm, "flicker_sem": fs,
                                       "flicker_mse_noisy": mean_sem(flicker_noisy)[0]}
     flips = {k: result["static"][k]["flip_ldr"] for k in METHODS}
     result["figure"] = comparison_figure(
         ref, images, ("Reference", f"PT+SVGF  FLIP {flips['off']:.3f}", f"PG+SVGF  FLIP {flips['pmm']:.3f}"),
-        f"{scene}: 1 spp + SVGF after {T} frames ({m['res']})", out / "denoised.png")
+        f"{scene}: 1 spp + SVGF after {T} frames ({m['res']})", out / "denoised.png", exposure)
     return result
 
 

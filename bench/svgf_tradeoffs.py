@@ -47,6 +47,7 @@ def main():
              "|---|---|---|---|---|---|---|---|"]
     for scene in args.scenes:
         ref = metrics.load_exr(refs.get(scene, args.res, args.ref_spp))
+        exposure = runner.scene_exposure(scene)
         rows = {}
         for k, (name, flags) in enumerate(VARIANTS.items()):
             stats, image = runner.render(scene, args.res, args.frames, "off", out / "svgf-tradeoffs" / scene,
@@ -54,7 +55,7 @@ def main():
             img = metrics.load_exr(image)
             svgf, pt = median_ms(stats, "svgf_total"), median_ms(stats, "total") - median_ms(stats, "svgf_total")
             rows[name] = {"flags": [str(f) for f in flags], "svgf_ms": svgf, "atrous_ms": median_ms(stats, "svgf_atrous"),
-                          "pt_frame_ms": pt, "flip_ldr": metrics.flip_ldr(img, ref), "relmse": metrics.relmse(img, ref)}
+                          "pt_frame_ms": pt, "flip_ldr": metrics.flip_ldr(img, ref, exposure), "relmse": metrics.relmse(img, ref)}
             r = rows[name]
             lines.append(f"| {scene} | {name} | {r['svgf_ms']:.1f} | {r['atrous_ms']:.1f} | {pt:.0f} "
                          f"| {svgf / pt:.2f} | {r['flip_ldr']:.4f} | {r['relmse']:.4g} |")

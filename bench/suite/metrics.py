@@ -29,15 +29,30 @@ def tonemap_srgb(radiance, exposure=1.0):
     return np.where(y <= 0.0031308, 12.92 * y, 1.055 * np.power(y, 1.0 / 2.4) - 0.055).astype(np.float32)
 
 
+def key_exposure(reference):
+    """The exposure a scene file records (scenes/README.md, "exposure"): the one that puts the
+    reference's log-average luminance over its lit pixels (luminance above 1e-4; an open sky or
+    background of zero would drag the average to black) at Reinhard's key 0.18, rounded to a
+    power of two (whole photographic stops). A property of the reference alone, never of a
+    method's image."""
+    r = np.asarray(reference, dtype=np.float64)
+    luminance = 0.2126 * r[..., 0] + 0.7152 * r[..., 1] + 0.0722 * r[..., 2]
+    lit = luminance[np.isfinite(luminance) & (luminance > 1e-4)]
+    if lit.size == 0:
+        raise ValueError("the reference has no lit pixel")
+    return float(2.0 ** np.round(np.log2(0.18 / np.exp(np.mean(np.log(lit))))))
+
+
 def relmse(image, reference):
     image = np.asarray(image, dtype=np.float64)
     reference = np.asarray(reference, dtype=np.float64)
     return float(np.mean((image - reference) ** 2 / (reference ** 2 + 0.01)))
 
 
-def flip_ldr(image, reference):
-    """Mean LDR-FLIP of the tonemapped images (0 = identical)."""
-    _, mean, _ = flip.evaluate(tonemap_srgb(reference), tonemap_srgb(image), "LDR")
+def flip_ldr(image, reference, exposure=1.0):
+    """Mean LDR-FLIP of the tonemapped images (0 = identical); exposure: the scene's
+    (runner.scene_exposure), as its PNG output shows it."""
+    _, mean, _ = flip.evaluate(tonemap_srgb(reference, exposure), tonemap_srgb(image, exposure), "LDR")
     return float(mean)
 
 

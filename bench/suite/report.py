@@ -46,6 +46,12 @@ def _relmse_cells(pt, pg):
             f"| {verdict(pt['relmse_last8'], pt['relmse_last8_sem'], pg['relmse_last8'], pg['relmse_last8_sem'])} ")
 
 
+def _exposures(ex):
+    """'cornell-box 2, sponza 32': the scene files' exposures the LDR-FLIP figures used (results
+    recorded before scenes had one used 1)."""
+    return ", ".join(f"{scene} {r.get('exposure', 1.0):g}" for scene, r in ex.items())
+
+
 def _equal_frame(ex, report_dir):
     lines = ["## Equal frame: 1 spp after T frames (paper, figure 3)", "",
              "| scene | PT FLIP | PG FLIP | ratio | relMSE ratio | frame time PT | frame time PG | guiding overhead |",
@@ -56,7 +62,8 @@ def _equal_frame(ex, report_dir):
             f"| {scene} | {pt['flip_ldr']:.3f} | {pg['flip_ldr']:.3f} | {pt['flip_ldr'] / max(pg['flip_ldr'], 1e-9):.2f}x "
             f"| {pg['relmse_last8'] / max(pt['relmse_last8'], 1e-12):.2f} | {_ms(pt['frame_ms'])} | {_ms(pg['frame_ms'])} "
             f"| {100.0 * (pg['frame_ms'] - pt['frame_ms']) / max(pt['frame_ms'], 1e-9):+.0f}% |")
-    lines += ["", "FLIP: mean LDR-FLIP of frame T (tonemapped as rtpg's PNG output); ratio = PT/PG (above 1: "
+    lines += ["", f"FLIP: mean LDR-FLIP of frame T (tonemapped as rtpg's PNG output, at the scene's exposure: "
+              f"{_exposures(ex)}); ratio = PT/PG (above 1: "
               "guiding is better). relMSE ratio = PG/PT of the mean relMSE of frames T-7..T (below 1: guiding is "
               "better). Frame times: medians over the frames of the run (frame 0 left out); overhead = (PG - PT) / PT.",
               "", "| scene | HDR-FLIP PT | HDR-FLIP PG | relMSE PT (± s.e.) | relMSE PG (± s.e.) | verdict | guided pixels | mean pi |",
@@ -149,7 +156,8 @@ def _convergence(ex, report_dir, settings):
 def _denoised(ex, report_dir, settings):
     lines = ["## Denoised: PT+SVGF against PG+SVGF (paper, table 2)", "",
              f"SVGF (`--denoise svgf`, docs/denoising.md) on every 1-spp frame; figures of the denoised frame after "
-             f"T = {settings['T']} frames at {settings['res']}, static camera. The paper reports LDR-FLIP 0.13 (PT+SVGF) "
+             f"T = {settings['T']} frames at {settings['res']}, static camera; LDR-FLIP at the scene's exposure "
+             f"({_exposures(ex)}). The paper reports LDR-FLIP 0.13 (PT+SVGF) "
              "against 0.05 (PG+SVGF) and 0.10 against 0.03 on its two scenes (ratios 0.38 and 0.30).", "",
              "| scene | FLIP PT+SVGF | FLIP PG+SVGF | PG/PT | relMSE PT+SVGF (± s.e.) | relMSE PG+SVGF (± s.e.) "
              "| verdict | FLIP PT / PG without SVGF |",

@@ -57,6 +57,12 @@ def render(scene, res, frames, guiding, out_dir, tag, reference=None, extra=(), 
     return json.loads(stats.read_text()), image
 
 
+def scene_exposure(name):
+    """The scene file's "exposure" (scenes/README.md; default 1): PNG output and LDR-FLIP multiply
+    radiance by it before the display transform."""
+    return float(json.loads(Path(scene_path(name)).read_text()).get("exposure", 1.0))
+
+
 class ReferenceCache:
     """References cached on disk by scene, resolution, samples, seed, camera and a hash of the
     renderer's sources (so a reference is never reused after the renderer changed)."""

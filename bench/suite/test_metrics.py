@@ -22,6 +22,20 @@ class MetricTests(unittest.TestCase):
         self.assertEqual(metrics.flip_hdr(r, r), 0.0)
         self.assertEqual(metrics.flicker([r, r, r]), 0.0)
 
+    def test_key_exposure_puts_the_lit_log_average_at_the_key(self):
+        # Half the pixels at luminance 0.045 and half at 0.18: log-average 0.09, so exposure 2
+        # (0.18 / 0.09); black background pixels are left out, a non-power of two rounds to one.
+        img = np.zeros((4, 6, 3), np.float32)
+        img[:2, :2] = 0.045
+        img[2:, :2] = 0.18
+        self.assertEqual(metrics.key_exposure(img), 2.0)
+        self.assertEqual(metrics.key_exposure(np.full((2, 2, 3), 0.18 / 3.0, np.float32)), 4.0)  # log2(3) = 1.58
+        with self.assertRaises(ValueError):
+            metrics.key_exposure(np.zeros((2, 2, 3), np.float32))
+        # A brighter LDR image at the scene's exposure is what FLIP compares: exposure changes FLIP.
+        self.assertNotEqual(metrics.flip_ldr(self.reference * 0.5, self.reference, 1.0),
+                            metrics.flip_ldr(self.reference * 0.5, self.reference, 0.05))
+
     def test_known_perturbation_gives_expected_relmse(self):
         # I = R + d everywhere: relMSE = mean(d^2 / (R^2 + 0.01)), computed independently here.
         d = 0.1

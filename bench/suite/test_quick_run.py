@@ -89,11 +89,13 @@ class QuickRun(unittest.TestCase):
         # no bound at this size: at 1 spp, cornell-indirect's FLIP is above that image's.
         for scene, r in self.results["experiments"]["equal_frame"].items():
             ref = metrics.load_exr(r["reference"])
-            black = metrics.flip_ldr(np.zeros_like(ref), ref)
+            exposure = r.get("exposure", 1.0)
+            black = metrics.flip_ldr(np.zeros_like(ref), ref, exposure)
             for method in ("off", "pmm"):
                 frame = experiments.saved_frame(OUT / "static" / scene / f"{method}.exr", r["T"] - 1)
                 flip = r["methods"][method]["flip_ldr"]
-                self.assertAlmostEqual(flip, metrics.flip_ldr(metrics.load_exr(frame), ref), places=6, msg=frame)
+                self.assertAlmostEqual(flip, metrics.flip_ldr(metrics.load_exr(frame), ref, exposure), places=6,
+                                       msg=frame)
                 self.assertLess(flip, black, f"{scene} {method}")
 
     def test_each_experiment_has_its_own_json(self):

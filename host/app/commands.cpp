@@ -32,9 +32,6 @@ namespace rtpg {
 namespace fs = std::filesystem;
 namespace {
 
-// The documented, fixed display transform of PNG output (kernels/shared/tonemap.h).
-constexpr float kPngExposure = 1.0f;
-
 std::string extension_of(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -96,14 +93,16 @@ double flicker_mse(const std::vector<glm::vec3>& image, const std::vector<glm::v
   return sum / (3.0 * static_cast<double>(image.size()));
 }
 
+// EXR: linear radiance; PNG: the documented display transform (kernels/shared/tonemap.h) after
+// the scene's exposure (Scene::exposure).
 void write_output(const std::string& path, const ImageRgb& image, ClRuntime& cl,
-                  const std::map<std::string, std::string>& metadata) {
+                  const std::map<std::string, std::string>& metadata, float exposure) {
   if (extension_of(path) == ".png") {
     std::vector<glm::vec4> radiance(image.pixels.size());
     for (std::size_t i = 0; i < radiance.size(); ++i)
       radiance[i] = glm::vec4(image.pixels[i], 1.0f);
     std::vector<std::uint8_t> rgba8;
-    tonemap_on_device(cl, radiance, image.width, image.height, kPngExposure, rgba8);
+    tonemap_on_device(cl, radiance, image.width, image.height, exposure, rgba8);
     write_png(path, image.width, image.height, rgba8);
   } else {
     write_exr(path, image, metadata);
@@ -248,7 +247,7 @@ int run_render(const RenderCommand& command) {
     m["frame"] = std::to_string(f);
     m["accumulated_frames"] = std::to_string(accumulator ? f + 1 : 1);
     m["render_time_ms"] = fmt::format("{:.3f}", totals.back());
-    write_output(path, out, cl, m);
+    write_output(path, out, cl, m, scene.exposure);
   };
   // The unfiltered frame (with --denoise) to --noisy-output or its --save-frames file.
   auto write_noisy_frame = [&](const std::string& path, int f) {
@@ -256,7 +255,7 @@ int run_render(const RenderCommand& command) {
     m["denoise"] = "off";
     m["frame"] = std::to_string(f);
     m["render_time_ms"] = fmt::format("{:.3f}", totals.back());
-    write_output(path, to_image(renderer, renderer.image()), cl, m);
+    write_output(path, to_image(renderer, renderer.image()), cl, m, scene.exposure);
   };
   for (int f = 0; f < command.frames; ++f) {
     FrameStats stats = renderer.render_frame(f);
@@ -449,6 +448,7 @@ int run_info(const CommonArguments& command) {
                                                                       : "map");
   std::printf("degenerate triangles dropped: %zu\n", scene.degenerate_triangles);
   std::printf("bounds: [%g %g %g] - [%g %g %g]\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
+  std::printf("exposure: %g\n", static_cast<double>(scene.exposure));
   std::printf("camera paths: %zu", scene.camera.paths.size());
   for (const auto& [name, path] : scene.camera.paths) std::printf(" %s", name.c_str());
   std::printf("\nfeatures:");

@@ -81,6 +81,9 @@ struct Scene {
   Environment environment;
   CameraSetup camera;
   int max_bounces = 0;  // the scene's "integrator.max_bounces"; 0 = the renderer's default
+  // The scene's "exposure": radiance is multiplied by it before the display transform of PNG
+  // output and of the benchmarks' LDR-FLIP (kernels/shared/tonemap.h); EXR output stays linear.
+  float exposure = 1.0f;
   std::size_t degenerate_triangles = 0;  // zero-area triangles the loader dropped
   std::vector<std::string> warnings;     // what the loader accepted but the user should know
 

@@ -4,6 +4,7 @@
 
 #include <fstream>
 #include <functional>
+#include <cmath>
 #include <map>
 #include <set>
 #include <filesystem>
@@ -120,7 +121,7 @@ class SceneBuilder {
 
   void build(const JsonNode& root) {
     root.check_object({"description", "camera", "camera_paths", "meshes", "shapes", "materials",
-                       "material_overrides", "sun", "environment", "integrator"});
+                       "material_overrides", "sun", "environment", "integrator", "exposure"});
     read_description(root);
     scene_.camera.view = read_camera(root.child("camera"));
     if (root.has("camera_paths"))
@@ -141,6 +142,7 @@ class SceneBuilder {
     if (root.has("sun")) read_sun(root.child("sun"));
     if (root.has("environment")) read_environment(root.child("environment"));
     if (root.has("integrator")) read_integrator(root.child("integrator"));
+    if (root.has("exposure")) read_exposure(root.child("exposure"));
     if (scene_.meshes.empty())
       throw InputError(path_, "the scene has no geometry (meshes, shapes)");
     if (!has_light())
@@ -176,6 +178,13 @@ class SceneBuilder {
       if (bounces < 1 || bounces > 64) value.fail("expected an integer in [1, 64]");
       scene_.max_bounces = bounces;
     }
+  }
+
+  void read_exposure(const JsonNode& value) {
+    const float exposure = value.number();
+    if (!std::isfinite(exposure) || exposure <= 0.0f || exposure > 1e6f)
+      value.fail("expected a number in (0, 1e6]");
+    scene_.exposure = exposure;
   }
 
   std::string context(const JsonNode& value) const { return value.path() + " in " + path_; }

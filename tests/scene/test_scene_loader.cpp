@@ -650,6 +650,20 @@ TEST(SceneLoaderErrors, MissingRequiredKeyAndBadValues) {
                      {"times.json", "camera_paths.p.keys[1].time", "increasing"});
 }
 
+// The display exposure (PNG output, the benchmarks' LDR-FLIP): 1 by default, a positive finite
+// number when given.
+TEST(SceneLoader, ExposureDefaultsToOneAndMustBePositive) {
+  TempDir dir;
+  write_file(dir / "plain.json", simple_scene(""));
+  EXPECT_EQ(load_scene(dir / "plain.json").exposure, 1.0f);
+  write_file(dir / "bright.json", simple_scene(R"("exposure": 32,)"));
+  EXPECT_EQ(load_scene(dir / "bright.json").exposure, 32.0f);
+  for (const char* bad : {"0", "-2", "1e7", "\"high\""}) {
+    write_file(dir / "bad.json", simple_scene(std::string("\"exposure\": ") + bad + ","));
+    expect_input_error([&] { load_scene(dir / "bad.json"); }, {"bad.json", "exposure"});
+  }
+}
+
 TEST(SceneLoaderErrors, NoLightSources) {
   TempDir dir;
   write_file(dir / "dark.json", std::string("{") + kCamera + R"(, "materials": {"m": {}},
