@@ -425,6 +425,44 @@ TEST_F(Cli, RenderWritesTonemappedPng) {
   EXPECT_LT(*lo, *hi) << "a flat image";
 }
 
+// The scene file's exposure scales radiance before the PNG's tonemap and leaves the EXR linear:
+// the same render at exposure 1 and 4 gives the same EXR, and a PNG at least as bright at every
+// channel (brighter wherever the exposure-1 PNG is neither black nor white).
+TEST_F(Cli, PngUsesTheScenesExposureAndExrStaysLinear) {
+  const std::string surface = R"({"base_color": [0.5, 0.5, 0.5]})";
+  write("dim.json", scene_with(surface));
+  write("bright.json", scene_with(surface, R"(, "exposure": 4)"));
+  for (const char* scene : {"dim", "bright"}) {
+    for (const char* ext : {".png", ".exr"}) {
+      const RunResult r = run_rtpg(dir(), std::string("render ") + scene +
+                                              ".json --res 24x16 --spp 4 --seed 2 --guiding off "
+                                              "-q -o " +
+                                              scene + ext);
+      ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+    }
+  }
+  const ExrImage dim = read_exr(dir() / "dim.exr"), bright = read_exr(dir() / "bright.exr");
+  ASSERT_FALSE(dim.pixels.empty());
+  EXPECT_EQ(dim.pixels, bright.pixels) << "EXR is linear radiance, not exposed";
+  std::vector<std::uint8_t> png[2];
+  for (int k = 0; k < 2; ++k) {
+    auto in = OIIO::ImageInput::open((dir() / (k == 0 ? "dim.png" : "bright.png")).string());
+    ASSERT_TRUE(in) << OIIO::geterror();
+    png[k].resize(24 * 16 * 3);
+    ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, png[k].data()));
+  }
+  int brighter = 0, between = 0;
+  for (std::size_t i = 0; i < png[0].size(); ++i) {
+    EXPECT_GE(png[1][i], png[0][i]) << "channel " << i;
+    if (png[0][i] > 0 && png[0][i] < 255) {
+      ++between;
+      brighter += png[1][i] > png[0][i];
+    }
+  }
+  EXPECT_GT(between, 0);
+  EXPECT_EQ(brighter, between);
+}
+
 TEST_F(Cli, StatisticsCarryRelMseAgainstReference) {
   const std::string common = "render --res 32x32 --spp 2 --seed 3 --guiding off -q";
   RunResult r = run_rtpg(dir(), common + " -o reference.exr");
