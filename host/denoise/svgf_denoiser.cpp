@@ -26,20 +26,6 @@ void upload(ClRuntime& rt, const cl::Buffer& b, const std::vector<T>& v) {
   rt.queue().enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
 }
 
-// A buffer the kernels read in place from host memory (zero copy); the kernels only read it
-// (CL_MEM_READ_ONLY), so the const_cast writes nothing.
-template <class T>
-cl::Buffer in_place(ClRuntime& rt, const std::vector<T>& v) {
-  return cl::Buffer(rt.context(), CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, v.size() * sizeof(T),
-                    const_cast<T*>(v.data()));
-}
-
-template <class T>
-void copy_on_device(ClRuntime& rt, const cl::Buffer& from, const cl::Buffer& to,
-                    const std::vector<T>& v) {
-  rt.queue().enqueueCopyBuffer(from, to, 0, 0, v.size() * sizeof(T));
-}
-
 }  // namespace
 
 SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings,
@@ -133,17 +119,20 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
   translate_cl_errors([&] {
     const auto start = Clock::now();
     if (zero_copy_) {
-      colour_in = in_place(runtime_, colour);
-      emission_in = in_place(runtime_, g.emission);
-      base_color_roughness_in = in_place(runtime_, g.base_color_roughness);
-      flags_in = in_place(runtime_, g.flags);
-      motion_in = in_place(runtime_, g.motion);
+      const cl::Context& c = runtime_.context();
+      colour_in = read_in_place(c, colour);
+      emission_in = read_in_place(c, g.emission);
+      base_color_roughness_in = read_in_place(c, g.base_color_roughness);
+      flags_in = read_in_place(c, g.flags);
+      motion_in = read_in_place(c, g.motion);
       // Next frame's history test compares with these, after the host has moved on.
-      copy_on_device(runtime_, in_place(runtime_, g.position_depth), cur.position_depth,
-                     g.position_depth);
-      copy_on_device(runtime_, in_place(runtime_, g.shading_normal), cur.shading_normal,
-                     g.shading_normal);
-      copy_on_device(runtime_, in_place(runtime_, g.material), cur.material, g.material);
+      const auto keep = [&](const auto& host, const cl::Buffer& own) {
+        runtime_.queue().enqueueCopyBuffer(read_in_place(c, host), own, 0, 0,
+                                           host.size() * sizeof(host[0]));
+      };
+      keep(g.position_depth, cur.position_depth);
+      keep(g.shading_normal, cur.shading_normal);
+      keep(g.material, cur.material);
     } else {
       upload(runtime_, colour_, colour);
       upload(runtime_, emission_, g.emission);

@@ -103,4 +103,17 @@ class ClRuntime {
   std::unique_ptr<Programs> programs_;
 };
 
+// A read-only device buffer over a host container's memory (CL_MEM_USE_HOST_PTR, any container
+// with data(), size() and value_type): no copy where the device shares host memory
+// (DeviceInfo::host_unified_memory). The kernels only read it, so the const_cast writes nothing.
+// The device may cache the data when the buffer is made (OpenCL 1.2, clCreateBuffer): make it
+// after the host has written the data, and release it before the host writes again. Throws
+// cl::Error.
+template <class Container>
+cl::Buffer read_in_place(const cl::Context& context, const Container& host) {
+  using T = typename Container::value_type;
+  return cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, host.size() * sizeof(T),
+                    const_cast<T*>(host.data()));
+}
+
 }  // namespace rtpg

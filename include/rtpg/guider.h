@@ -76,11 +76,7 @@ cl::Buffer wrap_channel(cl::Context& context, const Channel& host, const char* n
                 "a host channel's element size differs from include/rtpg/guiding_layout.h");
   if (host.empty()) throw GuiderError(std::string("in-place buffer ") + name + " is empty");
   cl::Buffer b;
-  // The kernels only read it (CL_MEM_READ_ONLY), so the const_cast writes nothing.
-  translate_cl_errors([&] {
-    b = cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, host.size() * Bytes,
-                   const_cast<typename Channel::value_type*>(host.data()));
-  });
+  translate_cl_errors([&] { b = read_in_place(context, host); });
   return b;
 }
 template <std::size_t Bytes, class Channel>
