@@ -71,12 +71,6 @@ def mean_sem(values):
     return statistics.mean(values), sem
 
 
-def median_frame_ms(stats, key="total"):
-    """Median over frames; frame 0 is left out (it builds programs and warms caches)."""
-    frames = stats["frames"][1:] or stats["frames"]
-    return statistics.median(f["time_ms"].get(key, 0.0) for f in frames)
-
-
 def final_frame_metrics(stats, img, ref, T, exposure):
     """What equal-frame and denoised report of one method's run: the relMSE and LDR-FLIP (at the
     scene's exposure) of frame T, the mean relMSE of frames T-7..T with its standard error, and
@@ -84,7 +78,7 @@ def final_frame_metrics(stats, img, ref, T, exposure):
     mean, sem = mean_sem(f["relmse"] for f in stats["frames"][T - LAST:T])
     return {"relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
             "flip_ldr": metrics.flip_ldr(img, ref, exposure),
-            "time_ms": {k: median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}}
+            "time_ms": {k: runner.median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}}
 
 
 def crop_box(err_map, size):
@@ -162,7 +156,7 @@ def equal_frame(ctx, scene):
         images[method] = img
         result["methods"][method] = {
             **final_frame_metrics(stats, img, ref, T, exposure), "flip_hdr": metrics.flip_hdr(img, ref),
-            "frame_ms": median_frame_ms(stats), "nonfinite": sum(f["nonfinite_samples"] for f in stats["frames"]),
+            "frame_ms": runner.median_frame_ms(stats), "nonfinite": sum(f["nonfinite_samples"] for f in stats["frames"]),
         }
         for key in ("guided_fraction", "trained_fraction", "mean_pi"):
             if key in stats["frames"][T - 1]:
@@ -302,7 +296,7 @@ def denoised(ctx, scene):
     for res, method_stats in ((m["res"], result["static"]["off"]["time_ms"]), (m["svgf_large_res"], None)):
         if method_stats is None:
             stats, _ = runner.render(scene, res, 4, "off", out, "cost-large", extra=["--denoise", "svgf"])
-            method_stats = {k: median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}
+            method_stats = {k: runner.median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}
         svgf = method_stats["svgf_total"]
         result["cost"][res] = {"svgf_ms": svgf, "pt_frame_ms": method_stats["total"] - svgf,
                                "kernels_ms": {k: v for k, v in method_stats.items() if k.startswith("svgf_")}}
@@ -359,7 +353,7 @@ def tradeoffs(ctx, scene):
         errors = [metrics.relmse(metrics.load_exr(saved_frame(image, f)), ref)
                   for f in range(m["trade_frames"] - LAST, m["trade_frames"])]
         mean, sem = mean_sem(errors)
-        rows[name] = {"train_ms": median_frame_ms(stats, "train"), "frame_ms": median_frame_ms(stats),
+        rows[name] = {"train_ms": runner.median_frame_ms(stats, "train"), "frame_ms": runner.median_frame_ms(stats),
                       "relmse_last8": mean, "relmse_last8_sem": sem, "flags": [str(f) for f in flags]}
     fig, ax = plt.subplots(figsize=(6, 4))
     for name, r in rows.items():

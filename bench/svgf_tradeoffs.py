@@ -11,7 +11,6 @@ a full run of the suite leaves them there; a missing one is rendered (1024 spp, 
 """
 import argparse
 import json
-import statistics
 import sys
 from pathlib import Path
 
@@ -25,11 +24,6 @@ VARIANTS = {
     "2 iterations": ["--svgf-iterations", 2],
     "one pixel per work-item": ["--svgf-lanes", 1],
 }
-
-
-def median_ms(stats, key):
-    frames = stats["frames"][1:] or stats["frames"]
-    return statistics.median(f["time_ms"].get(key, 0.0) for f in frames)
 
 
 def main():
@@ -53,8 +47,10 @@ def main():
             stats, image = runner.render(scene, args.res, args.frames, "off", out / "svgf-tradeoffs" / scene,
                                          f"v{k}", extra=["--denoise", "svgf", *flags])
             img = metrics.load_exr(image)
-            svgf, pt = median_ms(stats, "svgf_total"), median_ms(stats, "total") - median_ms(stats, "svgf_total")
-            rows[name] = {"flags": [str(f) for f in flags], "svgf_ms": svgf, "atrous_ms": median_ms(stats, "svgf_atrous"),
+            svgf = runner.median_frame_ms(stats, "svgf_total")
+            pt = runner.median_frame_ms(stats) - svgf
+            rows[name] = {"flags": [str(f) for f in flags], "svgf_ms": svgf,
+                          "atrous_ms": runner.median_frame_ms(stats, "svgf_atrous"),
                           "pt_frame_ms": pt, "flip_ldr": metrics.flip_ldr(img, ref, exposure), "relmse": metrics.relmse(img, ref)}
             r = rows[name]
             lines.append(f"| {scene} | {name} | {r['svgf_ms']:.1f} | {r['atrous_ms']:.1f} | {pt:.0f} "

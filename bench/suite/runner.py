@@ -2,6 +2,7 @@
 import hashlib
 import json
 import os
+import statistics
 import subprocess
 import tempfile
 from pathlib import Path
@@ -61,6 +62,12 @@ def scene_exposure(name):
     """The scene file's "exposure" (scenes/README.md; default 1): PNG output and LDR-FLIP multiply
     radiance by it before the display transform."""
     return float(json.loads(Path(scene_path(name)).read_text()).get("exposure", 1.0))
+
+
+def median_frame_ms(stats, key="total"):
+    """Median over frames; frame 0 is left out (it builds programs and warms caches)."""
+    frames = stats["frames"][1:] or stats["frames"]
+    return statistics.median(f["time_ms"].get(key, 0.0) for f in frames)
 
 
 class ReferenceCache:
