@@ -40,23 +40,6 @@ PG_FN float pg_atan_unit(float z) {
   return z + z * z2 * p;
 }
 
-/* Inverse of pg_square_to_disk for points in the closed unit disk. In the wedges where
- * |x| >= |y| the forward map has d = o_x (cos t, sin t) with t = (pi/4) o_y / o_x, so
- * t = atan(y / x); in the others t' = pi/2 - t = atan(x / y) with o_y the radius. */
-PG_FN float2 pg_disk_to_square(float2 d) {
-  float r = sqrt(d.x * d.x + d.y * d.y);
-  if (r == 0.0f) return pg_make_float2(0.5f, 0.5f);
-  float a, b;
-  if (fabs(d.x) >= fabs(d.y)) {
-    a = d.x > 0.0f ? r : -r;
-    b = a * pg_atan_unit(d.y / d.x) * (4.0f / PG_PI);
-  } else {
-    b = d.y > 0.0f ? r : -r;
-    a = b * pg_atan_unit(d.x / d.y) * (4.0f / PG_PI);
-  }
-  return pg_make_float2(clamp(0.5f * (a + 1.0f), 0.0f, 1.0f), clamp(0.5f * (b + 1.0f), 0.0f, 1.0f));
-}
-
 /* M: square -> hemisphere (z up), equal-area: z = 1 - r^2, xy scaled by sqrt(2 - r^2). */
 PG_FN float3 pg_square_to_hemisphere(float2 u) {
   float2 d = pg_square_to_disk(u);
@@ -65,12 +48,24 @@ PG_FN float3 pg_square_to_hemisphere(float2 u) {
   return pg_make_float3(d.x * s, d.y * s, 1.0f - r2);
 }
 
-/* M^-1 for directions with z >= 0 (callers check the hemisphere). */
+/* M^-1 for directions with z >= 0 (callers check the hemisphere). The lift scales the disk
+ * point d by sqrt(2 - r^2) and z = 1 - r^2, so the disk radius is sqrt(1 - z) and d points
+ * along (x, y): the wedge and the angle come from w itself, and no square root of x^2 + y^2 is
+ * needed. Inverse of pg_square_to_disk: in the wedges where |x| >= |y| the forward map has
+ * d = o_x (cos t, sin t) with t = (pi/4) o_y / o_x, so t = atan(y / x); in the others
+ * t' = pi/2 - t = atan(x / y) with o_y the radius. */
 PG_FN float2 pg_hemisphere_to_square(float3 w) {
-  float r2 = clamp(1.0f - w.z, 0.0f, 1.0f);
-  float xy = sqrt(w.x * w.x + w.y * w.y);
-  float scale = xy > 0.0f ? sqrt(r2) / xy : 0.0f;
-  return pg_disk_to_square(pg_make_float2(w.x * scale, w.y * scale));
+  float r = sqrt(clamp(1.0f - w.z, 0.0f, 1.0f));
+  if (r == 0.0f || (w.x == 0.0f && w.y == 0.0f)) return pg_make_float2(0.5f, 0.5f);
+  float a, b;
+  if (fabs(w.x) >= fabs(w.y)) {
+    a = w.x > 0.0f ? r : -r;
+    b = a * pg_atan_unit(w.y / w.x) * (4.0f / PG_PI);
+  } else {
+    b = w.y > 0.0f ? r : -r;
+    a = b * pg_atan_unit(w.x / w.y) * (4.0f / PG_PI);
+  }
+  return pg_make_float2(clamp(0.5f * (a + 1.0f), 0.0f, 1.0f), clamp(0.5f * (b + 1.0f), 0.0f, 1.0f));
 }
 
 /* Cosine-weighted hemisphere sampling (Malley's method) and its solid-angle density. */

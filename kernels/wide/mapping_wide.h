@@ -53,18 +53,14 @@ static inline pg_float3w pg_square_to_hemisphere_w(pg_floatw ux, pg_floatw uy) {
   return pg_make_float3w(dx * s, dy * s, 1.0f - r2);
 }
 
-/* M^-1 (pg_hemisphere_to_square with pg_disk_to_square) for w.z >= 0. */
+/* M^-1 (pg_hemisphere_to_square) for w.z >= 0. */
 static inline void pg_hemisphere_to_square_w(pg_float3w w, __private pg_floatw* ux,
                                              __private pg_floatw* uy) {
-  pg_floatw r2 = clamp(1.0f - w.z, 0.0f, 1.0f);
-  pg_floatw xy = sqrt(w.x * w.x + w.y * w.y);
-  pg_floatw scale = select((pg_floatw)(0.0f), sqrt(r2) / xy, xy > 0.0f);
-  pg_floatw dx = w.x * scale, dy = w.y * scale;
-  pg_floatw r = sqrt(dx * dx + dy * dy);
+  pg_floatw r = sqrt(clamp(1.0f - w.z, 0.0f, 1.0f));
   /* The wedge |x| >= |y| takes its radius from x and its angle from y / x; the other wedge
-   * swaps the roles (pg_disk_to_square). */
-  pg_intw swap = fabs(dx) < fabs(dy);
-  pg_floatw p = select(dx, dy, swap), q = select(dy, dx, swap);
+   * swaps the roles. */
+  pg_intw swap = fabs(w.x) < fabs(w.y);
+  pg_floatw p = select(w.x, w.y, swap), q = select(w.y, w.x, swap);
   pg_floatw radius = select(-r, r, p > 0.0f);
   /* pg_atan_unit's polynomial. */
   pg_floatw z = q / p, z2 = z * z;
@@ -78,7 +74,7 @@ static inline void pg_hemisphere_to_square_w(pg_float3w w, __private pg_floatw* 
   t = t * z2 - 0.3333314528f;
   pg_floatw angle = radius * (z + z * z2 * t) * (4.0f / PG_PI);
   pg_floatw a = select(radius, angle, swap), b = select(angle, radius, swap);
-  pg_intw centre = r == 0.0f;
+  pg_intw centre = (r == 0.0f) | ((w.x == 0.0f) & (w.y == 0.0f));
   *ux = select(clamp(0.5f * (a + 1.0f), 0.0f, 1.0f), (pg_floatw)(0.5f), centre);
   *uy = select(clamp(0.5f * (b + 1.0f), 0.0f, 1.0f), (pg_floatw)(0.5f), centre);
 }
