@@ -32,8 +32,10 @@ struct GuidingSettings {
   float max_weight = 1e8f;           // training weights above this are dropped as absurd
   float reproject_position = 0.05f;  // relative distance (to the depth) that rejects history
   float reproject_normal = 0.9f;     // normal cosine below which history is rejected
-  int train_interval = 1;          // a mature pixel (k >= k_max / 4) trains every this many frames,
-                                   // in a rotating pattern (the rest keep their state)
+  int train_interval = 2;          // a mature pixel (k >= k_max / 4) trains every this many frames,
+                                   // in a rotating pattern (the rest keep their state); 2: the
+                                   // same error as 1 for 14-24% less train time
+                                   // (docs/guiding.md, "What amortised training saves")
   int train_all_samples = 0;       // 1: every VPL trains, weighted by its full mixture density;
                                    // 0: BSDF-strategy VPLs only (paper 3.2)
   int local_x = 16, local_y = 16;  // work-group size of the kernels (the VPL tile)
