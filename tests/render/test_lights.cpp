@@ -6,6 +6,7 @@
 // Jacobian, are rejected.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -228,6 +229,44 @@ TEST(Lights, EmissiveTrianglesMatchTheirDensity) {
   const auto wrong = test::chi_square_test(
       sampler, [&](const glm::vec3& d) { return pdf(d) * 1.05; }, kSamples / 4, 40, 80, 12);
   EXPECT_LT(wrong.p_value, 1e-6) << wrong.describe();
+}
+
+// Distribution1D::sample_discrete picks the cell of the first upper edge above u * total,
+// stepped back over empty cells (so an empty cell is never drawn), for every u of a fine grid
+// and every cell edge, with empty cells at the ends and inside, and reports that cell's
+// probability and a remapped number in [0, 1).
+TEST(Distribution1D, PicksTheCellOfItsCdfAndNeverAnEmptyOne) {
+  std::mt19937 gen(17);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  for (std::size_t size : {1u, 2u, 3u, 8u, 9u, 40u}) {
+    std::vector<float> weights(size);
+    for (float& x : weights) x = u01(gen) < 0.25f ? 0.0f : u01(gen);
+    weights.front() = 0.0f;
+    if (size > 1) weights.back() = 0.0f;
+    weights[size / 2] = 1.0f;  // at least one cell to sample
+    const Distribution1D dist(weights);
+    std::vector<double> cdf(size + 1, 0.0);
+    for (std::size_t i = 0; i < size; ++i) cdf[i + 1] = cdf[i] + weights[i];
+    std::vector<float> us;
+    for (int k = 0; k <= 4096; ++k) us.push_back(std::min(k / 4096.0f, 0.99999994f));
+    for (std::size_t i = 0; i <= size; ++i)
+      us.push_back(std::min(static_cast<float>(cdf[i] / cdf.back()), 0.99999994f));
+    for (float u : us) {
+      const double target = static_cast<double>(u) * cdf.back();
+      std::size_t expected = std::min<std::size_t>(
+          static_cast<std::size_t>(std::upper_bound(cdf.begin() + 1, cdf.end(), target) -
+                                   (cdf.begin() + 1)),
+          size - 1);
+      while (expected > 0 && weights[expected] == 0.0f) --expected;
+      float probability = -1.0f, remapped = -1.0f;
+      const std::size_t got = dist.sample_discrete(u, &probability, &remapped);
+      ASSERT_EQ(got, expected) << "size " << size << " u " << u;
+      ASSERT_GT(weights[got], 0.0f) << "size " << size << " u " << u;
+      EXPECT_EQ(probability, static_cast<float>(weights[got] / dist.total())) << size;
+      EXPECT_GE(remapped, 0.0f);
+      EXPECT_LT(remapped, 1.0f);
+    }
+  }
 }
 
 // Distribution2D: samples fall in cells in proportion to their weights, and the density it
