@@ -4,7 +4,7 @@
  * normals differ. Rejected, disoccluded and skipped pixels restart from the initial state
  * (k = 0). */
 /* Per pixel (hand count; rules and roofline: docs/guiding.md, "The roofline"): 78 flops (2
- * divisions, 1 sqrt) where history is kept, 399 more (16 divisions, 18 sqrt/sin/cos) where the
+ * divisions, 1 sqrt) where history is kept, 372 more (13 divisions, 12 sqrt/sin/cos) where the
  * state is reframed; 132 bytes read, 32 written: memory-bound. */
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"

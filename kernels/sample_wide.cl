@@ -9,8 +9,8 @@
  * denominator is a difference of nearly equal numbers, where one fused product moves the
  * density by percents (tests/guiding/test_guiding_kernels.cpp). */
 /* Per pixel (hand count; docs/guiding.md, "The roofline"): 232 flops for a Lambert pixel
- * sampling its BSDF (11 divisions, 6 sqrt/sin/cos), +181 where a lane has a GGX lobe, +81 for a
- * trained model's density, +59 where a lane picks the Gaussian (553 at most); 68-100 bytes read,
+ * sampling its BSDF (11 divisions, 6 sqrt/sin/cos), +181 where a lane has a GGX lobe, +72 for a
+ * trained model's density, +59 where a lane picks the Gaussian (544 at most); 68-100 bytes read,
  * 44 written. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "shared/guiding_pixel.h"

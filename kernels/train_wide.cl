@@ -11,10 +11,11 @@
  * of nearly equal numbers, where one fused product moves D, and a sample's weight, by 1e-4
  * relative (tests/guiding/test_guiding_kernels.cpp). */
 /* Per pixel (hand count; docs/guiding.md, "The roofline"): 162 + b N + 67 N P + 176 P flops for
- * N neighbours and P E-step passes (a lane runs to its work-item's largest N and P), b = 137 for
- * Lambert lobes, 243 where a lane has a GGX lobe: 1358-1888 at N = 5, P = 1; 9570 at N = 20,
- * P = 3 with GGX. Bytes: 116 of its own + 48 N of neighbour VPLs read (each VPL once per image
- * from memory, the rest from cache), 33 written: compute-bound. */
+ * N neighbours and P E-step passes (a lane runs to its work-item's largest N and P), b = 128 for
+ * Lambert lobes, 234 where a lane has a GGX lobe: 1313-1843 at N = 5, P = 1; 9390 at N = 20,
+ * P = 3 with GGX (each M^-1 9 flops fewer since it lost its disk detour, two of them square
+ * roots and one a division). Bytes: 116 of its own + 48 N of neighbour VPLs read (each VPL once per
+ * image from memory, the rest from cache), 33 written: compute-bound. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
