@@ -231,13 +231,14 @@ TEST(Lights, EmissiveTrianglesMatchTheirDensity) {
   EXPECT_LT(wrong.p_value, 1e-6) << wrong.describe();
 }
 
-// Distribution1D::sample_discrete picks the cell of the first upper edge above u * total,
-// stepped back over empty cells (so an empty cell is never drawn), for every u of a fine grid
-// and every cell edge, with empty cells at the ends and inside, and reports that cell's
-// probability and a remapped number in [0, 1).
-TEST(Distribution1D, PicksTheCellOfItsCdfAndNeverAnEmptyOne) {
+// Distribution1D::sample_discrete on a fine uniform grid of u: each cell takes its share of the
+// grid (its probability, within two grid steps for the two edges), reports weight / total as
+// its probability and a remapped number in [0, 1), and an empty cell is never picked, also
+// for u at every cell edge; empty cells at the ends and inside, sizes 1 to 40.
+TEST(Distribution1D, PicksCellsInProportionAndNeverAnEmptyOne) {
   std::mt19937 gen(17);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  const int steps = 4096;
   for (std::size_t size : {1u, 2u, 3u, 8u, 9u, 40u}) {
     std::vector<float> weights(size);
     for (float& x : weights) x = u01(gen) < 0.25f ? 0.0f : u01(gen);
@@ -247,25 +248,23 @@ TEST(Distribution1D, PicksTheCellOfItsCdfAndNeverAnEmptyOne) {
     const Distribution1D dist(weights);
     std::vector<double> cdf(size + 1, 0.0);
     for (std::size_t i = 0; i < size; ++i) cdf[i + 1] = cdf[i] + weights[i];
-    std::vector<float> us;
-    for (int k = 0; k <= 4096; ++k) us.push_back(std::min(k / 4096.0f, 0.99999994f));
-    for (std::size_t i = 0; i <= size; ++i)
-      us.push_back(std::min(static_cast<float>(cdf[i] / cdf.back()), 0.99999994f));
-    for (float u : us) {
-      const double target = static_cast<double>(u) * cdf.back();
-      std::size_t expected = std::min<std::size_t>(
-          static_cast<std::size_t>(std::upper_bound(cdf.begin() + 1, cdf.end(), target) -
-                                   (cdf.begin() + 1)),
-          size - 1);
-      while (expected > 0 && weights[expected] == 0.0f) --expected;
+    std::vector<int> hits(size, 0);
+    const auto pick = [&](float u) {
       float probability = -1.0f, remapped = -1.0f;
-      const std::size_t got = dist.sample_discrete(u, &probability, &remapped);
-      ASSERT_EQ(got, expected) << "size " << size << " u " << u;
-      ASSERT_GT(weights[got], 0.0f) << "size " << size << " u " << u;
-      EXPECT_EQ(probability, static_cast<float>(weights[got] / dist.total())) << size;
+      const std::size_t cell = dist.sample_discrete(u, &probability, &remapped);
+      EXPECT_LT(cell, size);
+      EXPECT_GT(weights[cell], 0.0f) << "size " << size << " u " << u;
+      EXPECT_EQ(probability, weights[cell] / dist.total()) << "size " << size;
       EXPECT_GE(remapped, 0.0f);
       EXPECT_LT(remapped, 1.0f);
-    }
+      return cell;
+    };
+    for (int k = 0; k < steps; ++k) ++hits[pick(static_cast<float>(k) / steps)];
+    for (std::size_t i = 0; i <= size; ++i)
+      pick(std::min(static_cast<float>(cdf[i] / cdf.back()), 0.99999994f));
+    for (std::size_t i = 0; i < size; ++i)
+      EXPECT_NEAR(static_cast<double>(hits[i]) / steps, weights[i] / cdf.back(), 2.0 / steps)
+          << "size " << size << " cell " << i;
   }
 }
 
