@@ -1,0 +1,61 @@
+#!/usr/bin/env python3
+"""bench/variant_sweep.py (run by ctest as bench_variant_sweep): its statistics on hand-computed
+cases, a tiny sweep end to end (a finite ratio per variant; a rerun from the cached renders prints
+the same table) and the refusal of malformed variants."""
+import json
+import math
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+BENCH = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(BENCH))
+import variant_sweep  # noqa: E402
+
+
+class Statistics(unittest.TestCase):
+    def test_mean_and_standard_error(self):
+        m, se = variant_sweep.mean_and_standard_error([1.0, 2.0, 3.0])
+        self.assertEqual(m, 2.0)
+        self.assertAlmostEqual(se, 1.0 / math.sqrt(3.0), places=15)  # stdev 1 over sqrt(3)
+        self.assertEqual(variant_sweep.mean_and_standard_error([0.7]), (0.7, 0.0))
+
+    def test_window_is_the_last_frames(self):
+        stats = {"frames": [{"relmse": float(i)} for i in range(10)]}
+        self.assertEqual(variant_sweep.window_relmse(stats, 3), 8.0)  # frames 7, 8, 9
+        self.assertEqual(variant_sweep.window_relmse(stats, 10), 4.5)
+
+    def test_table_has_a_row_per_variant_and_the_mean(self):
+        table = {"a": {"s1": (0.5, 0.01), "s2": (1.0, 0.02)}}
+        text = variant_sweep.markdown_table(["s1", "s2"], table)
+        self.assertEqual(text.splitlines()[0], "| variant | s1 | s2 | mean |")
+        self.assertEqual(text.splitlines()[2], "| a | 0.500 ± 0.010 | 1.000 ± 0.020 | 0.750 |")
+
+
+class EndToEnd(unittest.TestCase):
+    def test_tiny_sweep(self):
+        with tempfile.TemporaryDirectory() as out:
+            cmd = [sys.executable, str(BENCH / "variant_sweep.py"), "--scenes", "cornell-box", "--seeds", "1", "2",
+                   "--res", "24x16", "--frames", "4", "--window", "2", "--ref-spp", "16", "--out", out, "--variants",
+                   json.dumps({"guided": [], "interval 2": ["--pg-train-interval", "2"]})]
+            first = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+            again = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+            self.assertEqual(first, again)  # the rerun reads the cached renders
+            table = json.loads((Path(out) / "sweep.json").read_text())["table"]
+            for name in ("guided", "interval 2"):
+                ratio, se = table[name]["cornell-box"]
+                self.assertTrue(math.isfinite(ratio) and ratio > 0.0 and se >= 0.0, (name, ratio, se))
+                self.assertIn(f"| {name} |", first)
+
+    def test_bad_variants_are_refused(self):
+        for bad in ["not json", '["a list"]', '{"a": "not a list"}']:
+            r = subprocess.run([sys.executable, str(BENCH / "variant_sweep.py"), "--variants", bad],
+                               capture_output=True, text=True)
+            self.assertEqual(r.returncode, 2, bad)
+            self.assertIn("--variants", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()

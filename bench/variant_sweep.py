@@ -1,0 +1,100 @@
+#!/usr/bin/env python3
+"""Error of guiding variants against path tracing at equal frames, on many scenes and seeds: the
+protocol of the variant tables in docs/guiding.md.
+
+    python3 bench/variant_sweep.py --variants '{"default": [], "interval 2": ["--pg-train-interval", "2"]}'
+    python3 bench/variant_sweep.py --variants '{"pi 0.1": ["--pg-pi-min", "0.1", "--pg-pi-max", "0.1"]}' --scenes cornell-box sponza
+
+Per scene and seed: `rtpg render` of --frames 1-spp frames with --guiding off and with each variant's
+extra arguments, against a cached reference (`rtpg reference`, --ref-spp, seed 777); the figure is
+the mean relMSE of the last --window frames, PG/PT per seed, then the mean over seeds with the
+standard error of that mean. Renders are cached in --out by scene, variant and seed (delete the
+folder after changing the renderer), references in --out/references by the renderer's source hash.
+Prints a line per scene and variant and a Markdown table; writes --out/sweep.json.
+"""
+import argparse
+import json
+import math
+import statistics
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from suite import runner  # noqa: E402
+
+SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza", "slit-room", "corridor",
+          "sunlit-room"]
+
+
+def mean_and_standard_error(values):
+    """Mean of the values and the standard error of that mean (0 for a single value)."""
+    m = statistics.fmean(values)
+    se = statistics.stdev(values) / math.sqrt(len(values)) if len(values) > 1 else 0.0
+    return m, se
+
+
+def window_relmse(stats, window):
+    """Mean relMSE of the last `window` frames of a run's statistics."""
+    frames = stats["frames"][-window:]
+    return statistics.fmean(f["relmse"] for f in frames)
+
+
+def markdown_table(scenes, table):
+    """table[variant][scene] = (mean, se): a row per variant, the mean over scenes last."""
+    lines = ["| variant | " + " | ".join(scenes) + " | mean |", "|---" * (len(scenes) + 2) + "|"]
+    for name, row in table.items():
+        cells = [f"{row[s][0]:.3f} ± {row[s][1]:.3f}" for s in scenes]
+        mean = statistics.fmean(row[s][0] for s in scenes)
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {mean:.3f} |")
+    return "\n".join(lines)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--variants", required=True, help='JSON object: variant name -> list of extra rtpg arguments')
+    parser.add_argument("--scenes", nargs="+", default=SCENES)
+    parser.add_argument("--seeds", nargs="+", type=int, default=[1, 2, 3])
+    parser.add_argument("--res", default="240x135")
+    parser.add_argument("--frames", type=int, default=32)
+    parser.add_argument("--window", type=int, default=8, help="last frames whose relMSE is averaged")
+    parser.add_argument("--ref-spp", type=int, default=1024)
+    parser.add_argument("--out", default=str(runner.ROOT / "build" / "variant-sweep"))
+    args = parser.parse_args()
+    try:
+        variants = json.loads(args.variants)
+    except json.JSONDecodeError as e:
+        parser.error(f"--variants is not JSON: {e}")
+    if not isinstance(variants, dict) or not all(isinstance(v, list) for v in variants.values()):
+        parser.error('--variants must be a JSON object of argument lists, e.g. {"default": []}')
+    if not 1 <= args.window <= args.frames:
+        parser.error(f"--window {args.window} must be between 1 and --frames {args.frames}")
+
+    out = Path(args.out)
+    refs = runner.ReferenceCache(out / "references")
+
+    def relmse(scene, tag, seed, guiding, extra):
+        reference = refs.get(scene, args.res, args.ref_spp, seed=777)
+        run_dir = out / scene
+        cached = run_dir / f"{tag}-{seed}.json"
+        if cached.exists():
+            stats = json.loads(cached.read_text())
+        else:
+            stats, _ = runner.render(scene, args.res, args.frames, guiding, run_dir, f"{tag}-{seed}", reference=reference,
+                                     extra=["--seed", seed, *extra])
+        return window_relmse(stats, args.window)
+
+    table = {name: {} for name in variants}
+    for scene in args.scenes:
+        pt = [relmse(scene, "pt", s, "off", []) for s in args.seeds]
+        for name, extra in variants.items():
+            tag = "pg-" + "".join(c if c.isalnum() else "_" for c in name)
+            pg = [relmse(scene, tag, s, "pmm", extra) for s in args.seeds]
+            table[name][scene] = mean_and_standard_error([a / b for a, b in zip(pg, pt)])
+            m, se = table[name][scene]
+            print(f"{scene:18s} {name:24s} PT {statistics.fmean(pt):.4g}  PG/PT {m:.3f} ± {se:.3f}", flush=True)
+    print(markdown_table(args.scenes, table))
+    (out / "sweep.json").write_text(json.dumps({"settings": vars(args), "table": table}, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    main()
