@@ -145,7 +145,8 @@ __kernel void train_wide(
         b = pg_pmm_batch_add_w(b, m, settings, samples[s], original.w);
       pg_intw live = ~done, step;
       /* A re-seed replaces the history: later passes refine the new model alone. */
-      base = pg_pmm_state_select_w(base, pg_pmm_initial_state_w(), live & b.reseed);
+      base = pg_pmm_state_select_w(base, pg_pmm_initial_state_w(),
+                                   live & (b.reseed >= settings.reseed_samples));
       pg_pmm_state_w next = pg_pmm_update_w(base, b, settings, target, &step);
       updated = select(updated, step, live);
       result = pg_pmm_state_select_w(result, pg_pmm_state_select_w(original, next, step), live);

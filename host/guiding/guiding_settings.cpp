@@ -40,6 +40,8 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
            "Prior variance, added as sigma_prior / (k + 1)"),
       real("reseed_ratio", &S::reseed_ratio, 0, kInf, true, false,
            "Re-seed a lobe on a sample this many times brighter than its history"),
+      integer("reseed_samples", &S::reseed_samples, 1, PG_MAX_TRAIN_SAMPLES,
+              "Samples of one batch that must call for a re-seed before it happens"),
       real("weight_clamp", &S::weight_clamp, 0, kInf, false, false,
            "Clamp training weights to this multiple of the running mean (0 = off)"),
       integer("em_passes", &S::em_passes, 1, 8, "E-step passes over each frame's training samples"),
@@ -139,6 +141,7 @@ pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {
   p.stride = window_stride(c.apron);
   p.train_interval = c.train_interval;
   p.train_all_samples = c.train_all_samples;
+  p.reseed_samples = c.reseed_samples;
   return p;
 }
 

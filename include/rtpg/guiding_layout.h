@@ -129,6 +129,7 @@ typedef struct pg_kernel_settings {
   int train_interval;    /* a mature pixel (k >= k_max / 4) trains every train_interval-th frame */
   int train_all_samples; /* 1: train on every VPL at its full mixture density (normal.w);
                             0: BSDF-strategy VPLs only (paper 3.2) */
+  int reseed_samples;    /* samples of one batch that must call for a re-seed before it happens */
 } pg_kernel_settings;
 
 #ifdef __cplusplus

@@ -21,7 +21,9 @@ struct GuidingSettings {
   float step_alpha = 1.0f;  // eta_k = max((k+1)^-alpha, 1/(k_max+1)): 1 = plain mean until k_max
   float sigma_eps = 1e-4f;  // regularisation of Sigma's diagonal (square units^2)
   float sigma_prior = 5e-2f;   // prior variance, added as sigma_prior / (k + 1)
-  float reseed_ratio = 10.0f;  // a sample with weight > ratio * W outside the lobe re-seeds it
+  float reseed_ratio = 10.0f;  // a sample with weight > ratio * W outside the lobe re-seeds it,
+  int reseed_samples = 2;      // when this many samples of one frame's batch say so (one may be
+                               // a firefly; docs/guiding.md, "Re-seeds that take two samples")
   float weight_clamp = 0.0f;   // training weights clamped to weight_clamp * W (0 = no clamp)
   int em_passes = 3;           // E-step passes over each frame's samples
   float max_correlation = 0.95f;

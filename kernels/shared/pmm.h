@@ -183,8 +183,13 @@ typedef struct {
   float a, ag, agx, agy, agxx, agyy, agxy; /* E-step weighted sums */
   float ax, ay, axx, ayy, axy;             /* plain weighted moments (to seed a model) */
   float count;
-  int reseed; /* a sample far brighter than the model's history fell outside its lobe */
+  int reseed; /* samples far brighter than the model's history that fell outside its lobe */
 } pg_pmm_batch;
+
+/* Whether a batch re-seeds its model: reseed_samples of its samples called for it. */
+PG_FN int pg_pmm_batch_reseeds(pg_pmm_batch b, pg_kernel_settings p) {
+  return b.reseed >= p.reseed_samples;
+}
 
 PG_FN pg_pmm_batch pg_pmm_batch_empty(void) {
   pg_pmm_batch b;
@@ -219,8 +224,9 @@ PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_se
     /* A narrow lobe gives far-away evidence gamma ~ 0 (G underflows), so EM alone could
      * never move it: a sample far outside the lobe (beyond 5 standard deviations, where
      * gamma is negligible) and much brighter than the history re-seeds the model. Samples
-     * nearer than that move the lobe through the ordinary M-step. */
-    if (q > 25.0f && a > p.reseed_ratio * history_weight) b.reseed = 1;
+     * nearer than that move the lobe through the ordinary M-step. One such sample may be a
+     * firefly of the one-path VPL radiance; reseed_samples asks for more of them. */
+    if (q > 25.0f && a > p.reseed_ratio * history_weight) b.reseed += 1;
   }
   b.ax += a * u.x;
   b.ay += a * u.y;
@@ -256,7 +262,7 @@ PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_kernel_setti
   float inv = 1.0f / b.count;
   float k = s.s1.w;
   pg_pmm_state batch;
-  if (k <= 0.0f || b.reseed) {
+  if (k <= 0.0f || pg_pmm_batch_reseeds(b, p)) {
     /* A new model: the plain weighted moments of the batch at weight pi_init. */
     float w = p.pi_init * inv;
     batch.s0 = pg_make_float4(b.a * inv, b.a * w, b.ax * w, b.ay * w);
@@ -304,7 +310,7 @@ PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples
       b = pg_pmm_batch_add(b, m, p, samples[j].x, pg_make_float2(samples[j].y, samples[j].z),
                            samples[j].w, s.s0.x);
     /* A re-seed replaces the history: later passes refine the new model alone. */
-    if (b.reseed) base = pg_pmm_initial_state();
+    if (pg_pmm_batch_reseeds(b, p)) base = pg_pmm_initial_state();
     out = pg_pmm_update(base, b, p, target_count, updated);
     if (!*updated) return s;
     m = pg_pmm_model_from_state(out, p);

@@ -77,7 +77,7 @@ typedef struct {
   pg_floatw a, ag, agx, agy, agxx, agyy, agxy;
   pg_floatw ax, ay, axx, ayy, axy;
   pg_floatw count;
-  pg_intw reseed;
+  pg_intw reseed; /* a count per lane, as pg_pmm_batch's */
 } pg_pmm_batch_w;
 
 static inline pg_pmm_batch_w pg_pmm_batch_empty_w(void) {
@@ -107,7 +107,7 @@ static inline pg_pmm_batch_w pg_pmm_batch_add_w(pg_pmm_batch_w b, pg_pmm_model_w
   pg_intw finite = ~m.valid | isfinite(gamma_model);
   pg_intw add = ok & ~zero & finite;
   b.count = select(b.count, b.count + 1.0f, ok & (zero | finite));
-  b.reseed |= add & m.valid & (q > 25.0f) & (a > p.reseed_ratio * history_weight);
+  b.reseed -= add & m.valid & (q > 25.0f) & (a > p.reseed_ratio * history_weight); /* mask -1 */
   b.ax = select(b.ax, b.ax + a * s.ux, add);
   b.ay = select(b.ay, b.ay + a * s.uy, add);
   b.axx = select(b.axx, b.axx + a * s.ux * s.ux, add);
@@ -130,7 +130,8 @@ static inline pg_pmm_state_w pg_pmm_update_w(pg_pmm_state_w s, pg_pmm_batch_w b,
                                              pg_kernel_settings p, pg_floatw target_count,
                                              __private pg_intw* updated) {
   pg_floatw inv = 1.0f / b.count;
-  pg_intw fresh = (s.k <= 0.0f) | b.reseed; /* a new model from the batch's plain moments */
+  /* A new model from the batch's plain moments (pg_pmm_batch_reseeds). */
+  pg_intw fresh = (s.k <= 0.0f) | (b.reseed >= p.reseed_samples);
   pg_floatw w = p.pi_init * inv;
   pg_pmm_state_w batch;
   batch.w = b.a * inv;

@@ -469,6 +469,31 @@ TEST(PmmEm, AStarvedBatchTakesAProportionallySmallerStep) {
   EXPECT_GT(std::fabs(double(full.s0.z) - s0.s0.z), 1e-3) << "the batch must move the mean";
 }
 
+// Re-seeding (pmm.h, pg_pmm_batch_add): a narrow lobe whose batch has samples far outside it
+// (beyond 5 standard deviations) and brighter than reseed_ratio times its history restarts
+// (k back to 1) once reseed_samples of them are in one batch, and otherwise trains on (k + 1).
+TEST(PmmEm, ReseedsOnlyWhenEnoughSamplesOfOneBatchCallForIt) {
+  const pg_pmm_state s = make_state(0.3f, 0.3f, 0.001f, 0.001f, 0.0f, 0.5f, 10.0f);  // W = 2
+  const float4 near_lobe(1.0f, 0.31f, 0.29f, 0.3f), far_bright(100.0f, 0.8f, 0.8f, 0.3f);
+  const float4 far_bright2(100.0f, 0.85f, 0.75f, 0.3f);
+  const auto k_after = [&](int reseed_samples, std::vector<float4> batch) {
+    rtpg::GuidingSettings settings;
+    settings.reseed_samples = reseed_samples;
+    const pg_kernel_settings p = rtpg::to_kernel_settings(settings);
+    int updated = 0;
+    const pg_pmm_state out = pg_pmm_train(s, batch.data(), static_cast<int>(batch.size()), p,
+                                          static_cast<float>(batch.size()), 1, &updated);
+    EXPECT_EQ(updated, 1);
+    return out.s1.w;
+  };
+  EXPECT_EQ(k_after(1, {near_lobe, near_lobe, far_bright}), 1.0f);
+  EXPECT_EQ(k_after(2, {near_lobe, near_lobe, far_bright}), 11.0f);
+  EXPECT_EQ(k_after(2, {near_lobe, far_bright, far_bright2}), 1.0f);
+  EXPECT_EQ(k_after(3, {near_lobe, far_bright, far_bright2}), 11.0f);
+  // Far but not brighter than 10 W = 20: no re-seed at any setting.
+  EXPECT_EQ(k_after(1, {near_lobe, float4(15.0f, 0.8f, 0.8f, 0.3f)}), 11.0f);
+}
+
 // One sample repeated (and the square's corners and edge midpoints, where the map M has its
 // kinks and the mean sits on the clamp): the empirical covariance is exactly zero, yet the
 // model keeps a positive definite Sigma and its mean at the sample.
