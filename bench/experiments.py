@@ -64,18 +64,11 @@ def available(scene):
         return False, str(e).splitlines()[-1]
 
 
-def mean_sem(values):
-    """Mean and its standard error (frames of one run have independent noise)."""
-    values = list(values)
-    sem = statistics.stdev(values) / len(values) ** 0.5 if len(values) > 1 else float("nan")
-    return statistics.mean(values), sem
-
-
 def final_frame_metrics(stats, img, ref, T, exposure):
     """What equal-frame and denoised report of one method's run: the relMSE and LDR-FLIP (at the
     scene's exposure) of frame T, the mean relMSE of frames T-7..T with its standard error, and
     median times per stage."""
-    mean, sem = mean_sem(f["relmse"] for f in stats["frames"][T - LAST:T])
+    mean, sem = runner.mean_sem(f["relmse"] for f in stats["frames"][T - LAST:T])
     return {"relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
             "flip_ldr": metrics.flip_ldr(img, ref, exposure),
             "time_ms": {k: runner.median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}}
@@ -222,7 +215,7 @@ def flicker(ctx, scene):
     for method in METHODS:
         stats, _ = runner.render(scene, m["res"], m["flicker_frames"], method, out, method, extra=["--no-jitter"])
         values = [f["flicker_mse"] for f in stats["frames"] if "flicker_mse" in f][-LAST:]
-        mean, sem = mean_sem(values)
+        mean, sem = runner.mean_sem(values)
         result["methods"][method] = {"flicker_mse": mean, "sem": sem}
     return result
 
@@ -314,12 +307,12 @@ def denoised(ctx, scene):
             imgs = {f: metrics.load_exr(saved_frame(image, f)) for f in frames}
             flicker = [f["flicker_mse"] for f in stats["frames"] if "flicker_mse" in f]
             flicker_noisy = [f["flicker_mse_noisy"] for f in stats["frames"] if "flicker_mse_noisy" in f]
-            fm, fs = mean_sem(flicker)
+            fm, fs = runner.mean_sem(flicker)
             result["path"][method] = {"frames": frames,
                                       "relmse": [metrics.relmse(imgs[f], refs[f]) for f in frames],
                                       "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f], exposure) for f in frames],
                                       "flicker_mse": fm, "flicker_sem": fs,
-                                      "flicker_mse_noisy": mean_sem(flicker_noisy)[0]}
+                                      "flicker_mse_noisy": runner.mean_sem(flicker_noisy)[0]}
     flips = {k: result["static"][k]["flip_ldr"] for k in METHODS}
     result["figure"] = comparison_figure(
         ref, images, ("Reference", f"PT+SVGF  FLIP {flips['off']:.3f}", f"PG+SVGF  FLIP {flips['pmm']:.3f}"),
@@ -352,7 +345,7 @@ def tradeoffs(ctx, scene):
                                      extra=flags + ["--save-frames", last])
         errors = [metrics.relmse(metrics.load_exr(saved_frame(image, f)), ref)
                   for f in range(m["trade_frames"] - LAST, m["trade_frames"])]
-        mean, sem = mean_sem(errors)
+        mean, sem = runner.mean_sem(errors)
         rows[name] = {"train_ms": runner.median_frame_ms(stats, "train"), "frame_ms": runner.median_frame_ms(stats),
                       "relmse_last8": mean, "relmse_last8_sem": sem, "flags": [str(f) for f in flags]}
     fig, ax = plt.subplots(figsize=(6, 4))

@@ -14,7 +14,6 @@ Prints a line per scene and variant and a Markdown table; writes --out/sweep.jso
 """
 import argparse
 import json
-import math
 import statistics
 import sys
 from pathlib import Path
@@ -24,13 +23,6 @@ from suite import runner  # noqa: E402
 
 SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza", "slit-room", "corridor",
           "sunlit-room"]
-
-
-def mean_and_standard_error(values):
-    """Mean of the values and the standard error of that mean (0 for a single value)."""
-    m = statistics.fmean(values)
-    se = statistics.stdev(values) / math.sqrt(len(values)) if len(values) > 1 else 0.0
-    return m, se
 
 
 def window_relmse(stats, window):
@@ -89,7 +81,7 @@ def main():
         for name, extra in variants.items():
             tag = "pg-" + "".join(c if c.isalnum() else "_" for c in name)
             pg = [relmse(scene, tag, s, "pmm", extra) for s in args.seeds]
-            table[name][scene] = mean_and_standard_error([a / b for a, b in zip(pg, pt)])
+            table[name][scene] = runner.mean_sem([a / b for a, b in zip(pg, pt)])
             m, se = table[name][scene]
             print(f"{scene:18s} {name:24s} PT {statistics.fmean(pt):.4g}  PG/PT {m:.3f} ± {se:.3f}", flush=True)
     print(markdown_table(args.scenes, table))

@@ -146,7 +146,7 @@ __kernel void train_wide(
       pg_intw live = ~done, step;
       /* A re-seed replaces the history: later passes refine the new model alone. */
       base = pg_pmm_state_select_w(base, pg_pmm_initial_state_w(),
-                                   live & (b.reseed >= settings.reseed_samples));
+                                   live & pg_pmm_batch_reseeds_w(b, settings));
       pg_pmm_state_w next = pg_pmm_update_w(base, b, settings, target, &step);
       updated = select(updated, step, live);
       result = pg_pmm_state_select_w(result, pg_pmm_state_select_w(original, next, step), live);

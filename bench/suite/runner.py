@@ -64,6 +64,14 @@ def scene_exposure(name):
     return float(json.loads(Path(scene_path(name)).read_text()).get("exposure", 1.0))
 
 
+def mean_sem(values):
+    """Mean and its standard error, for independent values (frames of one run, seeds); the error
+    of a single value is unknown (NaN)."""
+    values = list(values)
+    sem = statistics.stdev(values) / len(values) ** 0.5 if len(values) > 1 else float("nan")
+    return statistics.mean(values), sem
+
+
 def median_frame_ms(stats, key="total"):
     """Median over frames; frame 0 is left out (it builds programs and warms caches)."""
     frames = stats["frames"][1:] or stats["frames"]

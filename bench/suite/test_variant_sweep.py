@@ -13,14 +13,17 @@ from pathlib import Path
 BENCH = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(BENCH))
 import variant_sweep  # noqa: E402
+from suite import runner  # noqa: E402
 
 
 class Statistics(unittest.TestCase):
-    def test_mean_and_standard_error(self):
-        m, se = variant_sweep.mean_and_standard_error([1.0, 2.0, 3.0])
+    def test_mean_and_standard_error(self):  # the shared helper the sweep uses
+        m, se = runner.mean_sem([1.0, 2.0, 3.0])
         self.assertEqual(m, 2.0)
         self.assertAlmostEqual(se, 1.0 / math.sqrt(3.0), places=15)  # stdev 1 over sqrt(3)
-        self.assertEqual(variant_sweep.mean_and_standard_error([0.7]), (0.7, 0.0))
+        m, se = runner.mean_sem([0.7])
+        self.assertEqual(m, 0.7)
+        self.assertTrue(math.isnan(se))  # one seed: no error estimate
 
     def test_window_is_the_last_frames(self):
         stats = {"frames": [{"relmse": float(i)} for i in range(10)]}

@@ -124,6 +124,11 @@ static inline pg_pmm_batch_w pg_pmm_batch_add_w(pg_pmm_batch_w b, pg_pmm_model_w
   return b;
 }
 
+/* pg_pmm_batch_reseeds per lane. */
+static inline pg_intw pg_pmm_batch_reseeds_w(pg_pmm_batch_w b, pg_kernel_settings p) {
+  return b.reseed >= p.reseed_samples;
+}
+
 /* pg_pmm_update: the M-step of every lane; *updated is the mask of lanes whose state changed
  * (the others keep s). */
 static inline pg_pmm_state_w pg_pmm_update_w(pg_pmm_state_w s, pg_pmm_batch_w b,
@@ -131,7 +136,7 @@ static inline pg_pmm_state_w pg_pmm_update_w(pg_pmm_state_w s, pg_pmm_batch_w b,
                                              __private pg_intw* updated) {
   pg_floatw inv = 1.0f / b.count;
   /* A new model from the batch's plain moments (pg_pmm_batch_reseeds). */
-  pg_intw fresh = (s.k <= 0.0f) | (b.reseed >= p.reseed_samples);
+  pg_intw fresh = (s.k <= 0.0f) | pg_pmm_batch_reseeds_w(b, p);
   pg_floatw w = p.pi_init * inv;
   pg_pmm_state_w batch;
   batch.w = b.a * inv;
