@@ -12,6 +12,7 @@ DEBIAN_PACKAGES=(
   libembree-dev libopenimageio-dev openimageio-tools libglm-dev libassimp-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev
   libgtest-dev libgmock-dev libbenchmark-dev oclgrind clang-format
+  embree-tools
   python3 python3-pip python3-venv
 )
 
