@@ -19,8 +19,8 @@ time (megakernel), ends a path only when its throughput falls below 0.01 (no Rus
 traces one shadow ray per light at every vertex (two here), so it traces several times more rays
 per path than rtpg (one shadow ray per vertex, roulette from bounce 3). This Debian build also reads
 no PNG or TGA textures (those materials render untextured) and does not alpha-test; light
-intensities are not matched (ray counts do not depend on them). Its rays per second come from its
-own counters (BENCHMARK_RENDER_MRAYPS: every rtcIntersect1 and rtcOccluded1 call); rtpg's from its
+intensities and the scene file's material overrides do not reach the tutorial (it takes the MTL's
+colours). Its rays per second come from its own counters (BENCHMARK_RENDER_MRAYPS: every rtcIntersect1 and rtcOccluded1 call); rtpg's from its
 statistics (camera, bounce and shadow rays of the frame over the frame's total time).
 """
 import argparse
@@ -73,7 +73,9 @@ def tutorial_arguments(scene_file, width, height):
             "--fov", cam["fov"], "--size", width, height, "--spp", 1,
             "--max-path-length", int(scene.get("max_bounces", 8)) + 1]
     env = scene.get("environment", {})
-    if "color" in env and "map" not in env:
+    if "file" in env:
+        raise SetupError(f"{scene_file}: the tutorial has no environment map light")
+    if "color" in env:
         args += ["--ambientlight", *env["color"]]
     sun = scene.get("sun")
     if sun:

@@ -51,6 +51,12 @@ class Arguments(unittest.TestCase):
             embree_tutorial.tutorial_arguments(SCENES / "cornell-box.json", 64, 64)
         self.assertIn("cornell-box.json", str(e.exception))
 
+    @unittest.skipUnless(sponza_assets(), "no Sponza assets (scenes/README.md, 'Without ../shared/scenes')")
+    def test_environment_maps_are_refused(self):  # the tutorial could not match that light
+        with self.assertRaises(embree_tutorial.SetupError) as e:
+            embree_tutorial.tutorial_arguments(SCENES / "sponza-sky.json", 64, 64)
+        self.assertIn("environment map", str(e.exception))
+
 
 class Parsing(unittest.TestCase):
     def test_benchmark_summary(self):
