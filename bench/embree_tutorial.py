@@ -18,10 +18,11 @@ What is not, and why the per-path and per-ray figures differ: the tutorial shade
 time (megakernel), ends a path only when its throughput falls below 0.01 (no Russian roulette) and
 traces one shadow ray per light at every vertex (two here), so it traces several times more rays
 per path than rtpg (one shadow ray per vertex, roulette from bounce 3). This Debian build also reads
-no PNG or TGA textures (those materials render untextured) and does not alpha-test; light
+no PNG or TGA textures (those materials take their MTL colour) and does not alpha-test; light
 intensities and the scene file's material overrides do not reach the tutorial (it takes the MTL's
-colours). Its rays per second come from its own counters (BENCHMARK_RENDER_MRAYPS: every rtcIntersect1 and rtcOccluded1 call); rtpg's from its
-statistics (camera, bounce and shadow rays of the frame over the frame's total time).
+colours). Its rays per second come from its own counters (BENCHMARK_RENDER_MRAYPS: every
+rtcIntersect1 and rtcOccluded1 call); rtpg's from its statistics (camera, bounce and shadow rays of
+the frame over the frame's total time).
 """
 import argparse
 import json
@@ -98,6 +99,8 @@ def run_tutorial(args, frames):
     if r.returncode != 0:
         raise SetupError(f"{TUTORIAL} failed ({r.returncode}): {r.stderr.strip()[-400:]}")
     fps, mrays = parse_benchmark(r.stdout)
+    if not (fps > 0.0 and mrays > 0.0):
+        raise SetupError(f"the tutorial reported {fps} frames/s and {mrays} M rays/s")
     frame_ms = 1e3 / fps
     rays = mrays * 1e6 / fps
     return {"frame_ms": frame_ms, "rays_per_frame": rays, "mrays_per_s": mrays}
@@ -161,7 +164,8 @@ def main():
         rounds = []
         with tempfile.TemporaryDirectory() as tmp:
             for i in range(a.rounds):
-                rounds.append({"tutorial": run_tutorial(args, a.frames), "rtpg": run_rtpg(a.scene, a.res, a.frames, tmp)})
+                tutorial = run_tutorial(args, a.frames)
+                rounds.append({"tutorial": tutorial, "rtpg": run_rtpg(a.scene, a.res, a.frames, tmp)})
                 print(f"round {i + 1}: tutorial {rounds[-1]['tutorial']['frame_ms']:.1f} ms, "
                       f"rtpg {rounds[-1]['rtpg']['frame_ms']:.1f} ms", flush=True)
     except (SetupError, RuntimeError) as e:
