@@ -109,7 +109,7 @@ def run_tutorial(args, frames):
 def rtpg_frame_figures(stats):
     """Median over frames (frame 0 left out) of frame time and rays of a `rtpg render` run."""
     frames = stats["frames"][1:] or stats["frames"]
-    frame_ms = statistics.median(f["time_ms"]["total"] for f in frames)
+    frame_ms = runner.median_frame_ms(stats)
     rays = statistics.median(sum(f["rays"][k] for k in ("primary", "secondary", "shadow")) for f in frames)
     return {"frame_ms": frame_ms, "rays_per_frame": rays, "mrays_per_s": rays / frame_ms * 1e-3}
 
