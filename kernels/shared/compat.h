@@ -56,8 +56,6 @@ using std::cos;
 using std::exp;
 using std::fabs;
 using std::floor;
-using std::fmax;
-using std::fmin;
 using std::log;
 using std::sin;
 using std::sqrt;
@@ -73,6 +71,16 @@ PG_FN float4 pg_make_float4(float x, float y, float z, float w) {
 }
 PG_FN float3 pg_float4_xyz(float4 v) {
   return float3(v.x, v.y, v.z);
+}
+/* fmax and fmin with the results of OpenCL C and glibc (the other operand where one is NaN, the
+ * second where both compare equal, so signed zeros come out as glibc's, bit for bit), inline:
+ * std::fmax is a call into libm, made several times per path vertex on the host
+ * (docs/host-path-tracer.md, "Tried and kept"). */
+PG_FN float fmax(float a, float b) {
+  return (a > b || b != b) ? a : b;
+}
+PG_FN float fmin(float a, float b) {
+  return (a < b || b != b) ? a : b;
 }
 PG_FN float clamp(float x, float lo, float hi) {
   return fmin(fmax(x, lo), hi);
