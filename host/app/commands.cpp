@@ -146,7 +146,8 @@ nlohmann::json path_tracer_settings_json(const PathTracerSettings& s) {
   return {{"max_bounces", s.max_bounces},
           {"roulette_start", s.roulette_start},
           {"next_event", s.next_event},
-          {"guide_secondary", s.guide_secondary}};
+          {"guide_secondary", s.guide_secondary},
+          {"direct_light_in_vpls", s.direct_light_in_vpls}};
 }
 
 // The flag wins, then the scene's integrator setting, then the renderer's default.
@@ -205,6 +206,7 @@ int run_render(const RenderCommand& command) {
   settings.path_tracer.max_bounces = bounces_for(scene, command.max_bounces);
   settings.path_tracer.guide_secondary =
       command.guiding == "pmm" && command.guide_vertices == "all";
+  settings.path_tracer.direct_light_in_vpls = command.guide_direct_light == "mis";
   settings.path_tracer.guide_position = command.guiding_settings.reproject_position;
   settings.path_tracer.guide_normal = command.guiding_settings.reproject_normal;
   Renderer renderer = with_flag_names([&] { return Renderer(scene, settings); });

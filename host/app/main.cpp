@@ -44,6 +44,11 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
                   "vertices seen by the camera borrow their pixel's mixture)")
       ->check(CLI::IsMember({"first", "all"}))
       ->capture_default_str();
+  cmd->add_option("--guide-direct-light", r.guide_direct_light,
+                  "With --guiding pmm and next-event estimation: off (the VPLs leave out the light "
+                  "y emits) or mis (they carry it with its MIS weight)")
+      ->check(CLI::IsMember({"off", "mis"}))
+      ->capture_default_str();
   auto* grp = cmd->add_option_group("Guiding",
                                     "Settings of the PMM guider (include/rtpg/guiding_settings.h)");
   for (const rtpg::GuidingSettingInfo& row : rtpg::guiding_settings_table()) {

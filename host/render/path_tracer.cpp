@@ -211,8 +211,9 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         p.radiance += p.throughput * le * w;
         if (depth == 1) {
           // With next-event estimation at x0 the light's own direction is NEE's job: the
-          // guide learns only what arrives indirectly (emission at y stays out).
-          if (!nee) p.vpl_radiance += le;
+          // guide learns only what arrives indirectly (emission at y stays out), or the light
+          // with the MIS weight this sample got (direct_light_in_vpls).
+          if (!nee || settings_.direct_light_in_vpls) p.vpl_radiance += le * w;
           if (vpls) {
             vpls->position[i] = glm::vec4(dir, vpls->position[i].w);
             vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
@@ -232,8 +233,8 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         p.radiance += p.throughput * sp.emission * w;
         if (depth > 1) {
           p.vpl_radiance += p.vpl_throughput * sp.emission * w;
-        } else if (!nee) {
-          p.vpl_radiance += sp.emission;  // see the escaped case above
+        } else if (!nee || settings_.direct_light_in_vpls) {
+          p.vpl_radiance += sp.emission * w;  // see the escaped case above
         }
       }
       if (depth == 1 && vpls) {

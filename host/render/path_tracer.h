@@ -28,6 +28,11 @@ struct PathTracerSettings {
   // in some pixel (the same surface by the tests of reprojection, these thresholds) samples
   // that pixel's guiding mixture instead of its BSDF alone.
   bool guide_secondary = false;
+  // What the first-bounce VPLs learn of the light that y emits towards x0 when next-event
+  // estimation is on (docs/guiding.md, "Direct light in the training target"): false leaves it
+  // out (NEE samples the lights at x0); true adds it with the MIS weight the BSDF-side sample
+  // received, so directions where light sampling fails (a light seen through a slit) are learnt.
+  bool direct_light_in_vpls = false;
   float guide_position = 0.05f;  // relative distance to the pixel's depth
   float guide_normal = 0.9f;     // normal cosine
 };
