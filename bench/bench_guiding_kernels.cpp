@@ -506,6 +506,7 @@ void tbb_train(const Inputs& in, const pg_kernel_settings& params, std::uint32_t
           const sh::uint start =
               sh::pg_train_walk_start(seed, x, y, static_cast<sh::uint>(w), frame, params);
           float4 samples[PG_MAX_TRAIN_SAMPLES];
+          float densities[PG_MAX_TRAIN_SAMPLES];
           int kept = 0;
           for (int s = 0; s < n; ++s) {
             const int wi = sh::pg_train_window_index(start, s, params);
@@ -513,11 +514,12 @@ void tbb_train(const Inputs& in, const pg_kernel_settings& params, std::uint32_t
             if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
             const int j = sy * w + sx;
             kept += sh::pg_train_sample_from_vpl(px, in.vpls.position[j], in.vpls.normal[j],
-                                                 in.vpls.radiance_info[j], params, &samples[kept]);
+                                                 in.vpls.radiance_info[j], params, &samples[kept],
+                                                 &densities[kept]);
           }
           int updated = 0;
-          st = sh::pg_pmm_train(st, samples, kept, params, static_cast<float>(n), params.em_passes,
-                                &updated);
+          st = sh::pg_pmm_train(st, samples, densities, kept, params, static_cast<float>(n),
+                                params.em_passes, &updated);
           s0 = st.s0;
           s1 = st.s1;
           changed = static_cast<std::uint8_t>(updated);

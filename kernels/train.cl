@@ -56,6 +56,7 @@ __kernel void train(
     int n = min(min(pg_pmm_neighbour_count(s1.w, settings), side * side), PG_MAX_TRAIN_SAMPLES);
     uint start = pg_train_walk_start(seed, x, y, width, frame, settings);
     float4 samples[PG_MAX_TRAIN_SAMPLES];
+    float densities[PG_MAX_TRAIN_SAMPLES];
     int kept = 0;
     for (int s = 0; s < n; ++s) {
       int w = pg_train_window_index(start, s, settings);
@@ -63,17 +64,18 @@ __kernel void train(
 #if PG_TRAIN_LOCAL_TILE
       int t = ((int)get_local_id(1) + apron + dy) * tw + (int)get_local_id(0) + apron + dx;
       kept += pg_train_sample_from_vpl(px, tile_position[t], tile_normal[t], tile_radiance[t],
-                                       settings, &samples[kept]);
+                                       settings, &samples[kept], &densities[kept]);
 #else
       int sx = x + dx, sy = y + dy;
       if (sx < 0 || sy < 0 || sx >= (int)width || sy >= (int)height) continue;
       int j = sy * (int)width + sx;
       kept += pg_train_sample_from_vpl(px, vpl_position[j], vpl_normal[j], vpl_radiance_info[j],
-                                       settings, &samples[kept]);
+                                       settings, &samples[kept], &densities[kept]);
 #endif
     }
     int updated = 0;
-    state = pg_pmm_train(state, samples, kept, settings, (float)n, settings.em_passes, &updated);
+    state = pg_pmm_train(state, samples, densities, kept, settings, (float)n, settings.em_passes,
+                         &updated);
     s0 = state.s0;
     s1 = state.s1;
     changed = (uchar)updated;

@@ -63,6 +63,8 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
               "A mature pixel (k >= k_max/4) trains every this many frames"),
       integer("train_all_samples", &S::train_all_samples, 0, 1,
               "1: train on every VPL at its mixture density; 0: BSDF samples only"),
+      integer("pi_learning", &S::pi_learning, 0, 1,
+              "1: the mixing weight minimises the first bounce's second moment; 0: EM's"),
       integer("local_x", &S::local_x, 1, 65536, "Work-group (VPL tile) width"),
       integer("local_y", &S::local_y, 1, 65536, "Work-group (VPL tile) height"),
       integer("train_lanes", &S::train_lanes, 0, 16,
@@ -142,6 +144,7 @@ pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {
   p.train_interval = c.train_interval;
   p.train_all_samples = c.train_all_samples;
   p.reseed_samples = c.reseed_samples;
+  p.pi_learning = c.pi_learning;
   return p;
 }
 

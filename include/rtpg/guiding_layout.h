@@ -130,6 +130,8 @@ typedef struct pg_kernel_settings {
   int train_all_samples; /* 1: train on every VPL at its full mixture density (normal.w);
                             0: BSDF-strategy VPLs only (paper 3.2) */
   int reseed_samples;    /* samples of one batch that must call for a re-seed before it happens */
+  int pi_learning;       /* 1: the mixing weight minimises the first bounce's second moment;
+                            0: EM's weight (paper 3.2) */
 } pg_kernel_settings;
 
 #ifdef __cplusplus

@@ -34,12 +34,16 @@ struct GuidingSettings {
   float max_weight = 1e8f;           // training weights above this are dropped as absurd
   float reproject_position = 0.05f;  // relative distance (to the depth) that rejects history
   float reproject_normal = 0.9f;     // normal cosine below which history is rejected
-  int train_interval = 2;          // a mature pixel (k >= k_max / 4) trains every this many frames,
-                                   // in a rotating pattern (the rest keep their state); 2: the
-                                   // same error as 1 for 14-24% less train time
-                                   // (docs/guiding.md, "What amortised training saves")
-  int train_all_samples = 0;       // 1: every VPL trains, weighted by its full mixture density;
-                                   // 0: BSDF-strategy VPLs only (paper 3.2)
+  int train_interval = 2;     // a mature pixel (k >= k_max / 4) trains every this many frames,
+                              // in a rotating pattern (the rest keep their state); 2: the
+                              // same error as 1 for 14-24% less train time
+                              // (docs/guiding.md, "What amortised training saves")
+  int train_all_samples = 0;  // 1: every VPL trains, weighted by its full mixture density;
+                              // 0: BSDF-strategy VPLs only (paper 3.2)
+  int pi_learning = 0;        // 1: the mixing weight is the one that minimises the first
+                              // bounce's second moment (a Newton step per frame on the
+                              // training samples); 0: EM's weight (paper 3.2)
+                              // (docs/guiding.md, "A mixing weight that minimises the variance")
   int local_x = 16, local_y = 16;  // work-group size of the kernels (the VPL tile)
   int train_lanes = 0;   // pixels per work-item of the train kernel: 1 (train.cl), or 2, 4, 8, 16
                          // in vector lanes (train_wide.cl); 0 = auto: on CPU devices the SIMD

@@ -184,6 +184,12 @@ typedef struct {
   float ax, ay, axx, ayy, axy;             /* plain weighted moments (to seed a model) */
   float count;
   int reseed; /* samples far brighter than the model's history that fell outside its lobe */
+  /* The variance-aware mixing weight (pi_learning; docs/guiding.md, "A mixing weight that
+   * minimises the variance"): the first two derivatives in pi of the first bounce's second
+   * moment M(pi) = sum a^2 r / D(pi) at the E-step's model, v1 = -M' = sum a^2 r (G - B) / D^2
+   * and v2 = M'' / 2 = sum a^2 r (G - B)^2 / D^3 (G the Gaussian's density, B the BSDF's, r the
+   * density the sample was drawn with), and that model's pi. */
+  float v1, v2, model_pi;
 } pg_pmm_batch;
 
 /* Whether a batch re-seeds its model: reseed_samples of its samples called for it. */
@@ -197,14 +203,16 @@ PG_FN pg_pmm_batch pg_pmm_batch_empty(void) {
   b.ax = b.ay = b.axx = b.ayy = b.axy = 0.0f;
   b.count = 0.0f;
   b.reseed = 0;
+  b.v1 = b.v2 = b.model_pi = 0.0f;
   return b;
 }
 
-/* E-step for one sample: weight a (>= 0), square point u, direction wi, BSDF density of wi.
+/* E-step for one sample: weight a (>= 0), square point u, direction wi, BSDF density of wi,
+ * and the density the sample was drawn with (0 if unknown: it then adds nothing to v1, v2).
  * A model that does not exist yet takes every sample at the initial weight (so its first
  * M-step gives the weighted moments and pi = pi_init). */
 PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_settings p, float a,
-                                    float2 u, float bsdf_pdf, float history_weight) {
+                                    float2 u, float bsdf_pdf, float density, float history_weight) {
   if (!(a >= 0.0f) || !(a <= p.max_weight)) return b; /* NaN, negative or absurd: dropped */
   /* VPL radiance is a one-path estimate with a heavy tail: a single firefly would drag the
    * lobe to a random direction. Training (not rendering) clamps weights to a multiple of the
@@ -227,6 +235,13 @@ PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_se
      * nearer than that move the lobe through the ordinary M-step. One such sample may be a
      * firefly of the one-path VPL radiance; reseed_samples asks for more of them. */
     if (q > 25.0f && a > p.reseed_ratio * history_weight) b.reseed += 1;
+    if (p.pi_learning && density > 0.0f && d > 0.0f) {
+      float delta = g / m.pi - bsdf_pdf; /* dD/dpi */
+      float c = a * a * density / (d * d);
+      b.v1 += c * delta;
+      b.v2 += c * delta * delta / d;
+      b.model_pi = m.pi;
+    }
   }
   b.ax += a * u.x;
   b.ay += a * u.y;
@@ -271,8 +286,17 @@ PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_kernel_setti
   } else {
     /* Skip a batch that gives the Gaussian nothing: at eta = 1 it would zero S0. */
     if (!(b.ag > 0.0f)) return s;
-    batch.s0 = pg_make_float4(b.a * inv, b.ag * inv, b.agx * inv, b.agy * inv);
-    batch.s1 = pg_make_float4(b.agxx * inv, b.agyy * inv, b.agxy * inv, 0.0f);
+    /* With pi_learning the batch's mixing weight is not EM's ag / a but one Newton step on the
+     * convex M(pi) from the E-step's pi: its Gaussian statistics are scaled to that weight, so
+     * the running pi follows the variance-optimal one at the EM step size while the lobe's
+     * mean and covariance (ratios of these statistics) stay EM's. */
+    float scale = 1.0f;
+    if (p.pi_learning && b.v2 > 0.0f && isfinite(b.v1) && isfinite(b.v2))
+      scale = clamp(b.model_pi + 0.5f * b.v1 / b.v2, p.pi_min, p.pi_max) * b.a / b.ag;
+    float ag = b.ag * scale * inv;
+    batch.s0 = pg_make_float4(b.a * inv, ag, b.agx * scale * inv, b.agy * scale * inv);
+    batch.s1 =
+        pg_make_float4(b.agxx * scale * inv, b.agyy * scale * inv, b.agxy * scale * inv, 0.0f);
   }
   if (!pg_pmm_state_finite(batch)) return s;
   float eta = 1.0f;
@@ -290,13 +314,14 @@ PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_kernel_setti
 }
 
 /* One frame's training of one pixel from its n samples (x = weight a, y/z = square point u,
- * w = BSDF density), with `passes` E-step passes: each pass re-evaluates the responsibilities
- * under the model the previous pass's M-step would give, so a lobe that sits off its target
- * moves there within the frame instead of over many frames (a single pass converges slowly:
- * docs/guiding.md, "Training"). Only the last pass's statistics enter the state. */
-PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples, int n,
-                                pg_kernel_settings p, float target_count, int passes,
-                                PG_PRIVATE int* updated) {
+ * w = BSDF density; densities[j] = the density sample j was drawn with), with `passes` E-step
+ * passes: each pass re-evaluates the responsibilities under the model the previous pass's M-step
+ * would give, so a lobe that sits off its target moves there within the frame instead of over many
+ * frames (a single pass converges slowly: docs/guiding.md, "Training"). Only the last pass's
+ * statistics enter the state. */
+PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples,
+                                PG_PRIVATE const float* densities, int n, pg_kernel_settings p,
+                                float target_count, int passes, PG_PRIVATE int* updated) {
   pg_pmm_model m = pg_pmm_model_from_state(s, p);
   pg_pmm_state base = s, out = s;
   *updated = 0;
@@ -308,7 +333,7 @@ PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples
     pg_pmm_batch b = pg_pmm_batch_empty();
     for (int j = 0; j < n; ++j)
       b = pg_pmm_batch_add(b, m, p, samples[j].x, pg_make_float2(samples[j].y, samples[j].z),
-                           samples[j].w, s.s0.x);
+                           samples[j].w, densities[j], s.s0.x);
     /* A re-seed replaces the history: later passes refine the new model alone. */
     if (pg_pmm_batch_reseeds(b, p)) base = pg_pmm_initial_state();
     out = pg_pmm_update(base, b, p, target_count, updated);

@@ -23,13 +23,14 @@ typedef struct {
 } pg_train_pixel;
 
 /* One VPL (position_pdf, normal, radiance with the info bits in w) as a training sample of
- * this pixel: x = weight a = lum(L f_r cos) / r, (y, z) = square point, w = BSDF density.
- * Returns 0 when the VPL says nothing about this pixel's hemisphere. With train_all_samples
- * every VPL counts at the density its pixel really sampled with (the whole mixture D, in
- * normal.w); otherwise BSDF-strategy VPLs only, at the BSDF's density (paper 3.2). */
+ * this pixel: x = weight a = lum(L f_r cos) / r, (y, z) = square point, w = BSDF density, and
+ * *density = r, the density of its direction in this pixel's solid angle. Returns 0 when the VPL
+ * says nothing about this pixel's hemisphere. With train_all_samples every VPL counts at the
+ * density its pixel really sampled with (the whole mixture D, in normal.w); otherwise BSDF-strategy
+ * VPLs only, at the BSDF's density (paper 3.2). */
 PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float4 normal,
                                    float4 radiance_info, pg_kernel_settings p,
-                                   PG_PRIVATE float4* sample) {
+                                   PG_PRIVATE float4* sample, PG_PRIVATE float* density_out) {
   uint info = (uint)radiance_info.w;
   if ((info & PG_VPL_VALID) == 0u) return 0;
   if (!p.train_all_samples && PG_VPL_STRATEGY(info) != PG_STRATEGY_BSDF) return 0;
@@ -53,6 +54,7 @@ PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float
   float3 wl = pg_to_local(px.frame, w);
   if (wl.z <= 0.0f) return 0;
   float3 radiance = pg_float4_xyz(radiance_info);
+  *density_out = r;
   if (pg_max3(radiance) <= 0.0f) { /* a dark VPL: weight 0, no need to map it */
     *sample = pg_make_float4(0.0f, 0.5f, 0.5f, 0.0f);
     return 1;

@@ -31,10 +31,11 @@ typedef struct {
   pg_floatw info;
 } pg_vpls_w;
 
-/* A training sample per lane (pg_train_sample_from_vpl's float4, and whether it returned 1). */
+/* A training sample per lane (pg_train_sample_from_vpl's float4 and density, and whether it
+ * returned 1). */
 typedef struct {
   pg_intw kept;
-  pg_floatw a, ux, uy, bsdf_pdf;
+  pg_floatw a, ux, uy, bsdf_pdf, density;
 } pg_train_samples_w;
 
 /* pg_train_sample_from_vpl for every lane whose mask `asked` is set. */
@@ -63,6 +64,7 @@ static inline pg_train_samples_w pg_train_samples_from_vpls_w(pg_train_pixels_w 
   pg_hemisphere_to_square_w(wl, &s.ux, &s.uy);
   s.a = pg_luminance3w(pg_mul3w(v.radiance, f)) / r;
   s.bsdf_pdf = pdf;
+  s.density = r;
   /* A dark VPL: weight 0 at the square's centre. */
   pg_intw dark = pg_max3w(v.radiance) <= 0.0f;
   s.a = select(s.a, (pg_floatw)(0.0f), dark);
@@ -78,6 +80,7 @@ typedef struct {
   pg_floatw ax, ay, axx, ayy, axy;
   pg_floatw count;
   pg_intw reseed; /* a count per lane, as pg_pmm_batch's */
+  pg_floatw v1, v2, model_pi;
 } pg_pmm_batch_w;
 
 static inline pg_pmm_batch_w pg_pmm_batch_empty_w(void) {
@@ -86,6 +89,7 @@ static inline pg_pmm_batch_w pg_pmm_batch_empty_w(void) {
   b.ax = b.ay = b.axx = b.ayy = b.axy = (pg_floatw)(0.0f);
   b.count = (pg_floatw)(0.0f);
   b.reseed = (pg_intw)(0);
+  b.v1 = b.v2 = b.model_pi = (pg_floatw)(0.0f);
   return b;
 }
 
@@ -108,6 +112,14 @@ static inline pg_pmm_batch_w pg_pmm_batch_add_w(pg_pmm_batch_w b, pg_pmm_model_w
   pg_intw add = ok & ~zero & finite;
   b.count = select(b.count, b.count + 1.0f, ok & (zero | finite));
   b.reseed -= add & m.valid & (q > 25.0f) & (a > p.reseed_ratio * history_weight); /* mask -1 */
+  if (p.pi_learning) {
+    pg_intw learn = add & m.valid & (s.density > 0.0f) & (d > 0.0f);
+    pg_floatw delta = g / m.pi - s.bsdf_pdf;
+    pg_floatw c = a * a * s.density / (d * d);
+    b.v1 = select(b.v1, b.v1 + c * delta, learn);
+    b.v2 = select(b.v2, b.v2 + c * delta * delta / d, learn);
+    b.model_pi = select(b.model_pi, m.pi, learn);
+  }
   b.ax = select(b.ax, b.ax + a * s.ux, add);
   b.ay = select(b.ay, b.ay + a * s.uy, add);
   b.axx = select(b.axx, b.axx + a * s.ux * s.ux, add);
@@ -138,14 +150,21 @@ static inline pg_pmm_state_w pg_pmm_update_w(pg_pmm_state_w s, pg_pmm_batch_w b,
   /* A new model from the batch's plain moments (pg_pmm_batch_reseeds). */
   pg_intw fresh = (s.k <= 0.0f) | pg_pmm_batch_reseeds_w(b, p);
   pg_floatw w = p.pi_init * inv;
+  /* pi_learning: the batch's Gaussian statistics at the Newton step's weight. */
+  pg_floatw scale = (pg_floatw)(1.0f);
+  if (p.pi_learning) {
+    pg_intw learn = (b.v2 > 0.0f) & isfinite(b.v1) & isfinite(b.v2);
+    scale = select(scale, clamp(b.model_pi + 0.5f * b.v1 / b.v2, p.pi_min, p.pi_max) * b.a / b.ag,
+                   learn);
+  }
   pg_pmm_state_w batch;
   batch.w = b.a * inv;
-  batch.s0 = select(b.ag * inv, b.a * w, fresh);
-  batch.sx = select(b.agx * inv, b.ax * w, fresh);
-  batch.sy = select(b.agy * inv, b.ay * w, fresh);
-  batch.sxx = select(b.agxx * inv, b.axx * w, fresh);
-  batch.syy = select(b.agyy * inv, b.ayy * w, fresh);
-  batch.sxy = select(b.agxy * inv, b.axy * w, fresh);
+  batch.s0 = select(b.ag * scale * inv, b.a * w, fresh);
+  batch.sx = select(b.agx * scale * inv, b.ax * w, fresh);
+  batch.sy = select(b.agy * scale * inv, b.ay * w, fresh);
+  batch.sxx = select(b.agxx * scale * inv, b.axx * w, fresh);
+  batch.syy = select(b.agyy * scale * inv, b.ayy * w, fresh);
+  batch.sxy = select(b.agxy * scale * inv, b.axy * w, fresh);
   batch.k = (pg_floatw)(0.0f);
   pg_floatw k = select(s.k, (pg_floatw)(0.0f), fresh);
   pg_floatw eta = fmax(exp(-p.step_alpha * log(k + 1.0f)), 1.0f / (p.k_max + 1.0f));

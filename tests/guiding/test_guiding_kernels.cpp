@@ -328,6 +328,7 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
       const std::uint32_t start =
           sh::pg_train_walk_start(seed, x, y, static_cast<std::uint32_t>(w), frame, p);
       float4 samples[PG_MAX_TRAIN_SAMPLES];
+      float densities[PG_MAX_TRAIN_SAMPLES];
       int kept = 0;
       for (int k = 0; k < n; ++k) {
         const int c = sh::pg_train_window_index(start, k, p);
@@ -335,10 +336,11 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
         if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
         const int j = sy * w + sx;
         kept += sh::pg_train_sample_from_vpl(px, v.position[j], v.normal[j], v.radiance_info[j], p,
-                                             &samples[kept]);
+                                             &samples[kept], &densities[kept]);
       }
       int updated = 0;
-      s = sh::pg_pmm_train(s, samples, kept, p, static_cast<float>(n), p.em_passes, &updated);
+      s = sh::pg_pmm_train(s, samples, densities, kept, p, static_cast<float>(n), p.em_passes,
+                           &updated);
       set_state(out, i, s);
       trained[i] = updated;
     }
@@ -628,8 +630,10 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
     settings.apron = kc.apron;
     // The training options vary with the case (every case has its own apron): every VPL at
     // its mixture density with apron 2, amortised training of mature pixels and re-seeds that
-    // take two samples of a batch with apron 1.
+    // take two samples of a batch with apron 1, the variance-aware mixing weight with aprons 1
+    // and 3 (EM's with apron 2).
     settings.train_all_samples = kc.apron == 2 ? 1 : 0;
+    settings.pi_learning = kc.apron != 2 ? 1 : 0;
     settings.train_interval = kc.apron == 1 ? 3 : 1;
     settings.reseed_samples = kc.apron == 1 ? 2 : 1;
     const pg_kernel_settings p = to_kernel_settings(settings);

@@ -6,6 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <functional>
 #include <limits>
 #include <random>
 #include <string>
@@ -253,6 +257,9 @@ pg_pmm_state run_em(const pg_kernel_settings& p, const pg_lobes& lobes, float3 w
                     const Target& target, int epochs, int per_epoch, uint seed) {
   pg_pmm_state s = pg_pmm_initial_state();
   std::vector<float4> samples;
+  // The proposal's density over solid angle: uniform on the square, Jacobian 2 pi.
+  const std::vector<float> densities(static_cast<std::size_t>(per_epoch),
+                                     static_cast<float>(0.5 / 3.14159265358979323846));
   for (int e = 0; e < epochs; ++e) {
     samples.clear();
     for (int j = 0; j < per_epoch; ++j) {
@@ -264,7 +271,7 @@ pg_pmm_state run_em(const pg_kernel_settings& p, const pg_lobes& lobes, float3 w
       samples.push_back(float4(a, u.x, u.y, pg_bsdf_pdf(lobes, wo, wi)));
     }
     int updated = 0;
-    s = pg_pmm_train(s, samples.data(), static_cast<int>(samples.size()), p,
+    s = pg_pmm_train(s, samples.data(), densities.data(), static_cast<int>(samples.size()), p,
                      static_cast<float>(per_epoch), p.em_passes, &updated);
   }
   return s;
@@ -308,6 +315,120 @@ TEST(PmmEm, RecoversAGaussianTarget) {
     EXPECT_NEAR(c.xy, g.sxy, 0.15 * scale) << "Sigma_xy";
     // A pure Gaussian target: the Gaussian explains (almost) everything, pi at its upper clamp.
     EXPECT_NEAR(m.pi, p.pi_max, 0.03);
+  }
+}
+
+namespace {
+
+// The first bounce's second moment M(pi) = integral of E[F^2] / D over the hemisphere for the
+// model m at mixing weight pi (midpoint rule on a 300x300 grid of the square, whose map to the
+// hemisphere has the constant Jacobian 2 pi), and the pi in [pi_min, pi_max] that minimises it
+// (a grid of 0.0025).
+template <typename SecondMoment>
+double best_mixing_weight(const pg_pmm_model& m, const pg_kernel_settings& p, const pg_lobes& lobes,
+                          float3 wo, const SecondMoment& f2_of) {
+  constexpr int kCells = 300;
+  std::vector<double> f2, gauss, bsdf;
+  for (int iy = 0; iy < kCells; ++iy)
+    for (int ix = 0; ix < kCells; ++ix) {
+      const float2 u((ix + 0.5f) / kCells, (iy + 0.5f) / kCells);
+      const float3 wi = pg_square_to_hemisphere(u);
+      if (!(wi.z > 0.0f)) continue;
+      f2.push_back(f2_of(u, wi));
+      gauss.push_back(pg_pmm_gaussian_pdf(m, u) / (2.0 * 3.14159265358979323846));
+      bsdf.push_back(pg_bsdf_pdf(lobes, wo, wi));
+    }
+  double best = p.pi_min, best_moment = std::numeric_limits<double>::infinity();
+  for (double pi = p.pi_min; pi <= p.pi_max + 1e-9; pi += 0.0025) {
+    double moment = 0.0;
+    for (std::size_t j = 0; j < f2.size(); ++j)
+      moment += f2[j] / (pi * gauss[j] + (1.0 - pi) * bsdf[j]);
+    if (moment < best_moment) {
+      best_moment = moment;
+      best = pi;
+    }
+  }
+  return best;
+}
+
+// A noise factor of mean 1 that is a function of the sample's point: 20 with probability 1/20,
+// else 0 (a hash of the point's bits), so that run_em's targets can be one-path estimates with
+// fireflies. Its second moment is 20.
+double firefly(float2 u) {
+  std::uint32_t x = 0, y = 0;
+  std::memcpy(&x, &u.x, 4);
+  std::memcpy(&y, &u.y, 4);
+  std::uint32_t h = x * 2654435761u ^ (y + 0x9e3779b9u) * 2246822519u;
+  h ^= h >> 15;
+  h *= 2246822519u;
+  h ^= h >> 13;
+  return h % 20u == 0u ? 20.0 : 0.0;
+}
+
+}  // namespace
+
+// The variance-aware mixing weight (pi_learning; pmm.h, pg_pmm_update): trained on samples of a
+// target, the running pi settles where the first bounce's second moment is smallest for the
+// lobe that EM fitted, found here by quadrature. Without noise it agrees with EM's pi: at the
+// lower clamp where the BSDF alone follows the target (guiding gets out of the way), at the
+// upper clamp for a narrow lobe that the BSDF misses. With fireflies (one-path estimates whose
+// second moment is 20x their squared mean) the best weight is far above EM's: fireflies in the
+// lobe raise it where EM sees only the mean (pi ~ the lobe's 10% share), and fireflies outside
+// the lobe keep re-seeding EM's model (pi back to pi_init) while the lobe still deserves 0.3.
+// Tolerance 0.05: the running pi averages Newton steps of about k_max = 32 epochs of 2000
+// samples, each clamped to [pi_min, pi_max], so next to a clamp the noisy steps average a
+// little inside it; measured: 0.000, 0.000, 0.012, 0.039 (the last at the upper clamp).
+TEST(PmmEm, LearnedMixingWeightMinimisesTheSecondMoment) {
+  rtpg::GuidingSettings settings;
+  settings.pi_learning = 1;
+  const pg_kernel_settings learned = rtpg::to_kernel_settings(settings);
+  settings.pi_learning = 0;
+  const pg_kernel_settings em = rtpg::to_kernel_settings(settings);
+  const pg_material lambert{float3(0.8f), 1.0f, 0.0f, 0.0f};
+  const float3 wo = direction(30.0f, 0.0f);
+  const pg_lobes lobes = pg_make_lobes(lambert, wo);
+  const double two_pi = 2.0 * 3.14159265358979323846;
+  const Gauss2 narrow{0.7, 0.35, 0.002, 0.002, 0.0};
+  const auto lobe = [&](float2 u) { return narrow(u.x, u.y) / two_pi; };
+  const auto bsdf = [&](float3 wi) { return double(pg_bsdf_pdf(lobes, wo, wi)); };
+  struct Case {
+    const char* name;
+    bool em_at_best;                               // EM's own pi is the best one too
+    std::function<double(float2, float3)> target;  // one sample's F
+    std::function<double(float2, float3)> f2;      // E[F^2]
+  };
+  const Case cases[] = {
+      {"Lambertian", true, [&](float2, float3 wi) { return bsdf(wi); },
+       [&](float2, float3 wi) { return bsdf(wi) * bsdf(wi); }},
+      {"one narrow lobe", true, [&](float2 u, float3) { return lobe(u); },
+       [&](float2 u, float3) { return lobe(u) * lobe(u); }},
+      {"fireflies outside the lobe", false,
+       [&](float2 u, float3 wi) { return 0.5 * lobe(u) + 0.5 * bsdf(wi) * firefly(u); },
+       [&](float2 u, float3 wi) {
+         const double g = 0.5 * lobe(u), b = 0.5 * bsdf(wi);
+         return g * g + 2.0 * g * b + 20.0 * b * b;
+       }},
+      {"fireflies in the lobe", false,
+       [&](float2 u, float3 wi) { return 0.1 * lobe(u) * firefly(u) + 0.9 * bsdf(wi); },
+       [&](float2 u, float3 wi) {
+         const double g = 0.1 * lobe(u), b = 0.9 * bsdf(wi);
+         return 20.0 * g * g + 2.0 * g * b + b * b;
+       }},
+  };
+  uint seed = 300;
+  for (const Case& c : cases) {
+    const pg_pmm_state s_learned = run_em(learned, lobes, wo, c.target, 300, 2000, seed);
+    const pg_pmm_state s_em = run_em(em, lobes, wo, c.target, 300, 2000, seed++);
+    const pg_pmm_model m = pg_pmm_model_from_state(s_learned, learned);
+    const pg_pmm_model m_em = pg_pmm_model_from_state(s_em, em);
+    ASSERT_TRUE(m.valid && m_em.valid) << c.name;
+    const double best = best_mixing_weight(m, learned, lobes, wo, c.f2);
+    EXPECT_NEAR(m.pi, best, 0.05) << c.name << " (EM's pi " << m_em.pi << ")";
+    if (c.em_at_best) {
+      EXPECT_NEAR(m_em.pi, best, 0.03) << c.name;
+    } else {
+      EXPECT_GT(best - m_em.pi, 0.2) << c.name << " (EM's pi " << m_em.pi << ")";
+    }
   }
 }
 
@@ -366,7 +487,8 @@ pg_pmm_state update_with(const pg_pmm_state& s, const pg_kernel_settings& p,
   pg_pmm_batch b = pg_pmm_batch_empty();
   for (const auto& [a, u] : samples)
     b = pg_pmm_batch_add(b, m, p, a, u,
-                         pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(u)), s.s0.x);
+                         pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(u)), 0.0f,
+                         s.s0.x);
   return pg_pmm_update(s, b, p, static_cast<float>(samples.size()), updated);
 }
 
@@ -423,11 +545,13 @@ TEST(PmmEm, UnusableWeightsMixedIntoAGoodBatchAreDropped) {
     const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
     pg_pmm_batch bg = pg_pmm_batch_empty(), bm = pg_pmm_batch_empty();
     for (const auto& [a, v] : good)
-      bg = pg_pmm_batch_add(
-          bg, m, p, a, v, pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), s0.s0.x);
+      bg = pg_pmm_batch_add(bg, m, p, a, v,
+                            pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), 0.0f,
+                            s0.s0.x);
     for (const auto& [a, v] : mixed)
-      bm = pg_pmm_batch_add(
-          bm, m, p, a, v, pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), s0.s0.x);
+      bm = pg_pmm_batch_add(bm, m, p, a, v,
+                            pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), 0.0f,
+                            s0.s0.x);
     const pg_pmm_state sg = pg_pmm_update(s0, bg, p, 12.0f, &ug);
     const pg_pmm_state sm = pg_pmm_update(s0, bm, p, 12.0f, &um);
     EXPECT_EQ(ug, 1);
@@ -451,7 +575,8 @@ TEST(PmmEm, AStarvedBatchTakesAProportionallySmallerStep) {
   pg_pmm_batch b = pg_pmm_batch_empty();
   for (const float2 v : {float2(0.55f, 0.45f), float2(0.6f, 0.5f), float2(0.52f, 0.58f)})
     b = pg_pmm_batch_add(b, m, p, 1.0f, v,
-                         pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), s0.s0.x);
+                         pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), 0.0f,
+                         s0.s0.x);
   int full_updated = 0, starved_updated = 0;
   const pg_pmm_state full = pg_pmm_update(s0, b, p, 3.0f, &full_updated);
   const pg_pmm_state starved = pg_pmm_update(s0, b, p, 12.0f, &starved_updated);
@@ -481,8 +606,10 @@ TEST(PmmEm, ReseedsOnlyWhenEnoughSamplesOfOneBatchCallForIt) {
     settings.reseed_samples = reseed_samples;
     const pg_kernel_settings p = rtpg::to_kernel_settings(settings);
     int updated = 0;
-    const pg_pmm_state out = pg_pmm_train(s, batch.data(), static_cast<int>(batch.size()), p,
-                                          static_cast<float>(batch.size()), 1, &updated);
+    const std::vector<float> densities(batch.size(), 1.0f);
+    const pg_pmm_state out =
+        pg_pmm_train(s, batch.data(), densities.data(), static_cast<int>(batch.size()), p,
+                     static_cast<float>(batch.size()), 1, &updated);
     EXPECT_EQ(updated, 1);
     return out.s1.w;
   };
@@ -531,7 +658,7 @@ TEST(PmmEm, RepeatedSamplesAndCornersKeepSigmaPositiveDefinite) {
 // a state with k > 0 gives a valid model with a positive definite Sigma, and the model's
 // sampler and density produce finite values.
 TEST(PmmEm, SurvivesAHundredThousandJunkUpdates) {
-  const pg_kernel_settings p = default_params();
+  pg_kernel_settings p = default_params();
   std::mt19937 gen(77);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -569,14 +696,19 @@ TEST(PmmEm, SurvivesAHundredThousandJunkUpdates) {
   pg_pmm_state s = pg_pmm_initial_state();
   int valid_steps = 0;
   std::vector<float4> samples;
+  std::vector<float> densities;
   for (int step = 0; step < 100000; ++step) {
+    // The second half with the variance-aware mixing weight, whose sums take the densities.
+    p.pi_learning = step >= 50000 ? 1 : 0;
     if (u(gen) < 0.01f) repeated = float2(u(gen), u(gen));
     samples.clear();
+    densities.clear();
     const int count = static_cast<int>(26.0f * u(gen));
     for (int j = 0; j < count; ++j) {
       const float a = junk_weight();
       const float2 v = junk_point();
       samples.push_back(float4(a, v.x, v.y, junk_pdf()));
+      densities.push_back(junk_pdf());
     }
     // Alternately the building blocks (one E-step) and the kernels' step with 1-3 passes.
     int updated = 0;
@@ -584,11 +716,15 @@ TEST(PmmEm, SurvivesAHundredThousandJunkUpdates) {
     if (step % 2 == 0) {
       const pg_pmm_model m = pg_pmm_model_from_state(s, p);
       pg_pmm_batch b = pg_pmm_batch_empty();
-      for (const float4& x : samples)
-        b = pg_pmm_batch_add(b, m, p, x.x, float2(x.y, x.z), x.w, s.s0.x);
+      for (int j = 0; j < count; ++j) {
+        const float4& x = samples[static_cast<std::size_t>(j)];
+        b = pg_pmm_batch_add(b, m, p, x.x, float2(x.y, x.z), x.w,
+                             densities[static_cast<std::size_t>(j)], s.s0.x);
+      }
       s = pg_pmm_update(s, b, p, target, &updated);
     } else {
-      s = pg_pmm_train(s, samples.data(), count, p, target, 1 + (step / 2) % 3, &updated);
+      s = pg_pmm_train(s, samples.data(), densities.data(), count, p, target, 1 + (step / 2) % 3,
+                       &updated);
     }
     ASSERT_TRUE(pg_pmm_state_finite(s)) << "step " << step;
     ASSERT_GE(s.s1.w, 0.0f) << "step " << step;
@@ -756,9 +892,10 @@ TEST(PmmTrainSample, VplWeightByHand) {
   const float4 position_pdf(0.0f, 3.0f, 4.0f, 0.2f);
   const float4 normal(0.0f, 0.0f, -1.0f, 0.3f);  // w: the whole mixture's area density
   float4 sample;
-  ASSERT_EQ(
-      pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, bsdf_info), p, &sample),
-      1);
+  float density = 0.0f;
+  ASSERT_EQ(pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, bsdf_info), p,
+                                     &sample, &density),
+            1);
   EXPECT_NEAR(sample.x, 0.8 / (6.25 * kPiD), 1e-6);
   EXPECT_NEAR(sample.w, 0.8 / kPiD, 1e-6);
   const float3 w = pg_square_to_hemisphere(float2(sample.y, sample.z));
@@ -767,28 +904,28 @@ TEST(PmmTrainSample, VplWeightByHand) {
   EXPECT_NEAR(w.z, 0.8f, 1e-5f);
   // A guide-strategy VPL trains only with train_all_samples (paper 3.2), and then every VPL
   // counts at the whole mixture's density: 0.3 * 25 / 0.8 = 9.375.
-  EXPECT_EQ(
-      pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, guide_info), p, &sample),
-      0);
+  EXPECT_EQ(pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, guide_info), p,
+                                     &sample, &density),
+            0);
   p.train_all_samples = 1;
-  ASSERT_EQ(
-      pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, guide_info), p, &sample),
-      1);
+  ASSERT_EQ(pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, guide_info), p,
+                                     &sample, &density),
+            1);
   EXPECT_NEAR(sample.x, 0.8 / (9.375 * kPiD), 1e-6);
   p.train_all_samples = 0;
   // A distant VPL (an escaped ray) holds its direction and a solid-angle density already.
   const float distant_info = bsdf_info + float(PG_VPL_DISTANT);
   ASSERT_EQ(pg_train_sample_from_vpl(px, float4(0.0f, 0.6f, 0.8f, 0.2f), normal,
-                                     float4(2, 2, 2, distant_info), p, &sample),
+                                     float4(2, 2, 2, distant_info), p, &sample, &density),
             1);
   EXPECT_NEAR(sample.x, 0.8 / (0.2 * kPiD), 1e-5);
   // A VPL whose surface faces away from the pixel, or one below the pixel's horizon, says
   // nothing about its hemisphere.
   EXPECT_EQ(pg_train_sample_from_vpl(px, position_pdf, float4(0, 0, 1, 0.3f),
-                                     float4(2, 2, 2, bsdf_info), p, &sample),
+                                     float4(2, 2, 2, bsdf_info), p, &sample, &density),
             0);
   EXPECT_EQ(pg_train_sample_from_vpl(px, float4(0, 3, -4, 0.2f), float4(0, 0, 1, 0.3f),
-                                     float4(2, 2, 2, bsdf_info), p, &sample),
+                                     float4(2, 2, 2, bsdf_info), p, &sample, &density),
             0);
 }
 

@@ -55,12 +55,14 @@ StressResult stress(const char* name, const SampleSource& source, int updates,
   const pg_kernel_settings p = default_params();
   std::mt19937 gen(20261123u);
   std::vector<float4> samples(kSamplesPerUpdate);
+  // The density each sample was drawn with: uniform on the square (solid angle, Jacobian 2 pi).
+  const std::vector<float> densities(kSamplesPerUpdate, 0.15915494f);
   StressResult r;
   r.state = start;
   for (int step = 0; step < updates; ++step) {
     source(step, gen, samples);
     int updated = 0;
-    r.state = pg_pmm_train(r.state, samples.data(), kSamplesPerUpdate, p,
+    r.state = pg_pmm_train(r.state, samples.data(), densities.data(), kSamplesPerUpdate, p,
                            static_cast<float>(kSamplesPerUpdate), 2, &updated);
     const pg_pmm_state& s = r.state;
     if (!pg_pmm_state_finite(s) || !(s.s1.w >= 0.0f && s.s1.w <= p.k_max) || !(s.s0.x >= 0.0f) ||
