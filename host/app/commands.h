@@ -29,7 +29,7 @@ struct RenderCommand {
   std::string reference;         // EXR to compute relMSE against
   std::string stats_json;        // "" = none
   std::string guiding = "pmm";   // "off" or "pmm"
-  std::string guide_direct_light = "off";  // "off" or "mis": the VPLs carry y's emission
+  std::string guide_direct_light = "mis";  // "off" or "mis": the VPLs carry y's emission
                                            // with its MIS weight (PathTracerSettings)
   std::string guide_vertices = "first";    // "first" (the paper) or "all" (secondary vertices
                                            // borrow the mixture of the pixel showing them)

@@ -236,10 +236,11 @@ PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_se
      * firefly of the one-path VPL radiance; reseed_samples asks for more of them. */
     if (q > 25.0f && a > p.reseed_ratio * history_weight) b.reseed += 1;
     if (p.pi_learning && density > 0.0f && d > 0.0f) {
-      float delta = g / m.pi - bsdf_pdf; /* dD/dpi */
-      float c = a * a * density / (d * d);
-      b.v1 += c * delta;
-      b.v2 += c * delta * delta / d;
+      float inv_d = 1.0f / d;
+      float t = (g / m.pi - bsdf_pdf) * inv_d; /* (dD/dpi) / D */
+      float e = a * a * density * inv_d;       /* a^2 r / D */
+      b.v1 += e * t;
+      b.v2 += e * t * t;
       b.model_pi = m.pi;
     }
   }

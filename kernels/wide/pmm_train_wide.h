@@ -114,10 +114,11 @@ static inline pg_pmm_batch_w pg_pmm_batch_add_w(pg_pmm_batch_w b, pg_pmm_model_w
   b.reseed -= add & m.valid & (q > 25.0f) & (a > p.reseed_ratio * history_weight); /* mask -1 */
   if (p.pi_learning) {
     pg_intw learn = add & m.valid & (s.density > 0.0f) & (d > 0.0f);
-    pg_floatw delta = g / m.pi - s.bsdf_pdf;
-    pg_floatw c = a * a * s.density / (d * d);
-    b.v1 = select(b.v1, b.v1 + c * delta, learn);
-    b.v2 = select(b.v2, b.v2 + c * delta * delta / d, learn);
+    pg_floatw inv_d = 1.0f / d;
+    pg_floatw t = (g / m.pi - s.bsdf_pdf) * inv_d;
+    pg_floatw e = a * a * s.density * inv_d;
+    b.v1 = select(b.v1, b.v1 + e * t, learn);
+    b.v2 = select(b.v2, b.v2 + e * t * t, learn);
     b.model_pi = select(b.model_pi, m.pi, learn);
   }
   b.ax = select(b.ax, b.ax + a * s.ux, add);

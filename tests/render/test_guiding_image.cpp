@@ -37,6 +37,7 @@ struct RunShape {
   int spp = 1;
   std::string camera_path;
   bool guide_secondary = false;  // later vertices borrow their pixel's mixture
+  bool pi_learning = false;      // the variance-aware mixing weight (GuidingSettings)
 };
 
 // A guided sampler whose first-bounce samples claim a density 5% too high: every path that
@@ -81,8 +82,10 @@ TileSeries run(const Scene& scene, Method method, int size, int frames, ClRuntim
   settings.path_tracer.max_bounces = scene.max_bounces > 0 ? scene.max_bounces : 8;
   Renderer renderer(scene, settings);
   if (guided) {
+    GuidingSettings guiding;
+    guiding.pi_learning = shape.pi_learning ? 1 : 0;
     std::unique_ptr<FirstBounceSampler> sampler =
-        std::make_unique<GuidedFirstBounce>(cl, size, size, GuidingSettings{});
+        std::make_unique<GuidedFirstBounce>(cl, size, size, guiding);
     if (method == Method::GuidedWithBias)
       sampler = std::make_unique<PdfTooHigh>(std::move(sampler));
     renderer.set_first_bounce_sampler(std::move(sampler));
@@ -234,6 +237,14 @@ TEST(GuidingImage, UnbiasedAlongCameraPathAtTwoSpp) {
 
 // Four samples per frame along the camera path: reprojection, a model shared by the frame's
 // samples and next-event MIS against it, together.
+// The variance-aware mixing weight (--pg-pi-learning 1) changes only the densities the first
+// bounce samples with, and next-event MIS weighs against the same ones.
+TEST(GuidingImage, UnbiasedWithLearnedMixingWeightAlongCameraPathAtTwoSpp) {
+  RunShape shape{2, "pan"};
+  shape.pi_learning = true;
+  expect_same_means("cornell-box.json", 120, 0.0015, shape);
+}
+
 TEST(GuidingImage, UnbiasedAlongCameraPathAtFourSpp) {
   expect_same_means("cornell-box.json", 60, 0.0015, RunShape{4, "pan"});
 }
