@@ -129,16 +129,18 @@ double run(rtpg::ClRuntime& rt, int size, int frames, bool guided) {
       const float estimate = t > 0.0f ? kAlbedo / kPi * d.z * kLe / pdf : 0.0f;
       const double ref = exact(p);
       error += (estimate - ref) * (estimate - ref) / (ref * ref + 0.01);
-      // The VPL: where the bounce landed, its density in area measure there (the BSDF's for a
-      // BSDF sample, cos / pi for Lambert), the radiance it sends back; PG_VPL_* bits in w.
+      // The VPL: where the bounce landed, its densities in area measure there (the strategy's:
+      // the BSDF's for a BSDF sample, cos / pi for Lambert; and the whole mixture's, pdf), the
+      // radiance it sends back; PG_VPL_* bits in w (include/rtpg/guiding_layout.h).
       const std::uint32_t strategy = s.strategy[i];
       const float info =
           static_cast<float>((t > 0.0f ? PG_VPL_VALID : 0u) | (strategy << PG_VPL_STRATEGY_SHIFT));
       if (t > 0.0f) {
         const Vec3 y = p + d * t, ny = normalize(y - kLight);
         const float source_pdf = strategy == PG_STRATEGY_BSDF ? d.z / kPi : pdf;
-        v.position[i] = {y.x, y.y, y.z, source_pdf * std::fabs(dot(ny, d)) / (t * t)};
-        v.normal[i] = {ny.x, ny.y, ny.z, 0.0f};
+        const float to_area = std::fabs(dot(ny, d)) / (t * t);
+        v.position[i] = {y.x, y.y, y.z, source_pdf * to_area};
+        v.normal[i] = {ny.x, ny.y, ny.z, pdf * to_area};
         v.radiance_info[i] = {kLe, kLe, kLe, info};
       } else {
         v.position[i] = {0.0f, 0.0f, 0.0f, 0.0f};

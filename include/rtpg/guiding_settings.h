@@ -38,8 +38,9 @@ struct GuidingSettings {
                               // in a rotating pattern (the rest keep their state); 2: the
                               // same error as 1 for 14-24% less train time
                               // (docs/guiding.md, "What amortised training saves")
-  int train_all_samples = 0;  // 1: every VPL trains, weighted by its full mixture density;
-                              // 0: BSDF-strategy VPLs only (paper 3.2)
+  int train_all_samples = 1;  // 1: every VPL trains, weighted by its full mixture density;
+                              // 0: BSDF-strategy VPLs only (paper 3.2); 1 since it costs nothing
+                              // in train_wide (docs/guiding.md, "Every VPL trains, revisited")
   int pi_learning = 0;        // 1: the mixing weight is the one that minimises the first
                               // bounce's second moment (a Newton step per frame on the
                               // training samples); 0: EM's weight (paper 3.2)

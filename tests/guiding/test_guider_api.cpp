@@ -167,7 +167,7 @@ TEST(GuiderApi, CreateResetReprojectSampleTrainAndStateRoundTrip) {
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       const float pos[4] = {0.1f * x + 0.3f, 0.1f * y, 2.0f, 1.0f};  // w: area density
-      const float nrm[4] = {0.0f, 0.0f, -1.0f, 0.0f};
+      const float nrm[4] = {0.0f, 0.0f, -1.0f, 1.0f};  // w: the mixture's area density
       const float rad[4] = {5.0f, 5.0f, 5.0f, y == 0 ? 0.0f : kValidBsdfVpl};
       std::memcpy(&vp[4 * i], pos, sizeof pos);
       std::memcpy(&vn[4 * i], nrm, sizeof nrm);
@@ -243,7 +243,7 @@ TEST(GuiderApi, HostDistributionHasTheSampleKernelsDensity) {
 TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
   EXPECT_NO_THROW(rtpg::validate(rtpg::GuidingSettings{}));
   const auto& table = rtpg::guiding_settings_table();
-  EXPECT_EQ(table.size(), 25u);
+  EXPECT_EQ(table.size(), 26u);
   for (const rtpg::GuidingSettingInfo& row : table) {
     ASSERT_TRUE((row.float_field != nullptr) != (row.int_field != nullptr)) << row.name;
     EXPECT_TRUE(row.in_range(row.get(rtpg::GuidingSettings{}))) << row.name;
