@@ -14,7 +14,8 @@
  * N neighbours and P E-step passes (a lane runs to its work-item's largest N and P), b = 128 for
  * Lambert lobes, 234 where a lane has a GGX lobe: 1313-1843 at N = 5, P = 1; 9390 at N = 20,
  * P = 3 with GGX (each M^-1 9 flops fewer since it lost its disk detour, two of them square
- * roots and one a division). Bytes: 116 of its own + 48 N of neighbour VPLs read (each VPL once per
+ * roots and one a division); with pi_learning 8 flops and 2 divisions more per neighbour and
+ * pass. Bytes: 116 of its own + 48 N of neighbour VPLs read (each VPL once per
  * image from memory, the rest from cache), 33 written: compute-bound. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "shared/guiding_pixel.h"
