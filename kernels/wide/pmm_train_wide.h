@@ -59,14 +59,22 @@ static inline pg_train_samples_w pg_train_samples_from_vpls_w(pg_train_pixels_w 
   ok &= wl.z > 0.0f;
   pg_train_samples_w s;
   s.kept = ok;
+  s.density = r;
+  /* A dark VPL: weight 0 at the square's centre. Where no lane has a lit one (most steps in a
+   * room lit through an opening, whose one-path VPLs rarely find the light), the BSDF and the
+   * mapping are skipped, as the scalar function skips them for a dark VPL (docs/guiding.md,
+   * "Dark VPLs skipped in the lanes"). */
+  pg_intw dark = pg_max3w(v.radiance) <= 0.0f;
+  if (!any(ok & ~dark)) {
+    s.a = s.bsdf_pdf = (pg_floatw)(0.0f);
+    s.ux = s.uy = (pg_floatw)(0.5f);
+    return s;
+  }
   pg_floatw pdf;
   pg_float3w f = pg_scale3w(pg_bsdf_eval_pdf_w(px.lobes, px.wo, wl, any_specular, &pdf), wl.z);
   pg_hemisphere_to_square_w(wl, &s.ux, &s.uy);
   s.a = pg_luminance3w(pg_mul3w(v.radiance, f)) / r;
   s.bsdf_pdf = pdf;
-  s.density = r;
-  /* A dark VPL: weight 0 at the square's centre. */
-  pg_intw dark = pg_max3w(v.radiance) <= 0.0f;
   s.a = select(s.a, (pg_floatw)(0.0f), dark);
   s.ux = select(s.ux, (pg_floatw)(0.5f), dark);
   s.uy = select(s.uy, (pg_floatw)(0.5f), dark);
@@ -101,6 +109,10 @@ static inline pg_pmm_batch_w pg_pmm_batch_add_w(pg_pmm_batch_w b, pg_pmm_model_w
   pg_intw ok = s.kept & (a >= 0.0f) & (a <= p.max_weight);
   if (p.weight_clamp > 0.0f) a = select(a, fmin(a, p.weight_clamp * history_weight), m.valid);
   pg_intw zero = a == 0.0f;
+  if (!any(ok & ~zero)) { /* no lane adds more than its count (pg_pmm_batch_add's a = 0) */
+    b.count = select(b.count, b.count + 1.0f, ok);
+    return b;
+  }
   pg_floatw z1 = (s.ux - m.mx) / m.l11;
   pg_floatw z2 = (s.uy - m.my - m.l21 * z1) / m.l22;
   pg_floatw q = z1 * z1 + z2 * z2;
