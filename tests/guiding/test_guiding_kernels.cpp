@@ -621,7 +621,13 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
     HostGBuffer g = random_gbuffer(r, kc.width, kc.height);
     if (kc.apron == 3)
       for (std::size_t i = g.n() / 2; i < g.n(); ++i) g.metallic_specular[i] = float4(0.0f);
-    const HostVpls v = random_vpls(r, g.n());
+    HostVpls v = random_vpls(r, g.n());
+    // The left third of the image sees only dark VPLs (as a room lit through an opening
+    // mostly does): whole steps of train_wide's lanes take its shortcut for them, which must
+    // give what the scalar code gives pixel by pixel.
+    for (std::size_t i = 0; i < g.n(); ++i)
+      if (static_cast<int>(i % static_cast<std::size_t>(kc.width)) < kc.width / 3)
+        v.radiance_info[i] = float4(0.0f, 0.0f, 0.0f, v.radiance_info[i].w);
     const GuiderGBuffer dg = upload(rt, g);
     const GuiderVpls dv = upload(rt, v, g.width, g.height);
     GuidingSettings settings;
