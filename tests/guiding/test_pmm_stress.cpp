@@ -56,7 +56,7 @@ StressResult stress(const char* name, const SampleSource& source, int updates,
   std::mt19937 gen(20261123u);
   std::vector<float4> samples(kSamplesPerUpdate);
   // The density each sample was drawn with: uniform on the square (solid angle, Jacobian 2 pi).
-  const std::vector<float> densities(kSamplesPerUpdate, 0.15915494f);
+  const std::vector<float> densities(kSamplesPerUpdate, PG_INV_TWO_PI);
   StressResult r;
   r.state = start;
   for (int step = 0; step < updates; ++step) {
