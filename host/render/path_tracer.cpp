@@ -23,6 +23,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr std::size_t kGrain = 2048;
+// How many vertices ahead the shading loop starts loading the pixel a later vertex borrows
+// from (prefetch_borrowable).
+constexpr std::size_t kPrefetchAhead = 4;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -72,6 +75,7 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
   sampler_ = &sampler;
   prepare(n, vpls);
   auto start = Clock::now();
+  if (settings_.guide_secondary) collect_borrowable(g, sampler);
   start_paths(g, first, sampler, at, vpls);
   times.shade_ms += ms_since(start);
   run_shadow_rays(n, rays, times);
@@ -197,7 +201,14 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
   std::atomic<std::uint64_t> guided_vertices{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
     std::uint64_t guided_here = 0;
+    if (settings_.guide_secondary) {
+      for (std::size_t j = range.begin(); j < std::min(range.end(), range.begin() + kPrefetchAhead);
+           ++j)
+        prefetch_borrowable(j);
+    }
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
+      if (settings_.guide_secondary && j + kPrefetchAhead < range.end())
+        prefetch_borrowable(j + kPrefetchAhead);
       const std::uint32_t i = active_[j];
       PathState& p = paths_[i];
       const Ray ray = rays_[j];
@@ -336,26 +347,61 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
   rays.guided_vertices += guided_vertices.load();
 }
 
-bool PathTracer::borrow_guide(const SurfacePoint& sp, PixelGuide& guide) const {
+void PathTracer::collect_borrowable(const GBuffer& g, const FirstBounceSampler& sampler) {
+  borrowable_.resize(g.pixel_count());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, g.pixel_count(), kGrain),
+                    [&](const auto& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        BorrowablePixel& b = borrowable_[i];
+                        PixelGuide guide;
+                        if (!g.has_surface(i) || !sampler.pixel_guide(g, i, guide)) {
+                          b.position_depth = shared::float4(0.0f, 0.0f, 0.0f, 0.0f);
+                          continue;
+                        }
+                        b.position_depth = g.position_depth[i];
+                        b.normal = shared::pg_float4_xyz(g.shading_normal[i]);
+                        b.material = g.material[i];
+                        b.model = guide.model;
+                      }
+                    });
+}
+
+std::size_t PathTracer::borrowable_index(const glm::vec3& position) const {
   const GBuffer& g = *gbuffer_;
   float sx = 0.0f, sy = 0.0f;
-  if (!g.camera.project(sp.position, sx, sy)) return false;
+  if (!g.camera.project(position, sx, sy)) return kNotOnScreen;
   const float fx = std::floor(sx * static_cast<float>(g.width));
   const float fy = std::floor(sy * static_cast<float>(g.height));
   if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(g.width) &&
         fy < static_cast<float>(g.height)))
-    return false;
-  const std::size_t i = static_cast<std::size_t>(fy) * static_cast<std::size_t>(g.width) +
-                        static_cast<std::size_t>(fx);
-  if (!g.has_surface(i)) return false;
+    return kNotOnScreen;
+  return static_cast<std::size_t>(fy) * static_cast<std::size_t>(g.width) +
+         static_cast<std::size_t>(fx);
+}
+
+void PathTracer::prefetch_borrowable(std::size_t j) const {
+  const Hit& hit = hits_[j];
+  if (!hit.valid()) return;
+  const Ray& ray = rays_[j];
+  const std::size_t i = borrowable_index(ray.origin + ray.direction * hit.t);
+  if (i != kNotOnScreen) __builtin_prefetch(&borrowable_[i]);
+}
+
+bool PathTracer::borrow_guide(const SurfacePoint& sp, PixelGuide& guide) const {
+  const std::size_t i = borrowable_index(sp.position);
+  if (i == kNotOnScreen) return false;
+  const BorrowablePixel& b = borrowable_[i];
+  const GBuffer& g = *gbuffer_;
   const float depth = glm::dot(sp.position - g.camera.position, g.camera.forward);
   const shared::float4 here(sp.position.x, sp.position.y, sp.position.z, depth);
-  // The pixel must show this very surface (an occluder in front fails the position test).
-  if (!shared::pg_same_surface(g.position_depth[i], shared::pg_float4_xyz(g.shading_normal[i]),
-                               g.material[i], here, sp.shading_normal, sp.material_id,
-                               settings_.guide_position, settings_.guide_normal))
+  // The pixel must show this very surface (an occluder in front fails the position test)
+  // and lend a guide (position_depth.w > 0).
+  if (!shared::pg_same_surface(b.position_depth, b.normal, b.material, here, sp.shading_normal,
+                               sp.material_id, settings_.guide_position, settings_.guide_normal))
     return false;
-  return sampler_->pixel_guide(g, i, guide);
+  guide.model = b.model;
+  guide.frame = shared::pg_frame_from_normal(b.normal);
+  return true;
 }
 
 void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times) {

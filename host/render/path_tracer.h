@@ -99,6 +99,26 @@ class PathTracer {
   // Keeps the rays of the paths still alive at the front of rays_; active_ becomes their
   // pixels (owners[j] of slot j, or j itself when owners is null).
   void compact(std::size_t count, const std::vector<std::uint32_t>* owners);
+  // What borrow_guide() reads of the pixel a later vertex projects to, in one cache line:
+  // the vertices land all over the image, and the G-buffer's channels and the sampler's
+  // mixture, read apart, cost a cache miss each (docs/guiding.md, "Later vertices, revisited").
+  struct alignas(64) BorrowablePixel {
+    shared::float4 position_depth;  // w <= 0: the pixel has no guide to lend
+    glm::vec3 normal;               // shading normal
+    std::uint32_t material = 0;
+    shared::pg_pmm_model model;
+  };
+  static_assert(sizeof(BorrowablePixel) == 64, "one cache line per borrowable pixel");
+  // Fills borrowable_ from the G-buffer and the sampler's mixtures (guide_secondary).
+  void collect_borrowable(const GBuffer& g, const FirstBounceSampler& sampler);
+  // The pixel a world position projects to in this frame's camera, or kNotOnScreen.
+  static constexpr std::size_t kNotOnScreen = ~std::size_t{0};
+  std::size_t borrowable_index(const glm::vec3& position) const;
+  // Starts loading the borrowable pixel that the hit of slot j projects to, a few vertices
+  // before borrow_guide() reads it: later vertices land all over the image, and a table entry
+  // read cold stalls the shading loop for a whole cache miss (docs/guiding.md, "Later
+  // vertices, revisited").
+  void prefetch_borrowable(std::size_t j) const;
   // The guide of the pixel that shows surface point sp, if any (guide_secondary).
   bool borrow_guide(const SurfacePoint& sp, PixelGuide& guide) const;
   // Pixel estimates (non-finite ones dropped and counted) and the VPLs' radiance.
@@ -124,6 +144,7 @@ class PathTracer {
   std::vector<Hit> hits_;
   std::vector<std::uint8_t> occluded_;
   std::vector<ShadowWork> shadow_work_;
+  std::vector<BorrowablePixel> borrowable_;  // per pixel, with guide_secondary
 };
 
 }  // namespace rtpg

@@ -235,6 +235,12 @@ TEST(GuidingImage, UnbiasedAlongCameraPathAtTwoSpp) {
   expect_same_means("cornell-box.json", 120, 0.0015, RunShape{2, "pan"});
 }
 
+// Later vertices borrowing mixtures along a moving camera at 2 spp: the table of borrowable
+// pixels (PathTracer::collect_borrowable) is rebuilt for every sample's camera and model.
+TEST(GuidingImage, UnbiasedWithLaterVerticesGuidedAlongCameraPathAtTwoSpp) {
+  expect_same_means("cornell-box.json", 120, 0.0015, RunShape{2, "pan", true});
+}
+
 // Four samples per frame along the camera path: reprojection, a model shared by the frame's
 // samples and next-event MIS against it, together.
 // The variance-aware mixing weight (--pg-pi-learning 1) changes only the densities the first
