@@ -91,11 +91,6 @@ def crop_box(err_map, size):
     return y0, x0, s
 
 
-def saved_frame(image_path, frame):
-    """Where `rtpg render --save-frames` put `frame` (host/app frame_output_path: NAME-fNNNN.EXT)."""
-    return Path(image_path).with_name(f"{Path(image_path).stem}-f{frame:04d}{Path(image_path).suffix}")
-
-
 def comparison_figure(ref, images, titles, suptitle, path, exposure):
     """Reference, PT and PG (images["off"], images["pmm"]) side by side at the scene's exposure,
     each with a zoomed crop where PT's error is largest; titles: the reference's, PT's and PG's."""
@@ -128,7 +123,7 @@ def static_run(ctx, scene, method):
         stats, image = runner.render(scene, m["res"], counts[-1], method, out, method,
                                      reference=ctx.reference(scene, m["res"]),
                                      extra=["--save-frames", ",".join(str(t - 1) for t in counts)])
-        ctx.static_runs[key] = (stats, {t: saved_frame(image, t - 1) for t in counts})
+        ctx.static_runs[key] = (stats, {t: runner.saved_frame(image, t - 1) for t in counts})
     return ctx.static_runs[key]
 
 
@@ -229,27 +224,26 @@ def convergence(ctx, scene):
     exposure = result["exposure"] = runner.scene_exposure(scene)
     for method in METHODS:
         result["static"][method] = [f["relmse"] for f in static_run(ctx, scene, method)[0]["frames"]]
-    paths = json.loads(Path(runner.scene_path(scene)).read_text()).get("camera_paths", {})
-    if paths:
-        name = sorted(paths)[0]
+    name = runner.first_camera_path(scene)
+    if name:
         result["path_name"] = name
         refs = {f: metrics.load_exr(ctx.refs.get(scene, m["path_res"], m["path_ref_spp"], camera_path=name, frame=f))
                 for f in m["path_frames"]}
         for method in METHODS:
             _, image = runner.render(scene, m["path_res"], max(m["path_frames"]) + 1, method, out, f"path-{method}",
                                      extra=["--camera-path", name, "--save-frames", ",".join(map(str, m["path_frames"]))])
-            imgs = {f: metrics.load_exr(saved_frame(image, f)) for f in m["path_frames"]}
+            imgs = {f: metrics.load_exr(runner.saved_frame(image, f)) for f in m["path_frames"]}
             result["path"][method] = {"frames": m["path_frames"],
                                       "relmse": [metrics.relmse(imgs[f], refs[f]) for f in m["path_frames"]],
                                       "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f], exposure)
                                                    for f in m["path_frames"]]}
-    fig, axes = plt.subplots(1, 2 if paths else 1, figsize=(10 if paths else 5, 4), squeeze=False)
+    fig, axes = plt.subplots(1, 2 if name else 1, figsize=(10 if name else 5, 4), squeeze=False)
     for method, e in result["static"].items():
         axes[0, 0].semilogy(e, label=LABEL[method])
     axes[0, 0].set_title(f"{scene}: static camera ({m['res']})", fontsize=9)
     for method, p in result["path"].items():
         axes[0, 1].semilogy(p["frames"], p["relmse"], "o--", label=LABEL[method])
-    if paths:
+    if name:
         axes[0, 1].set_title(f"camera path '{result['path_name']}' ({m['path_res']})", fontsize=9)
     for ax in axes[0]:
         ax.set_xlabel("frame")
@@ -293,9 +287,8 @@ def denoised(ctx, scene):
         svgf = method_stats["svgf_total"]
         result["cost"][res] = {"svgf_ms": svgf, "pt_frame_ms": method_stats["total"] - svgf,
                                "kernels_ms": {k: v for k, v in method_stats.items() if k.startswith("svgf_")}}
-    paths = json.loads(Path(runner.scene_path(scene)).read_text()).get("camera_paths", {})
-    if paths:
-        name = sorted(paths)[0]
+    name = runner.first_camera_path(scene)
+    if name:
         result["path_name"] = name
         frames = m["path_frames"]
         refs = {f: metrics.load_exr(ctx.refs.get(scene, m["path_res"], m["path_ref_spp"], camera_path=name, frame=f))
@@ -304,7 +297,7 @@ def denoised(ctx, scene):
             stats, image = runner.render(scene, m["path_res"], max(frames) + 1, method, out, f"path-{method}",
                                          extra=["--camera-path", name, "--denoise", "svgf",
                                                 "--save-frames", ",".join(map(str, frames))])
-            imgs = {f: metrics.load_exr(saved_frame(image, f)) for f in frames}
+            imgs = {f: metrics.load_exr(runner.saved_frame(image, f)) for f in frames}
             flicker = [f["flicker_mse"] for f in stats["frames"] if "flicker_mse" in f]
             flicker_noisy = [f["flicker_mse_noisy"] for f in stats["frames"] if "flicker_mse_noisy" in f]
             fm, fs = runner.mean_sem(flicker)
@@ -343,7 +336,7 @@ def tradeoffs(ctx, scene):
         tag = f"v{len(rows)}"
         stats, image = runner.render(scene, m["trade_res"], m["trade_frames"], method, out, tag,
                                      extra=flags + ["--save-frames", last])
-        errors = [metrics.relmse(metrics.load_exr(saved_frame(image, f)), ref)
+        errors = [metrics.relmse(metrics.load_exr(runner.saved_frame(image, f)), ref)
                   for f in range(m["trade_frames"] - LAST, m["trade_frames"])]
         mean, sem = runner.mean_sem(errors)
         rows[name] = {"train_ms": runner.median_frame_ms(stats, "train"), "frame_ms": runner.median_frame_ms(stats),

@@ -11,6 +11,13 @@ the mean relMSE of the last --window frames, PG/PT per seed, then the mean over 
 standard error of that mean. Renders are cached in --out by scene, variant and seed (delete the
 folder after changing the renderer), references in --out/references by the renderer's source hash.
 Prints a line per scene and variant and a Markdown table; writes --out/sweep.json.
+
+With --camera-path every run follows the scene's first camera path (reprojection, history
+rejection and the model's age under motion are exercised) and the figure is the mean relMSE of
+the frames listed in --checkpoints against a reference of each of those frames (cached like the
+static ones):
+
+    python3 bench/variant_sweep.py --camera-path --checkpoints 23 31 --variants '{"default": []}'
 """
 import argparse
 import json
@@ -19,7 +26,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from suite import runner  # noqa: E402
+from suite import metrics, runner  # noqa: E402
 
 SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza", "slit-room", "corridor",
           "sunlit-room"]
@@ -51,6 +58,11 @@ def main():
     parser.add_argument("--window", type=int, default=8, help="last frames whose relMSE is averaged")
     parser.add_argument("--ref-spp", type=int, default=1024)
     parser.add_argument("--out", default=str(runner.ROOT / "build" / "variant-sweep"))
+    parser.add_argument("--camera-path", action="store_true",
+                        help="follow each scene's first camera path; the figure comes from --checkpoints")
+    parser.add_argument("--checkpoints", nargs="+", type=int,
+                        help="with --camera-path: 0-based frames compared with their own references "
+                             "(default: the last --window frames)")
     args = parser.parse_args()
     try:
         variants = json.loads(args.variants)
@@ -60,11 +72,39 @@ def main():
         parser.error('--variants must be a JSON object of argument lists, e.g. {"default": []}')
     if not 1 <= args.window <= args.frames:
         parser.error(f"--window {args.window} must be between 1 and --frames {args.frames}")
+    if args.checkpoints and not args.camera_path:
+        parser.error("--checkpoints needs --camera-path")
+    checkpoints = sorted(set(args.checkpoints or range(args.frames - args.window, args.frames)))
+    if args.camera_path and not all(0 <= f < args.frames for f in checkpoints):
+        parser.error(f"--checkpoints must be frames in [0, --frames {args.frames})")
 
     out = Path(args.out)
     refs = runner.ReferenceCache(out / "references")
 
+    def path_relmse(scene, tag, seed, guiding, extra):
+        """Mean relMSE of the checkpoint frames along the scene's first camera path."""
+        name = runner.first_camera_path(scene)
+        if not name:
+            raise SystemExit(f"variant_sweep.py: {runner.scene_path(scene)} has no camera path (--camera-path)")
+        run_dir = out / scene
+        cached = run_dir / f"path-{tag}-{seed}.relmse.json"
+        if cached.exists():
+            return json.loads(cached.read_text())["relmse"]
+        _, image = runner.render(scene, args.res, max(checkpoints) + 1, guiding, run_dir, f"path-{tag}-{seed}",
+                                 extra=["--seed", seed, "--camera-path", name, "--save-frames",
+                                        ",".join(map(str, checkpoints)), *extra])
+        errors = [metrics.relmse(metrics.load_exr(runner.saved_frame(image, f)),
+                                 metrics.load_exr(refs.get(scene, args.res, args.ref_spp, seed=777, camera_path=name,
+                                                           frame=f)))
+                  for f in checkpoints]
+        value = statistics.fmean(errors)
+        cached.write_text(json.dumps({"camera_path": name, "checkpoints": checkpoints, "relmse_per_checkpoint": errors,
+                                      "relmse": value}) + "\n")
+        return value
+
     def relmse(scene, tag, seed, guiding, extra):
+        if args.camera_path:
+            return path_relmse(scene, tag, seed, guiding, extra)
         reference = refs.get(scene, args.res, args.ref_spp, seed=777)
         run_dir = out / scene
         cached = run_dir / f"{tag}-{seed}.json"

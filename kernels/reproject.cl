@@ -1,8 +1,9 @@
 /* Guiding state of the previous frame -> this frame (paper 3.1): nearest-neighbour fetch
  * through the motion vector, rejected on position (depth), normal and material differences
  * (pg_same_surface, as SVGF does), and carried into this pixel's hemisphere frame when the
- * normals differ. Rejected, disoccluded and skipped pixels restart from the initial state
- * (k = 0). */
+ * normals differ; under a moving camera a glossy pixel's model ages as its view turns
+ * (pg_pmm_view_aged_k). Rejected, disoccluded and skipped pixels restart from the initial
+ * state (k = 0). */
 /* Per pixel (hand count; rules and roofline: docs/guiding.md, "The roofline"): 78 flops (2
  * divisions, 1 sqrt) where history is kept, 372 more (13 divisions, 12 sqrt/sin/cos) where the
  * state is reframed; 132 bytes read, 32 written: memory-bound. */
@@ -33,6 +34,13 @@ __kernel void reproject(PG_ARGS_GBUFFER PG_ARGS_PREV_GBUFFER PG_ARGS_IN_STATE PG
         s.s1 = in_state1[j];
         pg_frame from = pg_frame_from_normal(m), to = pg_frame_from_normal(n);
         if (pg_pmm_needs_reframe(from, to)) s = pg_pmm_reframe(s, from, to);
+        /* A still camera has motion exactly 0 (docs/design.md); its view directions differ
+         * only by the sub-pixel jitter, which is no change of view. */
+        if (mv.x != 0.0f || mv.y != 0.0f)
+          s.s1.w = pg_pmm_view_aged_k(
+              s.s1.w, pg_float4_xyz(view_dir[i]), pg_float4_xyz(prev_view_dir[j]),
+              pg_material_from_gbuffer(base_color_roughness[i], metallic_specular[i]),
+              settings.reproject_view_memory);
         if (pg_pmm_state_finite(s)) out = s;
       }
     }

@@ -58,6 +58,17 @@ def render(scene, res, frames, guiding, out_dir, tag, reference=None, extra=(), 
     return json.loads(stats.read_text()), image
 
 
+def saved_frame(image_path, frame):
+    """Where `rtpg render --save-frames` put `frame` (host/app frame_output_path: NAME-fNNNN.EXT)."""
+    return Path(image_path).with_name(f"{Path(image_path).stem}-f{frame:04d}{Path(image_path).suffix}")
+
+
+def first_camera_path(name):
+    """The scene's first camera path by name (scenes/README.md, "camera_paths"), or "" if it has none."""
+    paths = json.loads(Path(scene_path(name)).read_text()).get("camera_paths", {})
+    return sorted(paths)[0] if paths else ""
+
+
 def scene_exposure(name):
     """The scene file's "exposure" (scenes/README.md; default 1): PNG output and LDR-FLIP multiply
     radiance by it before the display transform."""

@@ -16,7 +16,7 @@ BENCH = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(BENCH))
 import compare  # noqa: E402
 import experiments  # noqa: E402
-from suite import equal_time, metrics  # noqa: E402
+from suite import equal_time, metrics, runner  # noqa: E402
 
 OUT = Path(sys.argv.pop(1)) if len(sys.argv) > 1 else BENCH.parent / "build" / "bench-quick"
 
@@ -92,7 +92,7 @@ class QuickRun(unittest.TestCase):
             exposure = r.get("exposure", 1.0)
             black = metrics.flip_ldr(np.zeros_like(ref), ref, exposure)
             for method in ("off", "pmm"):
-                frame = experiments.saved_frame(OUT / "static" / scene / f"{method}.exr", r["T"] - 1)
+                frame = runner.saved_frame(OUT / "static" / scene / f"{method}.exr", r["T"] - 1)
                 flip = r["methods"][method]["flip_ldr"]
                 self.assertAlmostEqual(flip, metrics.flip_ldr(metrics.load_exr(frame), ref, exposure), places=6,
                                        msg=frame)

@@ -52,6 +52,31 @@ class EndToEnd(unittest.TestCase):
                 self.assertTrue(math.isfinite(ratio) and ratio > 0.0 and se >= 0.0, (name, ratio, se))
                 self.assertIn(f"| {name} |", first)
 
+    def test_tiny_sweep_along_the_camera_path(self):
+        with tempfile.TemporaryDirectory() as out:
+            cmd = [sys.executable, str(BENCH / "variant_sweep.py"), "--scenes", "cornell-box", "--seeds", "1", "2",
+                   "--res", "24x16", "--frames", "4", "--window", "2", "--ref-spp", "16", "--out", out, "--camera-path",
+                   "--checkpoints", "1", "3", "--variants", json.dumps({"guided": []})]
+            first = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+            again = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+            self.assertEqual(first, again)  # the rerun reads the cached figures
+            ratio, se = json.loads((Path(out) / "sweep.json").read_text())["table"]["guided"]["cornell-box"]
+            self.assertTrue(math.isfinite(ratio) and ratio > 0.0 and se >= 0.0, (ratio, se))
+            run = json.loads((Path(out) / "cornell-box" / "path-pg-guided-1.relmse.json").read_text())
+            self.assertEqual(run["camera_path"], runner.first_camera_path("cornell-box"))
+            self.assertEqual(run["checkpoints"], [1, 3])
+            self.assertAlmostEqual(run["relmse"], sum(run["relmse_per_checkpoint"]) / 2, places=12)
+            # One reference per checkpoint frame, none for the static camera.
+            self.assertEqual(len(list((Path(out) / "references").glob("*.exr"))), 2)
+
+    def test_bad_checkpoints_are_refused(self):
+        base = [sys.executable, str(BENCH / "variant_sweep.py"), "--variants", "{}", "--frames", "4", "--window", "2"]
+        for extra in (["--checkpoints", "1"], ["--camera-path", "--checkpoints", "4"],
+                      ["--camera-path", "--checkpoints", "-1"]):
+            r = subprocess.run(base + extra, capture_output=True, text=True)
+            self.assertEqual(r.returncode, 2, extra)
+            self.assertIn("--checkpoints", r.stderr)
+
     def test_bad_variants_are_refused(self):
         for bad in ["not json", '["a list"]', '{"a": "not a list"}']:
             r = subprocess.run([sys.executable, str(BENCH / "variant_sweep.py"), "--variants", bad],

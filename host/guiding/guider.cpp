@@ -8,8 +8,8 @@
 namespace rtpg {
 namespace {
 
-static_assert(sizeof(pg_kernel_settings) == 23 * 4,
-              "pg_kernel_settings: 23 plain 4-byte fields, no padding");
+static_assert(sizeof(pg_kernel_settings) == 24 * 4,
+              "pg_kernel_settings: 24 plain 4-byte fields, no padding");
 static_assert(sizeof(shared::pg_pmm_state) == 4 * PG_STATE_FLOATS_PER_PIXEL,
               "the state's floats per pixel");
 

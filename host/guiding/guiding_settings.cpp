@@ -59,6 +59,9 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
            "Position change, relative to the depth, that rejects history"),
       real("reproject_normal", &S::reproject_normal, -1, 1, false, false,
            "Normal cosine below which history is rejected"),
+      real("reproject_view_memory", &S::reproject_view_memory, 0, kInf, false, false,
+           "Glossy pixels: the carried model's age falls by 1/e per this many GGX alphas of view "
+           "turn (0 = off)"),
       integer("train_interval", &S::train_interval, 1, 64,
               "A mature pixel (k >= k_max/4) trains every this many frames"),
       integer("train_all_samples", &S::train_all_samples, 0, 1,
@@ -135,6 +138,7 @@ pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {
   p.max_weight = c.max_weight;
   p.reproject_position = c.reproject_position;
   p.reproject_normal = c.reproject_normal;
+  p.reproject_view_memory = c.reproject_view_memory;
   p.sigma_prior = c.sigma_prior;
   p.reseed_ratio = c.reseed_ratio;
   p.weight_clamp = c.weight_clamp;

@@ -132,6 +132,8 @@ typedef struct pg_kernel_settings {
   int reseed_samples;    /* samples of one batch that must call for a re-seed before it happens */
   int pi_learning;       /* 1: the mixing weight minimises the first bounce's second moment;
                             0: EM's weight (paper 3.2) */
+  float reproject_view_memory; /* a glossy model's k falls by 1/e per this many GGX alphas of
+                                  view turn (pg_pmm_view_aged_k); 0: k survives reprojection */
 } pg_kernel_settings;
 
 #ifdef __cplusplus

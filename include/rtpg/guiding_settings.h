@@ -27,13 +27,18 @@ struct GuidingSettings {
   float weight_clamp = 0.0f;   // training weights clamped to weight_clamp * W (0 = no clamp)
   int em_passes = 3;           // E-step passes over each frame's samples
   float max_correlation = 0.95f;
-  float roughness_skip = 0.05f;      // roughness at or below: BSDF only, no training
-  int n_min = 5, n_max = 20;         // N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2);
-                                     // n_min == n_max gives a fixed N
-  int apron = 2;                     // neighbourhood radius: a (2*apron+1)^2 window of VPLs
-  float max_weight = 1e8f;           // training weights above this are dropped as absurd
-  float reproject_position = 0.05f;  // relative distance (to the depth) that rejects history
-  float reproject_normal = 0.9f;     // normal cosine below which history is rejected
+  float roughness_skip = 0.05f;        // roughness at or below: BSDF only, no training
+  int n_min = 5, n_max = 20;           // N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2);
+                                       // n_min == n_max gives a fixed N
+  int apron = 2;                       // neighbourhood radius: a (2*apron+1)^2 window of VPLs
+  float max_weight = 1e8f;             // training weights above this are dropped as absurd
+  float reproject_position = 0.05f;    // relative distance (to the depth) that rejects history
+  float reproject_normal = 0.9f;       // normal cosine below which history is rejected
+  float reproject_view_memory = 0.0f;  // where a pixel's BSDF has a glossy lobe, its carried
+                                       // model's age k falls by 1/e for every this many GGX
+                                       // alphas (radians) its view turns, so a stale lobe is
+                                       // relearnt; 0: k survives reprojection (paper 3.1)
+                                       // (docs/guiding.md, "Glossy history under a moving camera")
   int train_interval = 2;     // a mature pixel (k >= k_max / 4) trains every this many frames,
                               // in a rotating pattern (the rest keep their state); 2: the
                               // same error as 1 for 14-24% less train time

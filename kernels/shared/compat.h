@@ -51,6 +51,7 @@ using glm::cross;
 using glm::dot;
 using glm::length;
 using glm::normalize;
+using std::acos;
 using std::atan2;
 using std::cos;
 using std::exp;

@@ -367,6 +367,24 @@ PG_FN float2 pg_pmm_reframe_point(float2 u, pg_frame from, pg_frame to, PG_PRIVA
   return pg_hemisphere_to_square(w);
 }
 
+/* The age k of a model carried to a pixel whose view of the surface turned from prev_view to
+ * view (unit directions towards the camera; issue 9, lever 4; docs/guiding.md, "Glossy history
+ * under a moving camera"). The model learnt the product of the incident light and the BSDF seen
+ * from the old view; where the BSDF has a glossy lobe that product moves with the view, so k
+ * falls by 1/e for every view_memory * alpha radians the view turns (alpha = GGX roughness^2,
+ * about the lobe's angular width), and the next EM steps weigh the new view's samples more. A
+ * BSDF without a specular lobe (f0 = 0) is view-independent: k is kept. view_memory 0: off. */
+PG_FN float pg_pmm_view_aged_k(float k, float3 view, float3 prev_view, pg_material m,
+                               float view_memory) {
+  if (!(view_memory > 0.0f) || !(k > 0.0f)) return k;
+  float metallic = clamp(m.metallic, 0.0f, 1.0f), spec = clamp(m.specular, 0.0f, 1.0f);
+  float3 f0 = mix(pg_make_float3(spec, spec, spec), m.base_color, metallic);
+  if (!(pg_max3(f0) > 0.0f)) return k;
+  float r = fmax(m.roughness, PG_MIN_ROUGHNESS);
+  float turned = acos(clamp(dot(view, prev_view), -1.0f, 1.0f));
+  return k * exp(-turned / (view_memory * r * r));
+}
+
 PG_FN pg_pmm_state pg_pmm_reframe(pg_pmm_state s, pg_frame from, pg_frame to) {
   if (!(s.s1.w > 0.0f) || !(s.s0.y > 0.0f)) return s;
   float mx = clamp(s.s0.z / s.s0.y, 0.0f, 1.0f), my = clamp(s.s0.w / s.s0.y, 0.0f, 1.0f);

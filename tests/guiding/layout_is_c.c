@@ -8,8 +8,8 @@
 
 int main(void) {
   int failed = 0;
-  if (sizeof(pg_kernel_settings) != 23 * 4) {
-    printf("pg_kernel_settings: %u bytes, expected 92\n", (unsigned)sizeof(pg_kernel_settings));
+  if (sizeof(pg_kernel_settings) != 24 * 4) {
+    printf("pg_kernel_settings: %u bytes, expected 96\n", (unsigned)sizeof(pg_kernel_settings));
     failed = 1;
   }
   if (0 PG_GBUFFER_CHANNELS(PG_SUM_BYTES) != 5 * 16 + 4 + 4 + 8 ||

@@ -243,7 +243,7 @@ TEST(GuiderApi, HostDistributionHasTheSampleKernelsDensity) {
 TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
   EXPECT_NO_THROW(rtpg::validate(rtpg::GuidingSettings{}));
   const auto& table = rtpg::guiding_settings_table();
-  EXPECT_EQ(table.size(), 26u);
+  EXPECT_EQ(table.size(), 27u);
   for (const rtpg::GuidingSettingInfo& row : table) {
     ASSERT_TRUE((row.float_field != nullptr) != (row.int_field != nullptr)) << row.name;
     EXPECT_TRUE(row.in_range(row.get(rtpg::GuidingSettings{}))) << row.name;

@@ -789,6 +789,40 @@ double angle(float3 a, float3 b) {
 // differences of step 1e-3, whose float error is ~1e-7 / 1e-3 = 1e-4 relative per entry, growing
 // where the probe crosses a kink of M (the square's diagonals, excluded within 2e-3): 2% of
 // sqrt(Sxx Syy) per entry (0.6% measured).
+// A carried model ages with its view only where the BSDF has a glossy lobe: by 1/e per
+// view_memory * alpha radians of turn (alpha = roughness^2), not at all for a Lambert surface, a
+// still view, or with the option off (pmm.h, pg_pmm_view_aged_k).
+TEST(PmmViewAge, GlossyModelsForgetAsTheViewTurns) {
+  pg_material metal;
+  metal.base_color = float3(0.9f, 0.6f, 0.3f);
+  metal.roughness = 0.3f;
+  metal.metallic = 1.0f;
+  metal.specular = 0.5f;
+  pg_material lambert = metal;
+  lambert.metallic = 0.0f;
+  lambert.specular = 0.0f;
+  const float memory = 2.0f, alpha = 0.3f * 0.3f, k = 20.0f;
+  const float3 view(0.0f, 0.0f, 1.0f);
+  for (const float turned : {0.05f, 0.18f, 0.5f, 1.5f}) {
+    const float3 prev(std::sin(turned), 0.0f, std::cos(turned));
+    const float expected = k * std::exp(-turned / (memory * alpha));
+    EXPECT_NEAR(pg_pmm_view_aged_k(k, view, prev, metal, memory), expected, 1e-4f * k) << turned;
+    EXPECT_EQ(pg_pmm_view_aged_k(k, view, prev, lambert, memory), k) << turned;
+    EXPECT_EQ(pg_pmm_view_aged_k(k, view, prev, metal, 0.0f), k) << turned;
+  }
+  // One memory's worth of turn takes k to k / e; no turn keeps it; a fresh model stays fresh.
+  const float one = memory * alpha;
+  EXPECT_NEAR(
+      pg_pmm_view_aged_k(k, view, float3(std::sin(one), 0.0f, std::cos(one)), metal, memory),
+      k / std::exp(1.0f), 1e-4f * k);
+  EXPECT_EQ(pg_pmm_view_aged_k(k, view, view, metal, memory), k);
+  EXPECT_EQ(pg_pmm_view_aged_k(0.0f, view, float3(1.0f, 0.0f, 0.0f), metal, memory), 0.0f);
+  // A dielectric coating (specular > 0, metallic 0) is glossy too.
+  pg_material coated = lambert;
+  coated.specular = 0.04f;
+  EXPECT_LT(pg_pmm_view_aged_k(k, view, float3(1.0f, 0.0f, 0.0f), coated, memory), k);
+}
+
 TEST(PmmReframe, IdentityFrameKeepsTheState) {
   const pg_kernel_settings p = default_params();
   std::mt19937 gen(11);
