@@ -89,7 +89,9 @@ def main():
         run_dir = out / scene
         cached = run_dir / f"path-{tag}-{seed}.relmse.json"
         if cached.exists():
-            return json.loads(cached.read_text())["relmse"]
+            figures = json.loads(cached.read_text())
+            if figures["checkpoints"] == checkpoints and figures["camera_path"] == name:
+                return figures["relmse"]
         _, image = runner.render(scene, args.res, max(checkpoints) + 1, guiding, run_dir, f"path-{tag}-{seed}",
                                  extra=["--seed", seed, "--camera-path", name, "--save-frames",
                                         ",".join(map(str, checkpoints)), *extra])

@@ -68,6 +68,11 @@ class EndToEnd(unittest.TestCase):
             self.assertAlmostEqual(run["relmse"], sum(run["relmse_per_checkpoint"]) / 2, places=12)
             # One reference per checkpoint frame, none for the static camera.
             self.assertEqual(len(list((Path(out) / "references").glob("*.exr"))), 2)
+            # Other checkpoints: the cached figure of the same runs is not reused.
+            cmd[cmd.index("--checkpoints") + 1] = "2"
+            subprocess.run(cmd, check=True, capture_output=True, text=True)
+            run = json.loads((Path(out) / "cornell-box" / "path-pg-guided-1.relmse.json").read_text())
+            self.assertEqual(run["checkpoints"], [2, 3])
 
     def test_bad_checkpoints_are_refused(self):
         base = [sys.executable, str(BENCH / "variant_sweep.py"), "--variants", "{}", "--frames", "4", "--window", "2"]
