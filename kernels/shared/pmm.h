@@ -377,12 +377,10 @@ PG_FN float2 pg_pmm_reframe_point(float2 u, pg_frame from, pg_frame to, PG_PRIVA
 PG_FN float pg_pmm_view_aged_k(float k, float3 view, float3 prev_view, pg_material m,
                                float view_memory) {
   if (!(view_memory > 0.0f) || !(k > 0.0f)) return k;
-  float metallic = clamp(m.metallic, 0.0f, 1.0f), spec = clamp(m.specular, 0.0f, 1.0f);
-  float3 f0 = mix(pg_make_float3(spec, spec, spec), m.base_color, metallic);
-  if (!(pg_max3(f0) > 0.0f)) return k;
-  float r = fmax(m.roughness, PG_MIN_ROUGHNESS);
+  pg_lobes lobes = pg_make_lobes(m, pg_make_float3(0.0f, 0.0f, 1.0f)); /* f0 and alpha only */
+  if (!(pg_max3(lobes.f0) > 0.0f)) return k;
   float turned = acos(clamp(dot(view, prev_view), -1.0f, 1.0f));
-  return k * exp(-turned / (view_memory * r * r));
+  return k * exp(-turned / (view_memory * lobes.alpha));
 }
 
 PG_FN pg_pmm_state pg_pmm_reframe(pg_pmm_state s, pg_frame from, pg_frame to) {
