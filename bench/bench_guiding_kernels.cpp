@@ -5,7 +5,7 @@
 // from a cosine bounce (positions, normals, area densities, radiance with rare bright hits,
 // 20% guide-strategy and 10% escaped ones) and trained-like states (k spread over 0..kMax).
 //
-//   bench_guiding_kernels               1280x720 local-size sweep, 1920x1080 at 16x16,
+//   bench_guiding_kernels               1280x720 local-size sweep, 1920x1080 at 16x16 and auto,
 //                                       TBB train at 1280x720
 //   bench_guiding_kernels --rtpg_full   also the local-size sweep and TBB train at 1920x1080
 //
@@ -24,6 +24,8 @@
 //                        launched in the same iterations (1 for that one): the local-size
 //                        sweep, Local vs Global and the lanes as ratios that host drift does
 //                        not disturb
+//   row_work_groups      1 where the kernels run in work-groups along rows (local:auto on a CPU
+//                        device), 0 for a tile
 //   lanes                pixels per work-item of the train kernel (1: train.cl, else
 //                        train_wide.cl)
 //   flops_per_pixel      floating-point operations along each pixel's path (count_flops, from
@@ -468,6 +470,7 @@ void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int 
   state.counters["roofline_ms"] = bound_ms;
   state.counters["roofline_fraction"] = bound_ms / (kernel_ms / it);
   state.counters["vs_16x16_global"] = kernel_ms / ref_ms;
+  state.counters["row_work_groups"] = g->row_work_groups() ? 1.0 : 0.0;
   if (kernel == Kernel::Train) {
     state.counters["local_tile"] = g->train_uses_local_memory() ? 1.0 : 0.0;
     state.counters["lanes"] = g->train_lanes();
@@ -587,14 +590,16 @@ void register_all(bool full) {
   struct Local {
     int x, y;
   };
-  const std::vector<Local> sweep = {{8, 8}, {16, 16}, {32, 8}, {12, 6}};
+  // 0x0: the device's own work-groups (rows on CPUs: host/cl/work_groups.h), the default.
+  const std::vector<Local> sweep = {{8, 8}, {16, 16}, {32, 8}, {12, 6}, {0, 0}};
   const std::vector<std::pair<int, int>> sizes = {{1280, 720}, {1920, 1080}};
   for (auto [w, h] : sizes) {
     const bool sweep_here = w == 1280 || full;
     for (const Local& l : sweep) {
-      if (!sweep_here && !(l.x == 16 && l.y == 16)) continue;
+      if (!sweep_here && !(l.x == 16 && l.y == 16) && l.x != 0) continue;
       const std::string res = std::to_string(w) + "x" + std::to_string(h);
-      const std::string local = "/local:" + std::to_string(l.x) + "x" + std::to_string(l.y);
+      const std::string local =
+          l.x == 0 ? "/local:auto" : "/local:" + std::to_string(l.x) + "x" + std::to_string(l.y);
       auto add = [&](const std::string& name, Kernel k, M memory, int lanes = kRefLanes) {
         benchmark::RegisterBenchmark(name.c_str(), BM_GuidingKernel, k, w, h, l.x, l.y, memory,
                                      lanes)

@@ -8,7 +8,8 @@
 //
 //   bench_svgf                  960x540 and 1920x1080, the variance and a-trous kernels one
 //                               pixel per work-item (lanes:1) and in the device's SIMD lanes
-//                               (lanes:auto)
+//                               (lanes:auto), in the device's own work-groups (rows on CPUs)
+//                               and, with the lanes, in 16x16 tiles (local:16x16)
 //   bench_svgf --benchmark_filter='cornell/960'
 //
 // Time is the sum of the kernels' OpenCL profiling-event times of one denoise() (manual time).
@@ -24,6 +25,8 @@
 //   <kernel>_roofline    the kernel's roofline bound / its time (1: at the roof), the copy
 //                        and multiply-add yardsticks launched in the same iterations
 //   lanes                pixels per work-item of the variance and a-trous kernels
+//   row_work_groups      1 where the temporal and remodulate kernels run in work-groups along
+//                        rows, 0 for tiles (the filters always run in tiles)
 #include "bench_common.h"
 #include "bench_roofline.h"
 
@@ -141,16 +144,19 @@ struct Setup {
 
 // young: every frame starts without history (a camera cut, the first frame; what disoccluded
 // pixels cost), so every pixel takes the variance pass's 7x7 spatial estimate.
-Setup* setup_for(const std::string& scene_name, int w, int h, int lanes, bool young,
+// tile: 0 for the device's own work-groups (rows on CPUs: host/cl/work_groups.h), else a tile
+// of tile x tile work-items.
+Setup* setup_for(const std::string& scene_name, int w, int h, int lanes, int tile, bool young,
                  std::string* why) {
-  static std::map<std::tuple<std::string, int, int, int, bool>, std::unique_ptr<Setup>> cache;
-  const auto key = std::make_tuple(scene_name, w, h, lanes, young);
+  static std::map<std::tuple<std::string, int, int, int, int, bool>, std::unique_ptr<Setup>> cache;
+  const auto key = std::make_tuple(scene_name, w, h, lanes, tile, young);
   if (auto it = cache.find(key); it != cache.end()) return it->second.get();
   Frames* f = frames_for(scene_name, w, h, why);
   if (!f) return nullptr;
   auto s = std::make_unique<Setup>();
   SvgfSettings settings;
   settings.lanes = lanes;
+  settings.local_x = settings.local_y = tile;
   s->denoiser = std::make_unique<SvgfDenoiser>(runtime(), w, h, settings);
   // Two passes over the frames: the history is past min_history everywhere (steady state).
   for (int k = 0; k < 2 * kFrames; ++k) {
@@ -162,11 +168,11 @@ Setup* setup_for(const std::string& scene_name, int w, int h, int lanes, bool yo
 }
 
 void BM_Svgf(benchmark::State& state, const std::string& scene_name, int w, int h, int lanes,
-             bool young) {
+             int tile, bool young) {
   std::string why;
   Setup* s = nullptr;
   try {
-    s = setup_for(scene_name, w, h, lanes, young, &why);
+    s = setup_for(scene_name, w, h, lanes, tile, young, &why);
   } catch (const std::exception& e) {
     why = e.what();
   }
@@ -216,6 +222,7 @@ void BM_Svgf(benchmark::State& state, const std::string& scene_name, int w, int 
   state.counters["pt_frame_ms"] = f.pt_frame_ms;
   state.counters["frame_fraction"] = sum["svgf"] / it / f.pt_frame_ms;
   state.counters["lanes"] = s->denoiser->lanes();
+  state.counters["row_work_groups"] = s->denoiser->pixel_work_groups().rows ? 1.0 : 0.0;
   state.SetItemsProcessed(static_cast<std::int64_t>(n) * state.iterations());
 }
 
@@ -223,13 +230,15 @@ void register_all(bool /*full*/) {
   benchmark::AddCustomContext("opencl_device", runtime().info().device_name);
   for (const char* scene : {"cornell", "sponza"})
     for (auto [w, h] : {std::pair{960, 540}, std::pair{1920, 1080}})
-      for (int lanes : {1, 0})
+      for (auto [lanes, tile] : {std::pair{1, 0}, std::pair{0, 0}, std::pair{0, 16}})
         for (bool young : {false, true}) {
           const std::string name =
               std::string(scene) + "/" + std::to_string(w) + "x" + std::to_string(h) +
               "/lanes:" + (lanes == 0 ? std::string("auto") : std::to_string(lanes)) +
+              (tile == 0 ? std::string()
+                         : "/local:" + std::to_string(tile) + "x" + std::to_string(tile)) +
               "/history:" + (young ? "none" : "full");
-          benchmark::RegisterBenchmark(name.c_str(), BM_Svgf, std::string(scene), w, h, lanes,
+          benchmark::RegisterBenchmark(name.c_str(), BM_Svgf, std::string(scene), w, h, lanes, tile,
                                        young)
               ->UseManualTime()
               ->Unit(benchmark::kMillisecond)

@@ -1,5 +1,6 @@
 #include "denoise/svgf_denoiser.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <initializer_list>
@@ -51,15 +52,25 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
   remodulate_ = runtime.kernel("svgf_remodulate.cl", "svgf_remodulate");
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   translate_cl_errors([&] {
-    const std::size_t group = static_cast<std::size_t>(settings.local_x) * settings.local_y;
     const std::vector<std::size_t> max_items =
         runtime.device().getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>();
+    std::size_t max_group = max_items.at(0);
+    for (cl::Kernel* k : {&temporal_, &variance_, &atrous_, &remodulate_})
+      max_group =
+          std::min(max_group, k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device()));
+    // Temporal and remodulate read their own pixel (temporal also the bilinear taps of one
+    // back-projected position); variance and a-trous filter neighbourhoods.
+    pixel_groups_ = resolve_work_groups(runtime.info(), settings.local_x, settings.local_y,
+                                        KernelReach::Pixel, max_group);
+    filter_groups_ = resolve_work_groups(runtime.info(), settings.local_x, settings.local_y,
+                                         KernelReach::Neighbourhood, max_group);
+    const std::size_t group = static_cast<std::size_t>(filter_groups_.x) * filter_groups_.y;
     for (cl::Kernel* k : {&temporal_, &variance_, &atrous_, &remodulate_}) {
       const std::size_t limit = k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device());
-      if (group > limit || static_cast<std::size_t>(settings.local_x) > max_items.at(0) ||
-          static_cast<std::size_t>(settings.local_y) > max_items.at(1))
-        throw InputError("svgf settings", "local size " + std::to_string(settings.local_x) + "x" +
-                                              std::to_string(settings.local_y) + " is refused by " +
+      if (group > limit || static_cast<std::size_t>(filter_groups_.x) > max_items.at(0) ||
+          static_cast<std::size_t>(filter_groups_.y) > max_items.at(1))
+        throw InputError("svgf settings", "local size " + std::to_string(filter_groups_.x) + "x" +
+                                              std::to_string(filter_groups_.y) + " is refused by " +
                                               runtime.info().device_name + " (at most " +
                                               std::to_string(limit) + " work-items for kernel " +
                                               k->getInfo<CL_KERNEL_FUNCTION_NAME>() + ")");
@@ -89,14 +100,11 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
   output_host_.resize(n);
 }
 
-double SvgfDenoiser::run(cl::Kernel& kernel, int lanes) {
-  auto round_up = [](int v, int m) { return static_cast<std::size_t>((v + m - 1) / m * m); };
+double SvgfDenoiser::run(cl::Kernel& kernel, int lanes, const WorkGroupShape& shape) {
+  const ImageLaunch launch = image_launch(width_, height_, lanes, shape);
   cl::Event done;
-  runtime_.queue().enqueueNDRangeKernel(
-      kernel, cl::NullRange,
-      cl::NDRange(round_up((width_ + lanes - 1) / lanes, settings_.local_x),
-                  round_up(height_, settings_.local_y)),
-      cl::NDRange(settings_.local_x, settings_.local_y), nullptr, &done);
+  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, launch.global, launch.local, nullptr,
+                                        &done);
   done.wait();
   return ClRuntime::event_ms(done);
 }
@@ -157,7 +165,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     temporal_.setArg(a++, h);
     temporal_.setArg(a++, static_cast<cl_uint>(has_history_ ? 1 : 0));
     temporal_.setArg(a++, kernel_settings_);
-    times_["svgf_temporal"] = run(temporal_);
+    times_["svgf_temporal"] = run(temporal_, 1, pixel_groups_);
 
     a = 0;
     for (const cl::Buffer* b :
@@ -166,7 +174,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     variance_.setArg(a++, w);
     variance_.setArg(a++, h);
     variance_.setArg(a++, kernel_settings_);
-    times_["svgf_variance"] = run(variance_, lanes_);
+    times_["svgf_variance"] = run(variance_, lanes_, filter_groups_);
 
     double atrous_ms = 0.0;
     // Iteration k reads the variance pass's output (k = 0) or iteration k - 1's, and writes
@@ -183,7 +191,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
       atrous_.setArg(5, h);
       atrous_.setArg(6, static_cast<cl_int>(1 << k));
       atrous_.setArg(7, kernel_settings_);
-      atrous_ms += run(atrous_, lanes_);
+      atrous_ms += run(atrous_, lanes_, filter_groups_);
       in = out;
     }
     filtered_ = in;
@@ -196,7 +204,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     remodulate_.setArg(a++, w);
     remodulate_.setArg(a++, h);
     remodulate_.setArg(a++, kernel_settings_);
-    times_["svgf_remodulate"] = run(remodulate_);
+    times_["svgf_remodulate"] = run(remodulate_, 1, pixel_groups_);
 
     const auto download = Clock::now();
     runtime_.queue().enqueueReadBuffer(output_, CL_TRUE, 0, output_host_.size() * 16,

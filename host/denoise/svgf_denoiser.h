@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "cl/work_groups.h"
 #include "denoise/svgf_settings.h"
 #include "denoise/svgf_stage.h"
 #include "render/gbuffer.h"
@@ -57,10 +58,15 @@ class SvgfDenoiser {
   // Pixels per work-item of the variance and a-trous kernels (settings().lanes, 0 resolved
   // per device).
   int lanes() const { return lanes_; }
+  // The work-groups (settings().local_x and local_y, 0 resolved per device) of the pixel
+  // kernels (temporal, remodulate) and of the filters (variance, a-trous).
+  const WorkGroupShape& pixel_work_groups() const { return pixel_groups_; }
+  const WorkGroupShape& filter_work_groups() const { return filter_groups_; }
 
  private:
-  // Runs kernel over the image, each work-item covering `lanes` pixels of a row; blocking.
-  double run(cl::Kernel& kernel, int lanes = 1);
+  // Runs kernel over the image in work-groups of that shape, each work-item covering `lanes`
+  // pixels of a row; blocking.
+  double run(cl::Kernel& kernel, int lanes, const WorkGroupShape& shape);
   // The G-buffer channels the kernels read, this frame's and last frame's (ping-pong).
   struct Surfaces {
     cl::Buffer position_depth, shading_normal, material;
@@ -70,6 +76,7 @@ class SvgfDenoiser {
   int width_, height_;
   SvgfSettings settings_;
   int lanes_ = 1;
+  WorkGroupShape pixel_groups_, filter_groups_;
   bool zero_copy_ = false;
   shared::pg_svgf_settings kernel_settings_;
   cl::Kernel temporal_, variance_, atrous_, remodulate_;

@@ -38,8 +38,10 @@ const std::vector<SvgfSettingInfo>& svgf_settings_table() {
       integer("iterations", &S::iterations, 1, 12, "A-trous iterations (steps 1, 2, 4, ...)"),
       integer("history_iteration", &S::history_iteration, 0, 11,
               "The a-trous iteration (from 0) whose output is the next frame's history"),
-      integer("local_x", &S::local_x, 1, 65536, "Work-group width of the kernels"),
-      integer("local_y", &S::local_y, 1, 65536, "Work-group height of the kernels"),
+      integer("local_x", &S::local_x, 0, 65536,
+              "Work-group width of the kernels (0 with local_y 0: per device)"),
+      integer("local_y", &S::local_y, 0, 65536,
+              "Work-group height of the kernels (0 with local_x 0: per device)"),
       integer("lanes", &S::lanes, 0, 16,
               "Pixels per work-item of the variance and a-trous kernels: 1, 2, 4, 8 or 16 (0: the "
               "SIMD width on CPUs, else 1)"),
@@ -58,6 +60,10 @@ void validate(const SvgfSettings& s) {
     throw InputError("svgf settings", "history_iteration (" + std::to_string(s.history_iteration) +
                                           ") must be below iterations (" +
                                           std::to_string(s.iterations) + ")");
+  if ((s.local_x == 0) != (s.local_y == 0))
+    throw InputError("svgf settings", "local_x = " + std::to_string(s.local_x) +
+                                          " and local_y = " + std::to_string(s.local_y) +
+                                          ": both 0 (per device) or neither");
   if (s.lanes & (s.lanes - 1))
     throw InputError("svgf settings", "lanes = " + std::to_string(s.lanes) +
                                           " must be 0 (auto) or a power of two: 1, 2, 4, 8 or 16");

@@ -25,7 +25,9 @@ struct SvgfSettings {
   float albedo_floor = 1e-3f;        // demodulation divides by max(albedo, albedo_floor)
   int iterations = 5;                // a-trous iterations (steps 1, 2, 4, ...)
   int history_iteration = 0;         // the iteration whose output is next frame's history
-  int local_x = 16, local_y = 16;    // work-group size of the kernels
+  int local_x = 0, local_y = 0;      // work-group size of the kernels; 0 and 0 = per device:
+                                     // on CPUs temporal and remodulate in rows, the filters in
+                                     // 16x16; 16x16 elsewhere (host/cl/work_groups.h)
   // Pixels per work-item of the variance and a-trous kernels: 1 (svgf_variance.cl,
   // svgf_atrous.cl), or 2, 4, 8, 16 in vector lanes (svgf_variance_wide.cl,
   // svgf_atrous_wide.cl); 0 = the device's SIMD width on CPUs, 1 elsewhere

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "cl/work_groups.h"
 #include "guiding/kernel_args.h"
 #include "shared/pmm.h"
 
@@ -89,27 +90,42 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
                                 std::string("-DPG_TRAIN_LOCAL_TILE=") + (local_tile_ ? "1" : "0"));
 
   translate_cl_errors([&] {
-    const std::size_t group = static_cast<std::size_t>(settings.local_x) * settings.local_y;
-    std::vector<std::size_t> max_items = runtime.device().getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>();
+    const std::vector<std::size_t> max_items =
+        runtime.device().getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>();
+    std::size_t max_group = max_items.at(0);
+    for (cl::Kernel* k : {&reproject_, &sample_, &train_})
+      max_group =
+          std::min(max_group, k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device()));
+    // Reproject and sample read their own pixel (or one gathered through the motion vector);
+    // train reads a window of VPLs.
+    const WorkGroupShape pixel = resolve_work_groups(info, settings.local_x, settings.local_y,
+                                                     KernelReach::Pixel, max_group);
+    const WorkGroupShape window = resolve_work_groups(info, settings.local_x, settings.local_y,
+                                                      KernelReach::Neighbourhood, max_group);
+    pixel_rows_ = pixel.rows;
+    row_items_ = pixel.rows ? pixel.x : 0;
+    group_x_ = window.x;
+    group_y_ = window.y;
+    const std::size_t group = static_cast<std::size_t>(group_x_) * group_y_;
     for (cl::Kernel* k : {&reproject_, &sample_, &train_}) {
       const std::size_t limit = k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device());
-      if (group > limit || static_cast<std::size_t>(settings.local_x) > max_items.at(0) ||
-          static_cast<std::size_t>(settings.local_y) > max_items.at(1))
-        throw GuiderError("local size " + std::to_string(settings.local_x) + "x" +
-                          std::to_string(settings.local_y) + " is refused by " + info.device_name +
+      if (group > limit || static_cast<std::size_t>(group_x_) > max_items.at(0) ||
+          static_cast<std::size_t>(group_y_) > max_items.at(1))
+        throw GuiderError("local size " + std::to_string(group_x_) + "x" +
+                          std::to_string(group_y_) + " is refused by " + info.device_name +
                           " (at most " + std::to_string(limit) + " work-items for kernel " +
                           k->getInfo<CL_KERNEL_FUNCTION_NAME>() + ")");
     }
     if (local_tile_) {
-      const std::size_t tile = static_cast<std::size_t>(settings.local_x + 2 * settings.apron) *
-                               (settings.local_y + 2 * settings.apron) * 3 * 16;
+      const std::size_t tile = static_cast<std::size_t>(group_x_ + 2 * settings.apron) *
+                               (group_y_ + 2 * settings.apron) * 3 * 16;
       const std::size_t used = train_.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(runtime.device());
       if (tile + used > info.local_mem_size)
-        throw GuiderError(
-            "the VPL tile (" + std::to_string(tile) + " bytes for " +
-            std::to_string(settings.local_x) + "x" + std::to_string(settings.local_y) +
-            " pixels, apron " + std::to_string(settings.apron) + ") does not fit in the " +
-            std::to_string(info.local_mem_size) + " bytes of local memory of " + info.device_name);
+        throw GuiderError("the VPL tile (" + std::to_string(tile) + " bytes for " +
+                          std::to_string(group_x_) + "x" + std::to_string(group_y_) +
+                          " pixels, apron " + std::to_string(settings.apron) +
+                          ") does not fit in the " + std::to_string(info.local_mem_size) +
+                          " bytes of local memory of " + info.device_name);
     }
     for (State& s : state_) {
       s.state0 = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, n * 16);
@@ -158,19 +174,16 @@ void Guider::check_gbuffer(const GuiderGBuffer& g, const char* which) const {
 #undef RTPG_CHECK
 }
 
-double Guider::run(cl::Kernel& kernel, int lanes) {
+double Guider::run(cl::Kernel& kernel, int lanes, bool pixel_kernel) {
+  const WorkGroupShape shape = pixel_kernel && pixel_rows_
+                                   ? WorkGroupShape{true, row_items_, 1}
+                                   : WorkGroupShape{false, group_x_, group_y_};
+  const ImageLaunch launch = image_launch(width_, height_, lanes, shape);
   cl::Event done;
-  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, global_range(lanes),
-                                        cl::NDRange(settings_.local_x, settings_.local_y), nullptr,
+  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, launch.global, launch.local, nullptr,
                                         &done);
   done.wait();
   return ClRuntime::event_ms(done);
-}
-
-cl::NDRange Guider::global_range(int lanes) const {
-  auto round_up = [](int v, int m) { return static_cast<std::size_t>((v + m - 1) / m * m); };
-  return cl::NDRange(round_up((width_ + lanes - 1) / lanes, settings_.local_x),
-                     round_up(height_, settings_.local_y));
 }
 
 void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous) {
@@ -181,7 +194,7 @@ void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previo
     KernelArgs(reproject_) << current << previous << from.state0 << from.state1 << to.state0
                            << to.state1 << static_cast<cl_uint>(width_)
                            << static_cast<cl_uint>(height_) << kernel_settings_;
-    times_.reproject_ms = run(reproject_);
+    times_.reproject_ms = run(reproject_, 1, /*pixel_kernel=*/true);
   });
   current_ = 1 - current_;
 }
@@ -198,7 +211,7 @@ void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint3
                         << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
                         << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame)
                         << static_cast<cl_uint>(sample_index) << kernel_settings_;
-    times_.sample_ms = run(sample_, sample_lanes_);
+    times_.sample_ms = run(sample_, sample_lanes_, /*pixel_kernel=*/true);
   });
 }
 
@@ -209,17 +222,16 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
   PG_VPL_CHANNELS(RTPG_CHECK)
 #undef RTPG_CHECK
   const State &from = state_[current_], &to = state_[1 - current_];
-  const std::size_t tile = local_tile_
-                               ? static_cast<std::size_t>(settings_.local_x + 2 * settings_.apron) *
-                                     (settings_.local_y + 2 * settings_.apron) * 16
-                               : 16;
+  const std::size_t tile = local_tile_ ? static_cast<std::size_t>(group_x_ + 2 * settings_.apron) *
+                                             (group_y_ + 2 * settings_.apron) * 16
+                                       : 16;
   translate_cl_errors([&] {
     KernelArgs args(train_);
     args << current << vpls << from.state0 << from.state1 << to.state0 << to.state1 << trained_
          << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
          << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame) << kernel_settings_;
     if (train_lanes_ == 1) args << cl::Local(tile) << cl::Local(tile) << cl::Local(tile);
-    times_.train_ms = run(train_, train_lanes_);
+    times_.train_ms = run(train_, train_lanes_, /*pixel_kernel=*/false);
   });
   current_ = 1 - current_;
 }

@@ -68,8 +68,10 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
               "1: train on every VPL at its mixture density; 0: BSDF samples only"),
       integer("pi_learning", &S::pi_learning, 0, 1,
               "1: the mixing weight minimises the first bounce's second moment; 0: EM's"),
-      integer("local_x", &S::local_x, 1, 65536, "Work-group (VPL tile) width"),
-      integer("local_y", &S::local_y, 1, 65536, "Work-group (VPL tile) height"),
+      integer("local_x", &S::local_x, 0, 65536,
+              "Work-group (VPL tile) width (0 with local_y 0: per device)"),
+      integer("local_y", &S::local_y, 0, 65536,
+              "Work-group (VPL tile) height (0 with local_x 0: per device)"),
       integer("train_lanes", &S::train_lanes, 0, 16,
               "Pixels per work-item of the train kernel: 1, 2, 4, 8 or 16 (0: the SIMD width on "
               "CPUs, else 1)"),
@@ -118,6 +120,9 @@ void validate(const GuidingSettings& s) {
     if (value & (value - 1))
       fail(std::string(name) + " = " + setting_number(value) +
            " must be 0 (auto) or a power of two: 1, 2, 4, 8 or 16");
+  if ((s.local_x == 0) != (s.local_y == 0))
+    fail("local_x = " + setting_number(s.local_x) + " and local_y = " + setting_number(s.local_y) +
+         ": both 0 (per device) or neither");
   if (s.n_min > s.n_max)
     fail("n_min (" + setting_number(s.n_min) + ") must not exceed n_max (" +
          setting_number(s.n_max) + ")");

@@ -226,6 +226,7 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   // What the device ran (the settings' 0 = auto resolved) and whether samples were read in place.
   extra["train_lanes"] = guider_->train_lanes();
   extra["sample_lanes"] = guider_->sample_lanes();
+  extra["row_work_groups"] = guider_->row_work_groups() ? 1.0 : 0.0;
   extra["zero_copy"] = zero_copy_ ? 1.0 : 0.0;
   extra["host_device_bytes_per_pixel"] =
       static_cast<double>(bytes_) / static_cast<double>(std::max<std::size_t>(pixels_, 1));

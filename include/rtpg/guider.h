@@ -162,6 +162,9 @@ class Guider {
   int train_lanes() const { return train_lanes_; }
   // Pixels per work-item of the sample kernel (settings().sample_lanes, resolved likewise).
   int sample_lanes() const { return sample_lanes_; }
+  // Whether reproject and sample run in work-groups along rows (settings().local_x and local_y
+  // both 0 on a CPU device; host/cl/work_groups.h), not in tiles. Train runs in tiles.
+  bool row_work_groups() const { return pixel_rows_; }
 
   void reset();  // every pixel back to the initial state (k = 0: BSDF sampling)
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
@@ -183,16 +186,21 @@ class Guider {
  private:
   void check_gbuffer(const GuiderGBuffer& g, const char* which) const;
   void check_buffer(const cl::Buffer& b, std::size_t element_size, const std::string& name) const;
-  // Work-items over the image when each covers `lanes` pixels of a row.
-  cl::NDRange global_range(int lanes = 1) const;
-  // Launches over the image, waits, returns profiled ms.
-  double run(cl::Kernel& kernel, int lanes = 1);
+  // Launches over the image, `lanes` pixels of a row per work-item, waits, returns profiled ms.
+  // pixel_kernel: the kernel reads its own pixels only (KernelReach::Pixel).
+  double run(cl::Kernel& kernel, int lanes, bool pixel_kernel);
 
   ClRuntime& runtime_;
   int width_, height_;
   GuidingSettings settings_;
   pg_kernel_settings kernel_settings_;
   bool local_tile_ = false;
+  // The kernels' work-groups (host/cl/work_groups.h): reproject and sample in rows of up to
+  // row_items_ work-items where pixel_rows_, else in the group_x_ x group_y_ tile that train
+  // (and its VPL tile in local memory) always uses.
+  bool pixel_rows_ = false;
+  int row_items_ = 0;
+  int group_x_ = 16, group_y_ = 16;
   int train_lanes_ = 1;
   int sample_lanes_ = 1;
   struct State {  // the mixtures of every pixel (PG_STATE_CHANNELS)

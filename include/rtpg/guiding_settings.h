@@ -50,7 +50,10 @@ struct GuidingSettings {
                               // bounce's second moment (a Newton step per frame on the
                               // training samples); 0: EM's weight (paper 3.2)
                               // (docs/guiding.md, "A mixing weight that minimises the variance")
-  int local_x = 16, local_y = 16;  // work-group size of the kernels (the VPL tile)
+  // Work-group size of the kernels (the VPL tile of train.cl's local-memory variant); 0 and 0 =
+  // per device: on CPU devices reproject and sample in rows of up to 128 work-items and train in
+  // 16x16, 16x16 elsewhere (host/cl/work_groups.h; docs/guiding.md, "Work-groups along rows").
+  int local_x = 0, local_y = 0;
   int train_lanes = 0;   // pixels per work-item of the train kernel: 1 (train.cl), or 2, 4, 8, 16
                          // in vector lanes (train_wide.cl); 0 = auto: on CPU devices the SIMD
                          // width in floats (CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT), else 1

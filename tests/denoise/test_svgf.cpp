@@ -121,12 +121,24 @@ struct Case {
 // the lanes, images narrower than one work-item's lanes).
 TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
   ClRuntime rt;
-  std::vector<Case> cases = {{37, 23, 16, 16, 1}, {37, 23, 4, 4, 16}, {17, 13, 1, 1, 1},
-                             {17, 13, 1, 1, 4},   {40, 9, 7, 3, 8},   {40, 9, 2, 5, 2},
-                             {1, 1, 8, 8, 1},     {1, 1, 8, 8, 16},   {37, 23, 16, 16, 0}};
+  std::vector<Case> cases = {{37, 23, 16, 16, 1},
+                             {37, 23, 4, 4, 16},
+                             {17, 13, 1, 1, 1},
+                             {17, 13, 1, 1, 4},
+                             {40, 9, 7, 3, 8},
+                             {40, 9, 2, 5, 2},
+                             {1, 1, 8, 8, 1},
+                             {1, 1, 8, 8, 16},
+                             {37, 23, 16, 16, 0},
+                             // Work-groups per device (rows on CPUs: host/cl/work_groups.h).
+                             {37, 23, 0, 0, 0},
+                             {37, 23, 0, 0, 1}};
   if (!simulated(rt)) {
     cases.push_back({130, 71, 16, 8, 1});
     cases.push_back({130, 71, 16, 8, 16});
+    // Rows of several work-groups each (300 work-items a row: three groups of 100).
+    cases.push_back({300, 19, 0, 0, 1});
+    cases.push_back({300, 19, 0, 0, 0});
   }
   // Every case's denoiser lives to the end of the test: under Oclgrind, buffers allocated after
   // others were released draw false uninitialised-value reports (docs/denoising.md, "Tests").
@@ -371,6 +383,10 @@ TEST(SvgfKernels, BadInputIsAClearError) {
   late.history_iteration = 5;
   expect_refused(late, "history_iteration");
   EXPECT_THROW(SvgfDenoiser(rt, 0, 8), InputError);
+  SvgfSettings half_auto;  // a work-group size of 0 is per device in both directions or neither
+  half_auto.local_x = 0;
+  half_auto.local_y = 8;
+  expect_refused(half_auto, "local_x = 0 and local_y = 8");
   SvgfSettings three_lanes;
   three_lanes.lanes = 3;
   expect_refused(three_lanes, "lanes = 3");

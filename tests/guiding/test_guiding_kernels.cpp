@@ -239,7 +239,8 @@ struct PixelMixture {
   sh::pg_lobes lobes;
   float3 wo;
   sh::pg_frame frame;
-  float3 sampled_wi;  // the host sampler's own direction, in the frame
+  float3 sampled_wi;                      // the host sampler's own direction, in the frame
+  float xi = 0.0f, u1 = 0.0f, u2 = 0.0f;  // the random numbers it was drawn with
   float pdf(float3 wi) const { return sh::pg_pmm_pdf(model, lobes, wo, wi); }
 };
 
@@ -270,6 +271,9 @@ void host_sample(const std::vector<float>& state, const HostGBuffer& g, std::uin
     const float xi = sh::pg_rng_next(&rng), u1 = sh::pg_rng_next(&rng), u2 = sh::pg_rng_next(&rng);
     const sh::pg_pmm_sample_t smp = sh::pg_pmm_sample(m.model, m.lobes, m.wo, xi, u1, u2);
     m.sampled_wi = smp.wi;
+    m.xi = xi;
+    m.u1 = u1;
+    m.u2 = u2;
     const float3 w = sh::pg_to_world(m.frame, smp.wi);
     direction_pdf[i] = float4(w.x, w.y, w.z, smp.pdf);
     strategy[i] = smp.strategy;
@@ -293,6 +297,27 @@ float pdf_spread(const PixelMixture& m, float3 wi) {
   return spread;
 }
 
+// How far the host's sampled direction (in the pixel's frame) moves when its two sampling numbers
+// move by up to 4 units of 2^-24, as pdf_spread does for the density: where a sampler is
+// ill-conditioned (the GGX visible-normal sampler as u1 -> 1, where nh.z = sqrt(1 - p1^2 - p2^2)
+// cancels; the Gaussian's Box-Muller radius as u1 -> 0), the device's own few-ulp sin, cos, log
+// and sqrt move the direction by as much.
+float direction_spread(const PixelMixture& m) {
+  const float step = 1.0f / 16777216.0f;
+  float spread = 0.0f;
+  for (int k = 0; k < 16; ++k) {
+    const int a = k % 9 - 4, b = (k * 5) % 9 - 4;
+    const sh::pg_pmm_sample_t moved = sh::pg_pmm_sample(
+        m.model, m.lobes, m.wo, m.xi, std::clamp(m.u1 + a * step, 0.0f, 0.99999994f),
+        std::clamp(m.u2 + b * step, 0.0f, 0.99999994f));
+    if (!(moved.pdf > 0.0f)) continue;
+    spread =
+        std::max({spread, std::fabs(moved.wi.x - m.sampled_wi.x),
+                  std::fabs(moved.wi.y - m.sampled_wi.y), std::fabs(moved.wi.z - m.sampled_wi.z)});
+  }
+  return spread;
+}
+
 // The relative error float32 allows in the GGX density at wi. D(h) = a2 / (pi d^2) with
 // d = 1 - h.z^2 (1 - a2): near a sharp peak d is of the order of a2 (down to 1.6e-7), and the
 // ~1 that is subtracted carries rounding of a few units of 6e-8 (h.z^2, the product, and the
@@ -309,12 +334,17 @@ double ggx_relative_error(const PixelMixture& m, float3 wi) {
 
 // train.cl (either variant: the local tile holds zeros outside the image, i.e. no VPL, which
 // is what skipping those window cells does here).
+// conditioning (if given): per pixel, the largest relative error float32 allows in the weight of
+// one of its lit samples (ggx_relative_error at the sample's direction: a weight is L f cos / r
+// with the BSDF f), which the state's sums carry at most as far.
 std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer& g,
                               const HostVpls& v, std::uint32_t seed, std::uint32_t frame,
-                              const pg_kernel_settings& p, std::vector<int>& trained) {
+                              const pg_kernel_settings& p, std::vector<int>& trained,
+                              std::vector<double>* conditioning = nullptr) {
   const int w = g.width, h = g.height;
   std::vector<float> out = state;
   trained.assign(g.n(), 0);
+  if (conditioning) conditioning->assign(g.n(), 0.0);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const int i = y * w + x;
@@ -344,6 +374,17 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
         const int j = sy * w + sx;
         kept += sh::pg_train_sample_from_vpl(px, v.position[j], v.normal[j], v.radiance_info[j], p,
                                              &samples[kept], &densities[kept]);
+      }
+      if (conditioning) {
+        PixelMixture m;
+        m.lobes = px.lobes;
+        m.wo = px.wo;
+        for (int k = 0; k < kept; ++k)
+          if (samples[k].x > 0.0f)
+            (*conditioning)[i] =
+                std::max((*conditioning)[i],
+                         ggx_relative_error(m, sh::pg_square_to_hemisphere(sh::pg_make_float2(
+                                                   samples[k].y, samples[k].z))));
       }
       int updated = 0;
       s = sh::pg_pmm_train(s, samples, densities, kept, p, static_cast<float>(n), p.em_passes,
@@ -391,9 +432,10 @@ std::string describe(const sh::pg_pmm_state& s) {
   return buf;
 }
 
-// Local sizes the guider runs at: the two common ones and one that is not a power of two;
-// image sizes are not multiples of them (the padding work-items must do nothing, and the
-// local tile must be filled where they stand). Each with its own neighbourhood radius.
+// Local sizes the guider runs at: the two common ones, one that is not a power of two and 0x0,
+// the device's own (rows of work-groups on CPUs: host/cl/work_groups.h); image sizes are not
+// multiples of them (the padding work-items must do nothing, and the local tile must be filled
+// where they stand). Each with its own neighbourhood radius.
 struct KernelCase {
   int local_x, local_y;
   int width, height;
@@ -401,8 +443,10 @@ struct KernelCase {
 };
 
 std::vector<KernelCase> kernel_cases(const ClRuntime& rt) {
-  if (simulated(rt)) return {{8, 8, 13, 9, 2}, {16, 16, 19, 5, 1}, {12, 6, 14, 8, 3}};
-  return {{8, 8, 93, 61, 3}, {16, 16, 101, 77, 2}, {12, 6, 98, 47, 1}};
+  if (simulated(rt))
+    return {{8, 8, 13, 9, 2}, {16, 16, 19, 5, 1}, {12, 6, 14, 8, 3}, {0, 0, 21, 7, 2}};
+  // 300 pixels a row: three row groups of 100 work-items for one pixel per work-item.
+  return {{8, 8, 93, 61, 3}, {16, 16, 101, 77, 2}, {12, 6, 98, 47, 1}, {0, 0, 300, 29, 2}};
 }
 
 std::string name(const KernelCase& c) {
@@ -530,9 +574,10 @@ TEST(GuidingKernels, ReprojectMatchesHostReference) {
 // Device and host agree on every pixel's strategy and direction, and the device's pdf is the
 // mixture density of the direction it produced, for every variant of the kernel: sample.cl and
 // sample_wide.cl with 2, 4, 8 and 16 pixels per work-item (kernels/wide/).
-//  - Direction: 1e-4 per component. Device sin/cos/log/sqrt may be a few ulp off, and the GGX
-//    visible-normal sampler amplifies that in its tail (nh.z = sqrt(1 - p1^2 - p2^2) cancels
-//    as u1 -> 1).
+//  - Direction: 1e-4 per component plus twice direction_spread. Device sin/cos/log/sqrt may be a
+//    few ulp off, and the GGX visible-normal sampler amplifies that in its tail (nh.z =
+//    sqrt(1 - p1^2 - p2^2) cancels as u1 -> 1): the spread measures that amplification at the
+//    pixel's own sampling numbers.
 //  - pdf: compared with the host's pdf at the device's direction (brought into the pixel's
 //    frame), so that the sampler's conditioning does not count twice: within 1e-4 relative
 //    (exp of a quadratic form, fma contraction), plus twice pdf_spread there and
@@ -603,8 +648,14 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
         PixelMixture handed = mixture[i];
         handed.model = sh::pg_pmm_model_from_mixture(got_mixture_a[i], got_mixture_b[i]);
         const float host_side = handed.pdf(local);
-        const bool ok = std::fabs(b.x - a.x) <= 1e-4f && std::fabs(b.y - a.y) <= 1e-4f &&
-                        std::fabs(b.z - a.z) <= 1e-4f && std::isfinite(b.w) &&
+        // A direction component may differ by 1e-4 plus twice the sampler's spread there (in
+        // the frame; the change to world coordinates keeps lengths).
+        const float dir_spread = same_direction ? 0.0f : direction_spread(mixture[i]);
+        const float dir_tolerance = 1e-4f + 2.0f * dir_spread;
+        ill_conditioned += 2.0f * dir_spread > 1e-4f;
+        const bool ok = std::fabs(b.x - a.x) <= dir_tolerance &&
+                        std::fabs(b.y - a.y) <= dir_tolerance &&
+                        std::fabs(b.z - a.z) <= dir_tolerance && std::isfinite(b.w) &&
                         std::fabs(double(b.w) - reference) <= pdf_tolerance &&
                         handed.model.valid == mixture[i].model.valid &&
                         std::fabs(double(host_side) - b.w) <= pdf_tolerance;
@@ -612,8 +663,9 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
           ADD_FAILURE() << name(kc) << ", " << settings.sample_lanes << " lanes, frame " << frame
                         << " pixel " << i << ": host (" << a.x << " " << a.y << " " << a.z
                         << " pdf " << a.w << ") device (" << b.x << " " << b.y << " " << b.z
-                        << " pdf " << b.w << "), host pdf there " << reference << " +- "
-                        << pdf_tolerance << ", from the kernel's mixture " << host_side;
+                        << " pdf " << b.w << "), direction +- " << dir_tolerance
+                        << ", host pdf there " << reference << " +- " << pdf_tolerance
+                        << ", from the kernel's mixture " << host_side;
       }
       pixels += g.n();
     }
@@ -637,7 +689,10 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
 // for bit with each other: the same arithmetic on the same VPLs), and train_wide.cl with 2, 4,
 // 8 and 16 pixels per work-item (kernels/wide/). Tolerance 1e-4 relative (of the value, plus of
 // S0 for the moments): the step size uses exp and log (3 ulp each in OpenCL), the E-step exp of
-// a quadratic form, and the device may contract a*b+c into fma. A pixel could differ beyond that
+// a quadratic form, and the device may contract a*b+c into fma; plus, where a sharp GGX lobe
+// makes a sample's weight ill-conditioned in float32, twice ggx_relative_error at its direction
+// (as the sample test allows for the density; under Oclgrind a random 21x7 image had one pixel
+// whose brightest sample's weight moved by 1e-3 there). A pixel could differ beyond that
 // only where a decision flips on a few-ulp difference (a responsibility at the re-seeding
 // threshold, gamma = 1e-3, or a weight at max_weight); none does with these seeds, and any
 // mismatch fails the test. In
@@ -646,7 +701,7 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
 TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
   ClRuntime rt;
   Random r(303);
-  std::size_t pixels = 0, trained_total = 0, off = 0;
+  std::size_t pixels = 0, trained_total = 0, off = 0, ill_conditioned = 0;
   for (const KernelCase& kc : kernel_cases(rt)) {
     HostGBuffer g = random_gbuffer(r, kc.width, kc.height);
     if (kc.apron == 3)
@@ -684,20 +739,30 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
           variant == 0 ? " local" : " global, " + std::to_string(lanes[variant]) + " lanes";
       Guider guider(rt, kc.width, kc.height, settings);
       ASSERT_EQ(guider.train_uses_local_memory(), variant == 0);
+      // The device's own work-groups: reproject and sample in rows on a CPU device.
+      if (kc.local_x == 0) {
+        EXPECT_EQ(guider.row_work_groups(), rt.info().type == "cpu");
+      }
       ASSERT_EQ(guider.train_lanes(), lanes[variant]);
       std::vector<float> s = state;
       // Two frames: the second starts from the first's result (models seeded at k = 0 train on).
       for (std::uint32_t frame = 0; frame < 2; ++frame) {
         const std::uint32_t seed = 11u + frame;
         std::vector<int> trained;
-        const std::vector<float> expected = host_train(s, g, v, seed, frame, p, trained);
+        std::vector<double> conditioning;
+        const std::vector<float> expected =
+            host_train(s, g, v, seed, frame, p, trained, &conditioning);
         guider.write_state(s);
         guider.train(dg, dv, seed, frame);
         std::vector<float> got;
         guider.read_state(got);
         std::size_t mismatched = 0;
         for (std::size_t i = 0; i < g.n(); ++i) {
-          if (states_agree(state_at(expected, i), state_at(got, i), 1e-4f)) continue;
+          // 1e-4 relative, plus twice the float32 conditioning of the pixel's sample weights
+          // where a sharp GGX lobe makes it larger (counted: the sharp lobes only).
+          const float allowance = static_cast<float>(2.0 * conditioning[i]);
+          ill_conditioned += allowance > 1e-4f;
+          if (states_agree(state_at(expected, i), state_at(got, i), 1e-4f + allowance)) continue;
           ++mismatched;
           if (mismatched <= 5)
             ADD_FAILURE() << name(kc) << variant_name << " frame " << frame << " pixel " << i
@@ -727,8 +792,12 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
   }
   EXPECT_LE(off * 1000, pixels) << off << " of " << pixels << " pixels differ";
   EXPECT_GT(trained_total, pixels / 4);  // the EM step ran on many pixels
-  std::printf("[ info     ] train: %zu pixel steps, %zu trained, %zu differ\n", pixels,
-              trained_total, off);
+  // The conditioning allowance is for pixels with sharp lobes, not a blanket tolerance.
+  EXPECT_LT(ill_conditioned * 10, pixels);
+  std::printf(
+      "[ info     ] train: %zu pixel steps, %zu trained, %zu differ, %zu with ill-conditioned "
+      "weights\n",
+      pixels, trained_total, off, ill_conditioned);
 }
 
 }  // namespace
@@ -1068,6 +1137,11 @@ TEST(GuiderMisuse, ConfigurationsTheDeviceCannotRunAreRefused) {
   bad.train_lanes = 8;
   bad.train_memory = GuidingSettings::TrainMemory::Local;
   expect_guider_error([&] { Guider g(rt, 8, 8, bad); }, "train_lanes");
+  // A work-group size of 0 stands for the device's own in both directions or neither.
+  bad = GuidingSettings{};
+  bad.local_x = 16;
+  bad.local_y = 0;
+  expect_guider_error([&] { Guider g(rt, 8, 8, bad); }, "local_x = 16 and local_y = 0");
   // A local size no device accepts.
   GuidingSettings huge;
   huge.local_x = 4096;
