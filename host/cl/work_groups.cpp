@@ -20,6 +20,14 @@ WorkGroupShape resolve_work_groups(const DeviceInfo& info, int local_x, int loca
   return shape;
 }
 
+std::size_t largest_row_group(const cl::Device& device,
+                              std::initializer_list<cl::Kernel*> kernels) {
+  std::size_t largest = device.getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>().at(0);
+  for (cl::Kernel* k : kernels)
+    largest = std::min(largest, k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device));
+  return largest;
+}
+
 ImageLaunch image_launch(int width, int height, int lanes, const WorkGroupShape& shape) {
   const int items = (width + lanes - 1) / lanes;  // work-items per row
   auto round_up = [](int v, int m) { return static_cast<std::size_t>((v + m - 1) / m * m); };

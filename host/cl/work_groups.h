@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <initializer_list>
 
 #include "rtpg/cl_runtime.h"
 #include "rtpg/opencl.h"
@@ -34,6 +35,10 @@ enum class KernelReach { Pixel, Neighbourhood };
 // neighbourhood rows in cache (docs/guiding.md, "Work-groups along rows").
 WorkGroupShape resolve_work_groups(const DeviceInfo& info, int local_x, int local_y,
                                    KernelReach reach, std::size_t max_group);
+
+// The most work-items one row group of these kernels may hold on the device: the smallest of
+// their CL_KERNEL_WORK_GROUP_SIZE and the device's first CL_DEVICE_MAX_WORK_ITEM_SIZES.
+std::size_t largest_row_group(const cl::Device& device, std::initializer_list<cl::Kernel*> kernels);
 
 struct ImageLaunch {
   cl::NDRange global, local;

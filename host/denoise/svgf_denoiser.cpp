@@ -1,6 +1,5 @@
 #include "denoise/svgf_denoiser.h"
 
-#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <initializer_list>
@@ -54,10 +53,8 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
   translate_cl_errors([&] {
     const std::vector<std::size_t> max_items =
         runtime.device().getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>();
-    std::size_t max_group = max_items.at(0);
-    for (cl::Kernel* k : {&temporal_, &variance_, &atrous_, &remodulate_})
-      max_group =
-          std::min(max_group, k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device()));
+    const std::size_t max_group =
+        largest_row_group(runtime.device(), {&temporal_, &variance_, &atrous_, &remodulate_});
     // Temporal and remodulate read their own pixel (temporal also the bilinear taps of one
     // back-projected position); variance and a-trous filter neighbourhoods.
     pixel_groups_ = resolve_work_groups(runtime.info(), settings.local_x, settings.local_y,

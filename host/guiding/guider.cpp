@@ -92,10 +92,8 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
   translate_cl_errors([&] {
     const std::vector<std::size_t> max_items =
         runtime.device().getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>();
-    std::size_t max_group = max_items.at(0);
-    for (cl::Kernel* k : {&reproject_, &sample_, &train_})
-      max_group =
-          std::min(max_group, k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device()));
+    const std::size_t max_group =
+        largest_row_group(runtime.device(), {&reproject_, &sample_, &train_});
     // Reproject and sample read their own pixel (or one gathered through the motion vector);
     // train reads a window of VPLs.
     const WorkGroupShape pixel = resolve_work_groups(info, settings.local_x, settings.local_y,
