@@ -407,16 +407,9 @@ bool PathTracer::borrow_guide(const SurfacePoint& sp, PixelGuide& guide) const {
 void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times) {
   const auto start = Clock::now();
   occluded_.resize(count);
-  tracer_.occluded(shadow_rays_.data(), occluded_.data(), count);
+  // Slots without a shadow ray (inactive_ray()) are skipped, not queried, and not counted.
+  rays.shadow += tracer_.occluded(shadow_rays_.data(), occluded_.data(), count);
   times.trace_ms += ms_since(start);
-  rays.shadow += tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, count, kGrain), std::uint64_t{0},
-      [&](const auto& range, std::uint64_t valid) {
-        for (std::size_t j = range.begin(); j != range.end(); ++j)
-          valid += shadow_rays_[j].tmin <= shadow_rays_[j].tmax;
-        return valid;
-      },
-      std::plus<std::uint64_t>());
 }
 
 void PathTracer::apply_shadow_rays(std::size_t count, const std::vector<std::uint32_t>* owners) {

@@ -167,7 +167,6 @@ FrameStats Renderer::render_frame(int index) {
   build_gbuffer(index, stats);
   const GBuffer& gbuffer = gbuffers_[current_gbuffer_];
   const std::size_t n = gbuffer.pixel_count();
-  image_.assign(n, glm::vec3(0.0f));
   PassTimes times;
   RayCounts rays;
   const SampleCoordinates frame_at{settings_.seed, static_cast<std::uint32_t>(index), 0u};
@@ -185,8 +184,14 @@ FrameStats Renderer::render_frame(int index) {
                         stats.nonfinite_samples, rays, times);
     t = Clock::now();
     const float weight = 1.0f / static_cast<float>(settings_.spp);
+    // The first sample starts the sum from zero here, in parallel, instead of a serial fill of
+    // the image before the loop (docs/host-path-tracer.md, "Per-frame fills").
+    const bool first_sample = s == 0;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const auto& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) image_[i] += pass_[i] * weight;
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const glm::vec3 sum = first_sample ? glm::vec3(0.0f) : image_[i];
+        image_[i] = sum + pass_[i] * weight;
+      }
     });
     stats.time_ms["accumulate"] += ms_since(t);
   }

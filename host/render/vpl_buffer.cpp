@@ -3,9 +3,11 @@
 namespace rtpg {
 
 void VplBuffer::resize(std::size_t n) {
-  position.assign(n, glm::vec4(0.0f));
-  normal.assign(n, glm::vec4(0.0f));
-  radiance_info.assign(n, glm::vec4(0.0f));
+  if (info.size() != n) {
+    position.assign(n, glm::vec4(0.0f));
+    normal.assign(n, glm::vec4(0.0f));
+    radiance_info.assign(n, glm::vec4(0.0f));
+  }
   info.assign(n, 0u);
 }
 

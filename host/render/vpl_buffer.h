@@ -19,7 +19,12 @@ struct VplBuffer {
 #undef RTPG_HOST_CHANNEL
   std::vector<std::uint32_t> info;  // PG_VPL_* bits, the strategy in bits 8..15
 
-  void resize(std::size_t n);  // every VPL invalid
+  // Every VPL invalid: info 0. Each frame's path tracer calls it, so only a new size zeroes
+  // every channel; otherwise the channels keep last frame's values, read by nobody before the
+  // path tracer writes them (it rewrites radiance_info, the kernels' copy of info, for every
+  // pixel: PathTracer::gather). Zeroing all 52 bytes a pixel every frame was a serial pass of
+  // 27 MB at 960x540 (docs/host-path-tracer.md, "Per-frame fills").
+  void resize(std::size_t n);
 };
 
 }  // namespace rtpg

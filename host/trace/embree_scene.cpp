@@ -2,12 +2,14 @@
 
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 namespace rtpg {
 namespace {
@@ -214,44 +216,61 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
       });
 }
 
-void EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
-                           RayMode mode) const {
+std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
+                                  RayMode mode) const {
   RTCScene scene = impl_->scene;
+  // Half the path tracer's shadow slots hold no ray (no light sampled, or one behind the
+  // surface); asking Embree about them costs a call and a root-node test each
+  // (docs/host-path-tracer.md, "Empty shadow rays skipped").
+  const auto has_segment = [&](std::size_t i) { return rays[i].tmin <= rays[i].tmax; };
   if (mode == RayMode::Single) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
-      RTCIntersectContext context;
-      rtcInitIntersectContext(&context);
-      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-        RTCRay ray;
-        to_embree(rays[i], ray);
-        rtcOccluded1(scene, &context, &ray);
-        occluded[i] = std::isinf(ray.tfar) && ray.tfar < 0.0f ? 1 : 0;
-      }
-    });
-    return;
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
+        [&](const auto& range, std::size_t queried) {
+          RTCIntersectContext context;
+          rtcInitIntersectContext(&context);
+          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            occluded[i] = 0;
+            if (!has_segment(i)) continue;
+            RTCRay ray;
+            to_embree(rays[i], ray);
+            rtcOccluded1(scene, &context, &ray);
+            occluded[i] = std::isinf(ray.tfar) && ray.tfar < 0.0f ? 1 : 0;
+            ++queried;
+          }
+          return queried;
+        },
+        std::plus<std::size_t>());
   }
   const std::size_t packets = (count + 7) / 8;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets, kGrain / 8),
-                    [&](const auto& range) {
-                      RTCIntersectContext context;
-                      rtcInitIntersectContext(&context);
-                      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-                      for (std::size_t p = range.begin(); p != range.end(); ++p) {
-                        alignas(32) RTCRay8 ray;
-                        alignas(32) int valid[8];
-                        for (int lane = 0; lane < 8; ++lane) {
-                          const std::size_t i = p * 8 + lane;
-                          valid[lane] = i < count ? -1 : 0;
-                          set_ray8(ray, lane, rays[i < count ? i : count - 1]);
-                        }
-                        rtcOccluded8(valid, scene, &context, &ray);
-                        for (int lane = 0; lane < 8; ++lane) {
-                          const std::size_t i = p * 8 + lane;
-                          if (i >= count) break;
-                          occluded[i] = std::isinf(ray.tfar[lane]) && ray.tfar[lane] < 0.0f ? 1 : 0;
-                        }
-                      }
-                    });
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), std::size_t{0},
+      [&](const auto& range, std::size_t queried) {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        for (std::size_t p = range.begin(); p != range.end(); ++p) {
+          alignas(32) RTCRay8 ray;
+          alignas(32) int valid[8];
+          int lanes = 0;
+          for (int lane = 0; lane < 8; ++lane) {
+            const std::size_t i = p * 8 + lane;
+            valid[lane] = i < count && has_segment(i) ? -1 : 0;
+            lanes += valid[lane] != 0;
+            set_ray8(ray, lane, rays[i < count ? i : count - 1]);
+          }
+          if (lanes > 0) rtcOccluded8(valid, scene, &context, &ray);
+          queried += static_cast<std::size_t>(lanes);
+          for (int lane = 0; lane < 8; ++lane) {
+            const std::size_t i = p * 8 + lane;
+            if (i >= count) break;
+            occluded[i] =
+                valid[lane] != 0 && std::isinf(ray.tfar[lane]) && ray.tfar[lane] < 0.0f ? 1 : 0;
+          }
+        }
+        return queried;
+      },
+      std::plus<std::size_t>());
 }
 
 }  // namespace rtpg

@@ -1,0 +1,96 @@
+// The batched ray queries of host/trace/embree_scene.h: occlusion answers in both ray modes, and
+// the empty segments the path tracer leaves in its shadow slots (inactive rays, tmin > tmax)
+// answered 0 without a query and left out of the count of rays queried.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "scene/scene.h"
+#include "scene/shapes.h"
+#include "trace/embree_scene.h"
+
+namespace rtpg {
+namespace {
+
+// A 2x2 quad in the plane y = 0, centred at the origin.
+Scene quad_scene() {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  scene.meshes.push_back(make_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2}));
+  return scene;
+}
+
+Ray segment(glm::vec3 origin, glm::vec3 direction, float tmin, float tmax) {
+  Ray r;
+  r.origin = origin;
+  r.direction = direction;
+  r.tmin = tmin;
+  r.tmax = tmax;
+  return r;
+}
+
+// Rays down through the quad's plane from y = 1 (even slots above the quad, odd ones beside it),
+// alternating between a segment that reaches the plane, one that stops short of it and an empty one
+// (as inactive_ray() in host/render/path_tracer.cpp, and a NaN bound); 21 rays, so the last packet
+// of 8 is partial and one packet is empty in every lane.
+struct Case {
+  std::vector<Ray> rays;
+  std::vector<std::uint8_t> expected;
+  std::size_t segments = 0;  // rays with tmin <= tmax
+};
+
+Case shadow_slots() {
+  Case c;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int i = 0; i < 21; ++i) {
+    const float fi = static_cast<float>(i);
+    const glm::vec3 origin(i % 2 == 0 ? 0.05f * fi - 0.5f : 1.5f + 0.01f * fi, 1.0f, 0.0f);
+    const bool over_quad = std::fabs(origin.x) < 1.0f;
+    const int kind = (i >= 8 && i < 16) ? 2 : i % 3;  // slots 8..15: a packet of empty rays
+    if (kind == 0) {  // reaches y = -1: blocked where it crosses the quad
+      c.rays.push_back(segment(origin, {0, -1, 0}, 0.0f, 2.0f));
+      c.expected.push_back(over_quad ? 1 : 0);
+      ++c.segments;
+    } else if (kind == 1) {  // stops at y = 0.5
+      c.rays.push_back(segment(origin, {0, -1, 0}, 0.0f, 0.5f));
+      c.expected.push_back(0);
+      ++c.segments;
+    } else {  // empty: would cross the quad if it were traced over (0, 2)
+      c.rays.push_back(segment(origin, {0, -1, 0}, i % 2 ? 1.0f : nan, i % 2 ? 0.0f : 2.0f));
+      c.expected.push_back(0);
+    }
+  }
+  return c;
+}
+
+TEST(EmbreeScene, OccludedAnswersEmptySegmentsWithZeroAndCountsOnlyRaysQueried) {
+  const Scene scene = quad_scene();
+  const EmbreeScene tracer(scene);
+  const Case c = shadow_slots();
+  std::size_t blocked = 0;
+  for (std::uint8_t e : c.expected) blocked += e;
+  ASSERT_GT(blocked, 0u);  // the case tests both answers
+  for (RayMode mode : {RayMode::Single, RayMode::Packet8}) {
+    // Garbage in the output first: every slot must be written, empty ones included.
+    std::vector<std::uint8_t> occluded(c.rays.size(), 7);
+    const std::size_t queried =
+        tracer.occluded(c.rays.data(), occluded.data(), c.rays.size(), mode);
+    EXPECT_EQ(queried, c.segments) << (mode == RayMode::Single ? "single" : "packets of 8");
+    for (std::size_t i = 0; i < c.rays.size(); ++i)
+      EXPECT_EQ(occluded[i], c.expected[i])
+          << "ray " << i << (mode == RayMode::Single ? ", single" : ", packets of 8");
+  }
+}
+
+TEST(EmbreeScene, OccludedOfNoRaysQueriesNothing) {
+  const Scene scene = quad_scene();
+  const EmbreeScene tracer(scene);
+  std::uint8_t unused = 0;
+  EXPECT_EQ(tracer.occluded(nullptr, &unused, 0, RayMode::Single), 0u);
+  EXPECT_EQ(tracer.occluded(nullptr, &unused, 0, RayMode::Packet8), 0u);
+}
+
+}  // namespace
+}  // namespace rtpg
