@@ -185,7 +185,8 @@ FrameStats Renderer::render_frame(int index) {
     t = Clock::now();
     const float weight = 1.0f / static_cast<float>(settings_.spp);
     // The first sample starts the sum from zero here, in parallel, instead of a serial fill of
-    // the image before the loop (docs/host-path-tracer.md, "Per-frame fills").
+    // the image before the loop (docs/host-path-tracer.md, "Empty shadow rays skipped;
+    // per-frame fills").
     const bool first_sample = s == 0;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {

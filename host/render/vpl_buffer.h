@@ -23,7 +23,7 @@ struct VplBuffer {
   // every channel; otherwise the channels keep last frame's values, read by nobody before the
   // path tracer writes them (it rewrites radiance_info, the kernels' copy of info, for every
   // pixel: PathTracer::gather). Zeroing all 52 bytes a pixel every frame was a serial pass of
-  // 27 MB at 960x540 (docs/host-path-tracer.md, "Per-frame fills").
+  // 27 MB at 960x540 (docs/host-path-tracer.md, "Empty shadow rays skipped; per-frame fills").
   void resize(std::size_t n);
 };
 

@@ -219,9 +219,9 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
 std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
                                   RayMode mode) const {
   RTCScene scene = impl_->scene;
-  // Half the path tracer's shadow slots hold no ray (no light sampled, or one behind the
-  // surface); asking Embree about them costs a call and a root-node test each
-  // (docs/host-path-tracer.md, "Empty shadow rays skipped").
+  // Many of the path tracer's shadow slots hold no ray (no light sampled, or one behind the
+  // surface: half of them on the Cornell box); asking Embree about them costs a call and a
+  // root-node test each (docs/host-path-tracer.md, "Empty shadow rays skipped; per-frame fills").
   const auto has_segment = [&](std::size_t i) { return rays[i].tmin <= rays[i].tmax; };
   if (mode == RayMode::Single) {
     return tbb::parallel_reduce(
