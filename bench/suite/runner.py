@@ -13,6 +13,17 @@ SOURCE_DIRS = ("host", "kernels", "include")
 # run_reference), so a change to them leaves every reference valid (docs/denoising.md).
 DENOISER_ONLY = ("host/denoise/", "kernels/svgf_", "kernels/wide/svgf_wide.h", "kernels/shared/svgf.h",
                  "kernels/shared/planar.h")
+# Sources that only run on an OpenCL device or drive one: `rtpg reference` is plain path tracing on the
+# host (BsdfFirstBounce, no ClRuntime), so the guider (host/guiding/), the OpenCL layer (host/cl/), the
+# kernels' own files (kernels/*.cl) and their vector-lane code (kernels/wide/) cannot change a reference.
+# kernels/shared/ stays in the hash: the host path tracer compiles those headers.
+DEVICE_ONLY = ("host/cl/", "host/guiding/", "kernels/wide/")
+
+
+def reference_independent(rel):
+    """Whether a source file (path relative to the repository) cannot change what `rtpg reference` renders."""
+    top_level_kernel = rel.startswith("kernels/") and rel.count("/") == 1 and rel.endswith(".cl")
+    return rel.startswith(DENOISER_ONLY + DEVICE_ONLY) or top_level_kernel
 
 
 def rtpg_binary():
@@ -20,12 +31,13 @@ def rtpg_binary():
 
 
 def renderer_source_hash(root=ROOT):
-    """Hash of every source file a reference depends on: a reference made by other code is stale."""
+    """Hash of every source file a reference may depend on (all of host/, kernels/ and include/ but the
+    reference_independent ones): a reference made by other code is stale."""
     h = hashlib.sha256()
     for d in SOURCE_DIRS:
         for p in sorted((Path(root) / d).rglob("*")):
             rel = p.relative_to(root).as_posix()
-            if p.is_file() and p.suffix in (".h", ".hpp", ".cpp", ".cl") and not rel.startswith(DENOISER_ONLY):
+            if p.is_file() and p.suffix in (".h", ".hpp", ".cpp", ".cl") and not reference_independent(rel):
                 h.update(rel.encode())
                 h.update(p.read_bytes())
     return h.hexdigest()[:16]
