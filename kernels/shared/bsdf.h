@@ -55,10 +55,15 @@ PG_FN pg_lobes pg_make_lobes(pg_material m, float3 wo) {
   return l;
 }
 
+/* D(h) = a2 / (pi d^2) with d = 1 - cos^2 (1 - a2) = sin^2 + a2 cos^2 for a unit h. The second
+ * form, with sin^2 = h.x^2 + h.y^2, has no cancellation: near the peak of a sharp lobe d is of
+ * the order of a2 (1.6e-7 at the smallest roughness), which the first form got as the difference
+ * of two numbers near 1 whose rounding (and a compiler's freedom to contract it into an fma) is
+ * of the same size, so D was known only to a factor of several there (docs/design.md,
+ * "Floating point on other devices"). */
 PG_FN float pg_ggx_d(float3 h, float alpha) {
   float a2 = alpha * alpha;
-  float c2 = h.z * h.z;
-  float d = c2 * (a2 - 1.0f) + 1.0f;
+  float d = (h.x * h.x + h.y * h.y) + a2 * (h.z * h.z);
   return a2 / (PG_PI * d * d);
 }
 

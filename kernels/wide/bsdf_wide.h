@@ -49,10 +49,10 @@ static inline pg_floatw pg_ggx_lambda_w(pg_floatw cos_theta, pg_floatw alpha) {
   return select(lambda, (pg_floatw)(0.0f), c2 <= 0.0f);
 }
 
-/* GGX D (pg_ggx_d) of a half vector with cosine h_z. */
-static inline pg_floatw pg_ggx_d_w(pg_floatw h_z, pg_floatw alpha) {
+/* GGX D (pg_ggx_d) of the unit half vector h. */
+static inline pg_floatw pg_ggx_d_w(pg_float3w h, pg_floatw alpha) {
   pg_floatw a2 = alpha * alpha;
-  pg_floatw d = h_z * h_z * (a2 - 1.0f) + 1.0f;
+  pg_floatw d = (h.x * h.x + h.y * h.y) + a2 * (h.z * h.z);
   return a2 / (PG_PI * d * d);
 }
 
@@ -74,7 +74,7 @@ static inline pg_float3w pg_bsdf_eval_pdf_w(pg_lobes_w l, pg_float3w wo, pg_floa
     pg_float3w fresnel =
         pg_make_float3w(l.f0.x + (1.0f - l.f0.x) * m5, l.f0.y + (1.0f - l.f0.y) * m5,
                         l.f0.z + (1.0f - l.f0.z) * m5);
-    pg_floatw d = pg_ggx_d_w(h.z, l.alpha);
+    pg_floatw d = pg_ggx_d_w(h, l.alpha);
     pg_floatw lambda_o = pg_ggx_lambda_w(wo.z, l.alpha);
     pg_floatw g2 = 1.0f / (1.0f + lambda_o + pg_ggx_lambda_w(wi.z, l.alpha));
     pg_floatw spec = d * g2 / (4.0f * wo.z * wi.z);
@@ -94,7 +94,7 @@ static inline pg_floatw pg_bsdf_pdf_w(pg_lobes_w l, pg_float3w wo, pg_float3w wi
     pg_float3w h = pg_add3w(wo, wi);
     h = pg_scale3w(h, 1.0f / sqrt(pg_dot3w(h, h)));
     pg_floatw g1 = 1.0f / (1.0f + pg_ggx_lambda_w(wo.z, l.alpha));
-    pg_floatw pdf_spec = g1 * pg_ggx_d_w(h.z, l.alpha) / (4.0f * wo.z);
+    pg_floatw pdf_spec = g1 * pg_ggx_d_w(h, l.alpha) / (4.0f * wo.z);
     pdf = select(pdf, pdf + l.p_specular * pdf_spec, l.p_specular > 0.0f);
   }
   return select(pdf, (pg_floatw)(0.0f), (wo.z <= 0.0f) | (wi.z <= 0.0f));
