@@ -111,7 +111,7 @@ cl::Program ClRuntime::build(const std::string& kernel_file, const std::string& 
       log = std::string(e.what()) + " failed with " + cl_error_name(e.err()) + " (" +
             std::to_string(e.err()) + "), options '" + options + "', and no build log";
     }
-    throw ClBuildError(kernel_file, info_.device_name, log, e.err());
+    throw ClBuildError(kernel_file, info_.device_name, attribute_build_log(log, source), e.err());
   }
   ++programs_->stats.source_builds;
 

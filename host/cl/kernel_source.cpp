@@ -2,8 +2,11 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "rtpg/errors.h"
 
@@ -136,6 +139,39 @@ std::string resolve_kernel_source(const std::string& kernel_file, const KernelFi
   Resolver resolver(load);
   resolver.include(kernel_file, "");
   return resolver.take();
+}
+
+std::string attribute_build_log(const std::string& log, const std::string& resolved_source) {
+  // origin[r - 1]: the file and line of the submitted text's line r (the directives' own lines
+  // keep an empty path).
+  std::vector<std::pair<std::string, int>> origin;
+  static const std::regex directive(R"re(^#line (\d+) "([^"]*)"$)re");
+  std::istringstream in(resolved_source);
+  std::string line, path;
+  int next = 1;
+  while (std::getline(in, line)) {
+    std::smatch m;
+    if (std::regex_match(line, m, directive)) {
+      next = std::stoi(m[1].str());
+      path = m[2].str();
+      origin.emplace_back(std::string(), 0);
+    } else {
+      origin.emplace_back(path, next++);
+    }
+  }
+  static const std::regex raw_position(R"((<kernel>|input\.cl):(\d+)(:\d+)?)");
+  std::string out;
+  auto last = log.cbegin();
+  for (std::sregex_iterator it(log.begin(), log.end(), raw_position), end; it != end; ++it) {
+    const std::smatch& m = *it;
+    out.append(last, m[0].second);
+    last = m[0].second;
+    const unsigned long raw = std::stoul(m[2].str());
+    if (raw >= 1 && raw <= origin.size() && !origin[raw - 1].first.empty())
+      out += " (" + origin[raw - 1].first + ":" + std::to_string(origin[raw - 1].second) + ")";
+  }
+  out.append(last, log.cend());
+  return out;
 }
 
 }  // namespace rtpg

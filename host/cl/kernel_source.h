@@ -37,4 +37,11 @@ using KernelFileLoader = std::function<std::optional<std::string>(const std::str
 std::string resolve_kernel_source(const std::string& kernel_file,
                                   const KernelFileLoader& load = load_kernel_file);
 
+// A build log with each position in the submitted text, as compilers that ignore #line print
+// them (NVIDIA's OpenCL: "<kernel>:6:14: error"; Oclgrind: "input.cl:12:3"), followed by the
+// file and line that resolved_source's #line directives give it:
+// "<kernel>:6:14 (kernels/shared/bad_helper.h:3): error". Positions the compiler already
+// attributed (PoCL: "kernels/bad.cl:6:14") are left as they are.
+std::string attribute_build_log(const std::string& log, const std::string& resolved_source);
+
 }  // namespace rtpg

@@ -61,6 +61,26 @@ TEST(KernelSource, IncludesEachFileOnceAndKeepsLineNumbers) {
       << source;
 }
 
+// Compilers that ignore #line print positions in the submitted text (NVIDIA's OpenCL:
+// "<kernel>:N:C", Oclgrind: "input.cl:N:C"); the log names the real file and line beside each.
+TEST(KernelSource, BuildLogPositionsInTheSubmittedTextNameTheRealLines) {
+  const std::map<std::string, std::string> files = {
+      {"k.cl", "// kernel\n#include \"shared/a.h\"\nint k = oops;\n"},
+      {"shared/a.h", "int a;\nint b = bad;\n"},
+  };
+  const std::string source = resolve_kernel_source("k.cl", loader(files));
+  // Submitted lines: 1 #line, 2 "// kernel", 3 #line, 4 "int a;", 5 "int b = bad;",
+  // 6 #line, 7 "int k = oops;".
+  EXPECT_EQ(attribute_build_log("<kernel>:5:9: error: bad\n<kernel>:7:9: error: oops\n", source),
+            "<kernel>:5:9 (kernels/shared/a.h:2): error: bad\n"
+            "<kernel>:7:9 (kernels/k.cl:3): error: oops\n");
+  EXPECT_EQ(attribute_build_log("input.cl:4: warning", source),
+            "input.cl:4 (kernels/shared/a.h:1): warning");
+  // Already attributed positions, lines past the end, and directive lines stay as they are.
+  const std::string untouched = "kernels/k.cl:3:9: error\n<kernel>:99:1: x\n<kernel>:6:1: y\n";
+  EXPECT_EQ(attribute_build_log(untouched, source), untouched);
+}
+
 TEST(KernelSource, LeavesCommentedAndAngleIncludesAlone) {
   const std::map<std::string, std::string> files = {
       {"k.cl",
