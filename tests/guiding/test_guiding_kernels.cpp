@@ -365,19 +365,24 @@ float model_spread(const PixelMixture& m, float3 wi) {
   return spread;
 }
 
-// How far the host's sampled direction (in the pixel's frame) moves when its two sampling numbers
-// move by up to 4 units of 2^-24, as pdf_spread does for the density: where a sampler is
-// ill-conditioned (the GGX visible-normal sampler as u1 -> 1, where nh.z = sqrt(1 - p1^2 - p2^2)
-// cancels; the Gaussian's Box-Muller radius as u1 -> 0), the device's own few-ulp sin, cos, log
-// and sqrt move the direction by as much.
+// How far the host's sampled direction (in the pixel's frame) moves when its two sampling numbers,
+// or the components of the local view direction wo, move by up to 4 units of 2^-24, as
+// pdf_spread does for the density: where a sampler is ill-conditioned (the GGX visible-normal
+// sampler as u1 -> 1, where nh.z = sqrt(1 - p1^2 - p2^2) cancels; the Gaussian's Box-Muller
+// radius as u1 -> 0; a sharp GGX lobe seen at grazing angles, whose visible normals follow wo.z's
+// few ulp), the device's own few-ulp sin, cos, log, sqrt and change of frame move the direction
+// by as much.
 float direction_spread(const PixelMixture& m) {
   const float step = 1.0f / 16777216.0f;
   float spread = 0.0f;
-  for (int k = 0; k < 16; ++k) {
-    const int a = k % 9 - 4, b = (k * 5) % 9 - 4;
-    const sh::pg_pmm_sample_t moved = sh::pg_pmm_sample(
-        m.model, m.lobes, m.wo, m.xi, std::clamp(m.u1 + a * step, 0.0f, 0.99999994f),
-        std::clamp(m.u2 + b * step, 0.0f, 0.99999994f));
+  for (int k = 0; k < 32; ++k) {
+    const int a = k % 9 - 4, b = (k * 5) % 9 - 4, c = (k * 7) % 9 - 4;
+    const bool move_wo = k >= 16;
+    const float3 wo =
+        move_wo ? float3(m.wo.x + a * step, m.wo.y + b * step, m.wo.z + c * step) : m.wo;
+    const float u1 = move_wo ? m.u1 : std::clamp(m.u1 + a * step, 0.0f, 0.99999994f);
+    const float u2 = move_wo ? m.u2 : std::clamp(m.u2 + b * step, 0.0f, 0.99999994f);
+    const sh::pg_pmm_sample_t moved = sh::pg_pmm_sample(m.model, m.lobes, wo, m.xi, u1, u2);
     if (!(moved.pdf > 0.0f)) continue;
     spread =
         std::max({spread, std::fabs(moved.wi.x - m.sampled_wi.x),
