@@ -159,7 +159,8 @@ std::string attribute_build_log(const std::string& log, const std::string& resol
       origin.emplace_back(path, next++);
     }
   }
-  static const std::regex raw_position(R"((<kernel>|input\.cl):(\d+)(:\d+)?)");
+  // At most 9 digits: a longer number is no line of ours, and stoul must not throw here.
+  static const std::regex raw_position(R"((<kernel>|input\.cl):(\d{1,9})(:\d+)?)");
   std::string out;
   auto last = log.cbegin();
   for (std::sregex_iterator it(log.begin(), log.end(), raw_position), end; it != end; ++it) {

@@ -77,7 +77,9 @@ TEST(KernelSource, BuildLogPositionsInTheSubmittedTextNameTheRealLines) {
   EXPECT_EQ(attribute_build_log("input.cl:4: warning", source),
             "input.cl:4 (kernels/shared/a.h:1): warning");
   // Already attributed positions, lines past the end, and directive lines stay as they are.
-  const std::string untouched = "kernels/k.cl:3:9: error\n<kernel>:99:1: x\n<kernel>:6:1: y\n";
+  const std::string untouched =
+      "kernels/k.cl:3:9: error\n<kernel>:99:1: x\n<kernel>:6:1: y\n<kernel>:123456789012345678901: "
+      "z\n";
   EXPECT_EQ(attribute_build_log(untouched, source), untouched);
 }
 
