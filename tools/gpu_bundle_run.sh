@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# run.sh of a bundle made by tools/gpu_bundle.sh: the OpenCL tests, then the guiding kernels'
+# roofline benchmark, on RTPG_DEVICE (default gpu); the binaries embed the kernels and read no
+# other file. Logs go to OUT (default DIR/out): tests.log, bench.log, bench.json, devices.log. TESTS (binary names) narrows the tests; NO_BENCH=1 skips the benchmark.
+# Exit status: the number of test binaries that failed, 0 if none.
+set -uo pipefail
+dir=$(cd "$(dirname "$0")" && pwd)
+out=${1:-$dir/out}
+mkdir -p "$out"
+export RTPG_DEVICE="${RTPG_DEVICE:-gpu}" RTPG_CACHE_DIR="${RTPG_CACHE_DIR:-$out/cache}"
+export LD_LIBRARY_PATH="$dir/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+# The carried ICD loader reads the system's vendor files; a driver whose OpenCL library is
+# installed without one (NVIDIA's in a container) gets one in a folder of its own.
+if [ -z "${OCL_ICD_VENDORS:-}" ]; then
+  vendors="$out/vendors"
+  mkdir -p "$vendors"
+  cp /etc/OpenCL/vendors/*.icd "$vendors/" 2>/dev/null || true
+  nvidia=$(ldconfig -p 2>/dev/null | awk '$1 == "libnvidia-opencl.so.1" {print $NF; exit}')
+  [ -n "$nvidia" ] || nvidia=$(find /usr/lib /usr/lib64 /usr/local/nvidia -name libnvidia-opencl.so.1 2>/dev/null | head -n 1)
+  [ -n "$nvidia" ] && [ ! -e "$vendors/nvidia.icd" ] && echo "$nvidia" > "$vendors/nvidia.icd"
+  export OCL_ICD_VENDORS="$vendors"
+fi
+{ ls "$OCL_ICD_VENDORS"; cat "$OCL_ICD_VENDORS"/*.icd; } > "$out/devices.log" 2>&1
+failed=0
+: > "$out/tests.log"
+for t in ${TESTS:-$(ls "$dir/bin" | grep '^test_')}; do
+  start=$(date +%s)
+  "$dir/bin/$t" --gtest_color=no >> "$out/tests.log" 2>&1
+  rc=$?
+  [ "$rc" = 0 ] || failed=$((failed + 1))
+  echo "== $t: exit $rc, $(( $(date +%s) - start )) s" | tee -a "$out/tests.log"
+done
+grep -E '^\[  FAILED  \] [A-Za-z]' "$out/tests.log" | sort -u
+if [ -z "${NO_BENCH:-}" ]; then
+  # One repetition: on a GPU each configuration is already the mean of thousands of launches.
+  "$dir/bin/bench_guiding_kernels" --benchmark_repetitions=1 \
+    --benchmark_filter='^(CopyFloat4|FmaPeak|(Reproject|Sample|Train)/1280x720/local:auto(/memory:global)?/min)' \
+    --benchmark_out="$out/bench.json" --benchmark_out_format=json > "$out/bench.log" 2>&1
+  grep -E 'manual_time' "$out/bench.log"
+fi
+exit "$failed"
