@@ -379,7 +379,11 @@ PG_FN float pg_pmm_view_aged_k(float k, float3 view, float3 prev_view, pg_materi
   if (!(view_memory > 0.0f) || !(k > 0.0f)) return k;
   pg_lobes lobes = pg_make_lobes(m, pg_make_float3(0.0f, 0.0f, 1.0f)); /* f0 and alpha only */
   if (!(pg_max3(lobes.f0) > 0.0f)) return k;
-  float turned = acos(clamp(dot(view, prev_view), -1.0f, 1.0f));
+  /* The angle between the unit views as 2 atan2(|a - b|, |a + b|), not acos of their dot
+   * product, which near 1 loses half the digits: acos(1 - 1 ulp) = 3.5e-4 rad, a third of the
+   * sharpest lobe's memory M alpha at M = 2, so a still-looking turn aged k by a factor of up to
+   * 1.5 or not at all depending on rounding (docs/design.md, "Floating point on other devices"). */
+  float turned = 2.0f * atan2(length(view - prev_view), length(view + prev_view));
   return k * exp(-turned / (view_memory * lobes.alpha));
 }
 

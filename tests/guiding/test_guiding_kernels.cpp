@@ -191,26 +191,23 @@ HostVpls random_vpls(Random& r, std::size_t n) {
 enum Outcome { kSkipped, kOutside, kRejected, kCopied, kReframed };
 
 // The relative error float32 allows in an aged k = k exp(-E), E = turned / (M alpha)
-// (pg_pmm_view_aged_k). turned = acos(c) of the views' dot product c, which each device rounds
-// by a few ulp: acos amplifies that by 1 / sqrt(1 - c^2), and up to sqrt(2 dc) where the views
-// are within ulps of each other; exp turns E's absolute error into k's relative one. For a
-// glossy lobe E reaches tens (k ages to 1e-30 and below), so k is known to 1e-5 only for
-// small turns.
+// (pg_pmm_view_aged_k). turned = 2 atan2(|a - b|, |a + b|) keeps its inputs' few ulp relative to
+// itself (up to 32 units of 2^-24 with the lengths' square roots and a device's atan2), and exp
+// turns E's absolute error into k's relative one: for a glossy lobe E reaches tens (k ages to
+// 1e-30 and below), so k is known to about E times 2e-6.
 double aged_k_relative_error(float3 view, float3 prev_view, const sh::pg_material& material,
                              float view_memory) {
   const sh::pg_lobes lobes = sh::pg_make_lobes(material, sh::pg_make_float3(0.0f, 0.0f, 1.0f));
   if (!(view_memory > 0.0f) || !(sh::pg_max3(lobes.f0) > 0.0f)) return 0.0;
   const double ulp = 6e-8;
-  const double c = std::clamp(
-      double(view.x) * prev_view.x + double(view.y) * prev_view.y + double(view.z) * prev_view.z,
-      -1.0, 1.0);
-  const double dc = 8.0 * ulp, s = std::sqrt(std::max(1.0 - c * c, 0.0));
-  const double turned = std::acos(c);
-  const double turned_error =
-      std::min(dc / std::max(s, 1e-30), std::sqrt(2.0 * dc)) + 4.0 * ulp * turned;
-  const double scale = double(view_memory) * lobes.alpha;
-  const double exponent_error = turned_error / scale + 8.0 * ulp * (turned / scale);
-  return std::expm1(exponent_error) + 4.0 * ulp;
+  const double dx = double(view.x) - prev_view.x, dy = double(view.y) - prev_view.y,
+               dz = double(view.z) - prev_view.z;
+  const double sx = double(view.x) + prev_view.x, sy = double(view.y) + prev_view.y,
+               sz = double(view.z) + prev_view.z;
+  const double turned = 2.0 * std::atan2(std::sqrt(dx * dx + dy * dy + dz * dz),
+                                         std::sqrt(sx * sx + sy * sy + sz * sz));
+  const double exponent = turned / (double(view_memory) * lobes.alpha);
+  return std::expm1(32.0 * ulp * exponent) + 4.0 * ulp;
 }
 
 // reproject.cl. k_conditioning (if given): per pixel, aged_k_relative_error where the view
@@ -589,10 +586,10 @@ void make_reprojection_pair(Random& r, int w, int h, HostGBuffer& prev, HostGBuf
 // the horizon threshold (w.z = 1e-4) may be carried on one side and dropped on the other:
 // such pixels are counted and bounded (none are expected at these sizes). The first and last
 // cases age glossy models as their view turns (reproject_view_memory); k then goes through
-// acos and exp, which may differ by a few ulp between the device and the host: within 1e-5
-// relative plus twice aged_k_relative_error (the exponent's conditioning; on an NVIDIA H100 a
-// k aged by exp(-90) differed by 2e-5 relative, docs/design.md, "Floating point on other
-// devices").
+// atan2 and exp, which may differ by a few ulp between the device and the host: within 1e-5
+// relative plus twice aged_k_relative_error (the exponent's conditioning; on an NVIDIA H100,
+// with acos then, a k aged by exp(-90) differed by 2e-5 relative, docs/design.md, "Floating
+// point on other devices").
 TEST(GuidingKernels, ReprojectMatchesHostReference) {
   ClRuntime rt;
   Random r(101);

@@ -823,6 +823,28 @@ TEST(PmmViewAge, GlossyModelsForgetAsTheViewTurns) {
   EXPECT_LT(pg_pmm_view_aged_k(k, view, float3(1.0f, 0.0f, 0.0f), coated, memory), k);
 }
 
+// The sharpest lobe (roughness 0.02, M alpha = 8e-4 rad) under a slow camera: turns of 1e-5 to
+// 1e-3 rad age k as exp(-turn / (M alpha)) says, within 1e-4 of k. acos of the views' dot
+// product could not tell a turn below 3.5e-4 rad from none (cos rounds to 1) and aged those by a
+// factor of up to 1.5 or not at all (docs/design.md, "Floating point on other devices").
+TEST(PmmViewAge, SmallTurnsOfASharpLobeAgeByTheirAngle) {
+  pg_material mirror;
+  mirror.base_color = float3(0.9f);
+  mirror.roughness = 0.0f;  // clamped to PG_MIN_ROUGHNESS
+  mirror.metallic = 1.0f;
+  mirror.specular = 0.5f;
+  const float memory = 2.0f, alpha = PG_MIN_ROUGHNESS * PG_MIN_ROUGHNESS, k = 20.0f;
+  const float3 view(0.0f, 0.0f, 1.0f);
+  for (const double turned : {1e-5, 5e-5, 1e-4, 3e-4, 1e-3}) {
+    const float3 prev(static_cast<float>(std::sin(turned)), 0.0f,
+                      static_cast<float>(std::cos(turned)));
+    // The exact angle between the two float vectors, in double.
+    const double exact = std::atan2(double(prev.x), double(prev.z));
+    const double expected = k * std::exp(-exact / (double(memory) * alpha));
+    EXPECT_NEAR(pg_pmm_view_aged_k(k, view, prev, mirror, memory), expected, 1e-4 * k) << turned;
+  }
+}
+
 TEST(PmmReframe, IdentityFrameKeepsTheState) {
   const pg_kernel_settings p = default_params();
   std::mt19937 gen(11);
