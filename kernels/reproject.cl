@@ -6,9 +6,9 @@
  * state (k = 0). */
 /* Per pixel (hand count; rules and roofline: docs/guiding.md, "The roofline"): 78 flops (2
  * divisions, 1 sqrt) where history is kept, 372 more (13 divisions, 12 sqrt/sin/cos) where the
- * state is reframed, about 60 more (the lobes, an acos, an exp, a division) and 48 bytes more
- * read where a model ages (reproject_view_memory > 0); 132 bytes read, 32 written:
- * memory-bound. */
+ * state is reframed, about 72 more (the lobes, two lengths, an atan2, an exp, a division) and
+ * 48 bytes more read where a model ages (reproject_view_memory > 0); 132 bytes read, 32
+ * written: memory-bound. */
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
 #include "shared/pmm.h"
