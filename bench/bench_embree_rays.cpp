@@ -1,5 +1,6 @@
 // Embree alone: primary, secondary (incoherent first bounce) and shadow rays per second on the
-// Cornell box and Crytek Sponza, one ray at a time or in 8-wide packets (RayMode). The rays
+// Cornell box and Crytek Sponza, one ray at a time, in 8-wide packets or in streams of 256
+// (rtcIntersect1M / rtcOccluded1M) (RayMode). The rays
 // come from the scene's camera and its real first hits and are built once, outside the timed
 // loop (bench_common.h: make_ray_sets). Time is wall time of the whole batch (Embree over all
 // cores with TBB), set as manual time.
@@ -8,8 +9,9 @@
 //   bench_embree_rays --rtpg_full           also 640x360 and 3840x2160
 //   bench_embree_rays --benchmark_filter=sponza
 //
-// Packet8 benchmarks also trace the same set one ray at a time in every iteration
-// (interleaved, not timed) and report packet_speedup = single time / packet time: the host
+// Packet8 and Stream benchmarks also trace the same set one ray at a time in every iteration
+// (interleaved, not timed) and report packet_speedup or stream_speedup = single time / their
+// time: the host
 // drifts by 10-30% within minutes (docs/design.md, "PoCL and OpenCL facts"), so ratios are taken
 // inside one iteration.
 #include "bench_common.h"
@@ -50,20 +52,21 @@ void BM_EmbreeRays(benchmark::State& state, const std::string& scene_name, int w
     return;
   }
   const double count = static_cast<double>(rays_of(s->rays, kind).size());
-  double packet_s = 0.0, single_s = 0.0;
+  double mode_s = 0.0, single_s = 0.0;
   for (auto _ : state) {
     const double t = trace_set(*s->tracer, s->rays, kind, mode);
     state.SetIterationTime(t);
-    if (mode == RayMode::Packet8) {
-      packet_s += t;
+    if (mode != RayMode::Single) {
+      mode_s += t;
       single_s += trace_set(*s->tracer, s->rays, kind, RayMode::Single);
     }
   }
   state.counters["rays"] = count;
   state.counters["rays_per_s"] =
       benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
-  if (mode == RayMode::Packet8 && packet_s > 0.0)
-    state.counters["packet_speedup"] = single_s / packet_s;
+  if (mode != RayMode::Single && mode_s > 0.0)
+    state.counters[mode == RayMode::Packet8 ? "packet_speedup" : "stream_speedup"] =
+        single_s / mode_s;
   if (kind != RayKind::Shadow) {
     std::size_t hit = 0;
     for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i)
@@ -82,10 +85,13 @@ void register_all(bool full) {
   for (const char* scene : {"cornell", "sponza"})
     for (auto [w, h] : sizes)
       for (RayKind kind : {RayKind::Primary, RayKind::Secondary, RayKind::Shadow})
-        for (RayMode mode : {RayMode::Single, RayMode::Packet8}) {
+        for (RayMode mode : {RayMode::Single, RayMode::Packet8, RayMode::Stream}) {
+          const char* mode_name = mode == RayMode::Single    ? "single"
+                                  : mode == RayMode::Packet8 ? "packet8"
+                                                             : "stream";
           const std::string name = std::string("EmbreeRays/") + scene + "/" + kind_name(kind) +
-                                   "/" + (mode == RayMode::Single ? "single" : "packet8") + "/" +
-                                   std::to_string(w) + "x" + std::to_string(h);
+                                   "/" + mode_name + "/" + std::to_string(w) + "x" +
+                                   std::to_string(h);
           benchmark::RegisterBenchmark(name.c_str(), BM_EmbreeRays, std::string(scene), w, h, kind,
                                        mode)
               ->UseManualTime()

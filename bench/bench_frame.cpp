@@ -13,8 +13,9 @@
 //                         their kernels' profiling-event times
 //   embree_only_ms        sum over ray kinds of (rays of that kind in the frame, from
 //                         FrameStats) x (Embree's time per ray on a representative set of that
-//                         kind: camera rays in packets of 8, cosine bounces and NEE shadow rays
-//                         from the real first hits one by one, as the path tracer traces them),
+//                         kind: camera rays, cosine bounces and NEE shadow rays from the real
+//                         first hits, each in the RayMode the renderer uses for it:
+//                         kCameraRayMode and the others in host/render/path_tracer.h),
 //                         timed in the same iteration as the frame
 //   ratio                 frame_ms / embree_only_ms
 //   guiding_overhead      pmm only: (pmm frame - off frame) / off frame, with an off frame
@@ -74,9 +75,9 @@ double embree_only_ms(FrameSetup& s, const FrameStats& stats) {
     const std::size_t n = rays_of(s.rays, k).size();
     return n ? trace_set(tracer, s.rays, k, mode) / static_cast<double>(n) : 0.0;
   };
-  const double p = per_ray(RayKind::Primary, RayMode::Packet8);
-  const double b = per_ray(RayKind::Secondary, RayMode::Single);
-  const double sh = per_ray(RayKind::Shadow, RayMode::Single);
+  const double p = per_ray(RayKind::Primary, kCameraRayMode);
+  const double b = per_ray(RayKind::Secondary, kBounceRayMode);
+  const double sh = per_ray(RayKind::Shadow, kShadowRayMode);
   return 1e3 * (static_cast<double>(stats.primary_rays) * p +
                 static_cast<double>(stats.secondary_rays) * b +
                 static_cast<double>(stats.shadow_rays) * sh);

@@ -85,7 +85,7 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
   for (int depth = 1; depth <= settings_.max_bounces && !active_.empty(); ++depth) {
     const std::size_t m = active_.size();
     start = Clock::now();
-    tracer_.intersect(rays_.data(), hits_.data(), m);
+    tracer_.intersect(rays_.data(), hits_.data(), m, kBounceRayMode);
     times.trace_ms += ms_since(start);
     rays.secondary += m;
 
@@ -408,7 +408,7 @@ void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& 
   const auto start = Clock::now();
   occluded_.resize(count);
   // Slots without a shadow ray (inactive_ray()) are skipped, not queried, and not counted.
-  rays.shadow += tracer_.occluded(shadow_rays_.data(), occluded_.data(), count);
+  rays.shadow += tracer_.occluded(shadow_rays_.data(), occluded_.data(), count, kShadowRayMode);
   times.trace_ms += ms_since(start);
 }
 

@@ -38,6 +38,13 @@ struct PathTracerSettings {
   float guide_normal = 0.9f;     // normal cosine
 };
 
+// How a frame's rays go to Embree (host/trace/ray.h): camera rays in packets of 8; bounce and
+// shadow rays in streams, 1.1-1.2x and 1.7-1.8x as fast as one by one (2026-11-26, AVX-512)
+// (docs/host-path-tracer.md, "Embree's stream API"). bench_frame times Embree alone the same way.
+inline constexpr RayMode kCameraRayMode = RayMode::Packet8;
+inline constexpr RayMode kBounceRayMode = RayMode::Stream;
+inline constexpr RayMode kShadowRayMode = RayMode::Stream;
+
 struct RayCounts {
   std::uint64_t secondary = 0, shadow = 0;
   std::uint64_t guided_vertices = 0;  // later vertices that sampled a borrowed guide

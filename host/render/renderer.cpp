@@ -103,7 +103,7 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
       camera_rays_[i] = ray;
     }
   });
-  tracer_->intersect(camera_rays_.data(), camera_hits_.data(), n, RayMode::Packet8);
+  tracer_->intersect(camera_rays_.data(), camera_hits_.data(), n, kCameraRayMode);
   stats.time_ms["primary"] += ms_since(start);
   stats.primary_rays += n;
 

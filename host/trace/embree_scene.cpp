@@ -67,6 +67,7 @@ void check(RTCDevice device, const char* call) {
 }
 
 constexpr std::size_t kGrain = 1024;
+constexpr std::size_t kStreamChunk = 256;  // rays handed to rtcIntersect1M / rtcOccluded1M at once
 
 }  // namespace
 
@@ -165,6 +166,33 @@ void set_ray8(RTCRay8& packet, int lane, const Ray& r) {
 
 void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMode mode) const {
   RTCScene scene = impl_->scene;
+  if (mode == RayMode::Stream) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+      alignas(64) RTCRayHit chunk[kStreamChunk];
+      for (std::size_t first = range.begin(); first < range.end(); first += kStreamChunk) {
+        const std::size_t n = std::min(kStreamChunk, range.end() - first);
+        for (std::size_t k = 0; k < n; ++k) {
+          to_embree(rays[first + k], chunk[k].ray);
+          chunk[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          chunk[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect1M(scene, &context, chunk, static_cast<unsigned int>(n), sizeof(RTCRayHit));
+        for (std::size_t k = 0; k < n; ++k) {
+          const RTCRayHit& rh = chunk[k];
+          Hit& h = hits[first + k];
+          h.mesh = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID;
+          h.triangle = rh.hit.primID;
+          h.t = rh.ray.tfar;
+          h.u = rh.hit.u;
+          h.v = rh.hit.v;
+        }
+      }
+    });
+    return;
+  }
   if (mode == RayMode::Single) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
       RTCIntersectContext context;
@@ -223,6 +251,34 @@ std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::
   // surface: half of them on the Cornell box); asking Embree about them costs a call and a
   // root-node test each (docs/host-path-tracer.md, "Empty shadow rays skipped; per-frame fills").
   const auto has_segment = [&](std::size_t i) { return rays[i].tmin <= rays[i].tmax; };
+  if (mode == RayMode::Stream) {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
+        [&](const auto& range, std::size_t queried) {
+          RTCIntersectContext context;
+          rtcInitIntersectContext(&context);
+          context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+          alignas(64) RTCRay chunk[kStreamChunk];
+          std::uint32_t slot[kStreamChunk];
+          std::size_t i = range.begin();
+          while (i < range.end()) {
+            unsigned int n = 0;
+            for (; i < range.end() && n < kStreamChunk; ++i) {
+              occluded[i] = 0;
+              if (!has_segment(i)) continue;
+              to_embree(rays[i], chunk[n]);
+              slot[n++] = static_cast<std::uint32_t>(i);
+            }
+            if (n == 0) continue;
+            rtcOccluded1M(scene, &context, chunk, n, sizeof(RTCRay));
+            for (unsigned int k = 0; k < n; ++k)
+              occluded[slot[k]] = std::isinf(chunk[k].tfar) && chunk[k].tfar < 0.0f ? 1 : 0;
+            queried += n;
+          }
+          return queried;
+        },
+        std::plus<std::size_t>());
+  }
   if (mode == RayMode::Single) {
     return tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},

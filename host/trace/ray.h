@@ -27,7 +27,8 @@ struct Hit {
 
 // How a batch is handed to Embree. Packets of 8 pay off only for coherent rays (camera and
 // shadow rays towards one light); incoherent bounces are as fast one by one (docs/design.md,
-// "PoCL and OpenCL facts").
-enum class RayMode { Single, Packet8 };
+// "PoCL and OpenCL facts"). Stream: rtcIntersect1M / rtcOccluded1M over chunks of rays
+// (docs/host-path-tracer.md, "Embree's stream API").
+enum class RayMode { Single, Packet8, Stream };
 
 }  // namespace rtpg

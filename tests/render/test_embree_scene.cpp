@@ -1,10 +1,13 @@
-// The batched ray queries of host/trace/embree_scene.h: occlusion answers in both ray modes, and
-// the empty segments the path tracer leaves in its shadow slots (inactive rays, tmin > tmax)
-// answered 0 without a query and left out of the count of rays queried.
+// The batched ray queries of host/trace/embree_scene.h: the same hits and occlusion answers in
+// every ray mode (one by one, packets of 8, streams), and the empty segments the path tracer
+// leaves in its shadow slots (inactive rays, tmin > tmax) answered 0 without a query and left
+// out of the count of rays queried.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "scene/scene.h"
@@ -41,6 +44,10 @@ struct Case {
   std::size_t segments = 0;  // rays with tmin <= tmax
 };
 
+const char* mode_name(RayMode mode) {
+  return mode == RayMode::Single ? "single" : mode == RayMode::Packet8 ? "packets of 8" : "stream";
+}
+
 Case shadow_slots() {
   Case c;
   const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -72,15 +79,14 @@ TEST(EmbreeScene, OccludedAnswersEmptySegmentsWithZeroAndCountsOnlyRaysQueried) 
   std::size_t blocked = 0;
   for (std::uint8_t e : c.expected) blocked += e;
   ASSERT_GT(blocked, 0u);  // the case tests both answers
-  for (RayMode mode : {RayMode::Single, RayMode::Packet8}) {
+  for (RayMode mode : {RayMode::Single, RayMode::Packet8, RayMode::Stream}) {
     // Garbage in the output first: every slot must be written, empty ones included.
     std::vector<std::uint8_t> occluded(c.rays.size(), 7);
     const std::size_t queried =
         tracer.occluded(c.rays.data(), occluded.data(), c.rays.size(), mode);
-    EXPECT_EQ(queried, c.segments) << (mode == RayMode::Single ? "single" : "packets of 8");
+    EXPECT_EQ(queried, c.segments) << mode_name(mode);
     for (std::size_t i = 0; i < c.rays.size(); ++i)
-      EXPECT_EQ(occluded[i], c.expected[i])
-          << "ray " << i << (mode == RayMode::Single ? ", single" : ", packets of 8");
+      EXPECT_EQ(occluded[i], c.expected[i]) << "ray " << i << ", " << mode_name(mode);
   }
 }
 
@@ -88,8 +94,50 @@ TEST(EmbreeScene, OccludedOfNoRaysQueriesNothing) {
   const Scene scene = quad_scene();
   const EmbreeScene tracer(scene);
   std::uint8_t unused = 0;
-  EXPECT_EQ(tracer.occluded(nullptr, &unused, 0, RayMode::Single), 0u);
-  EXPECT_EQ(tracer.occluded(nullptr, &unused, 0, RayMode::Packet8), 0u);
+  for (RayMode mode : {RayMode::Single, RayMode::Packet8, RayMode::Stream})
+    EXPECT_EQ(tracer.occluded(nullptr, &unused, 0, mode), 0u) << mode_name(mode);
+}
+
+// 2000 rays from random points above and below the quad in random directions (a third of them
+// hit it, from either side), more than one TBB range and stream chunk and a partial last one:
+// packets and streams return the hits of one-by-one queries to the bit, and the same occlusion.
+TEST(EmbreeScene, EveryRayModeGivesTheSameAnswers) {
+  const Scene scene = quad_scene();
+  const EmbreeScene tracer(scene);
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 2000; ++i) {
+    const glm::vec3 origin(u(gen), u(gen), u(gen));
+    glm::vec3 to(0.7f * u(gen), 0.0f, 0.7f * u(gen));
+    if (i % 3 != 0) to = glm::vec3(u(gen), u(gen), u(gen));  // mostly elsewhere
+    rays.push_back(segment(origin, to - origin, 0.0f, i % 5 == 0 ? 0.5f : 2.0f));
+  }
+  std::vector<Hit> single(rays.size());
+  std::vector<std::uint8_t> single_occluded(rays.size());
+  tracer.intersect(rays.data(), single.data(), rays.size(), RayMode::Single);
+  tracer.occluded(rays.data(), single_occluded.data(), rays.size(), RayMode::Single);
+  std::size_t hits = 0;
+  for (const Hit& h : single) hits += h.valid();
+  EXPECT_GT(hits, rays.size() / 5);
+  EXPECT_LT(hits, rays.size() / 2);
+  for (RayMode mode : {RayMode::Packet8, RayMode::Stream}) {
+    std::vector<Hit> got(rays.size());
+    std::vector<std::uint8_t> occluded(rays.size(), 7);
+    tracer.intersect(rays.data(), got.data(), rays.size(), mode);
+    tracer.occluded(rays.data(), occluded.data(), rays.size(), mode);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      const Hit &a = single[i], &b = got[i];
+      ASSERT_EQ(a.mesh, b.mesh) << "ray " << i << ", " << mode_name(mode);
+      EXPECT_EQ(occluded[i], single_occluded[i]) << "ray " << i << ", " << mode_name(mode);
+      EXPECT_EQ(occluded[i], a.valid() ? 1 : 0) << "ray " << i << ", " << mode_name(mode);
+      if (!a.valid()) continue;
+      EXPECT_EQ(a.triangle, b.triangle) << "ray " << i << ", " << mode_name(mode);
+      EXPECT_EQ(std::memcmp(&a.t, &b.t, sizeof a.t), 0) << "ray " << i << ", " << mode_name(mode);
+      EXPECT_EQ(std::memcmp(&a.u, &b.u, sizeof a.u), 0) << "ray " << i << ", " << mode_name(mode);
+      EXPECT_EQ(std::memcmp(&a.v, &b.v, sizeof a.v), 0) << "ray " << i << ", " << mode_name(mode);
+    }
+  }
 }
 
 }  // namespace
