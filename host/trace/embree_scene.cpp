@@ -162,6 +162,23 @@ void set_ray8(RTCRay8& packet, int lane, const Ray& r) {
   packet.flags[lane] = 0;
 }
 
+// A closest-hit query of one ray, and its answer as a Hit.
+void start_query(const Ray& r, RTCRayHit& rh) {
+  to_embree(r, rh.ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+Hit hit_of(const RTCRayHit& rh) {
+  Hit h;
+  h.mesh = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID;
+  h.triangle = rh.hit.primID;
+  h.t = rh.ray.tfar;
+  h.u = rh.hit.u;
+  h.v = rh.hit.v;
+  return h;
+}
+
 }  // namespace
 
 void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMode mode) const {
@@ -174,21 +191,9 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
       alignas(64) RTCRayHit chunk[kStreamChunk];
       for (std::size_t first = range.begin(); first < range.end(); first += kStreamChunk) {
         const std::size_t n = std::min(kStreamChunk, range.end() - first);
-        for (std::size_t k = 0; k < n; ++k) {
-          to_embree(rays[first + k], chunk[k].ray);
-          chunk[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-          chunk[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        }
+        for (std::size_t k = 0; k < n; ++k) start_query(rays[first + k], chunk[k]);
         rtcIntersect1M(scene, &context, chunk, static_cast<unsigned int>(n), sizeof(RTCRayHit));
-        for (std::size_t k = 0; k < n; ++k) {
-          const RTCRayHit& rh = chunk[k];
-          Hit& h = hits[first + k];
-          h.mesh = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID;
-          h.triangle = rh.hit.primID;
-          h.t = rh.ray.tfar;
-          h.u = rh.hit.u;
-          h.v = rh.hit.v;
-        }
+        for (std::size_t k = 0; k < n; ++k) hits[first + k] = hit_of(chunk[k]);
       }
     });
     return;
@@ -199,16 +204,9 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
       rtcInitIntersectContext(&context);
       for (std::size_t i = range.begin(); i != range.end(); ++i) {
         RTCRayHit rh;
-        to_embree(rays[i], rh.ray);
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        start_query(rays[i], rh);
         rtcIntersect1(scene, &context, &rh);
-        Hit& h = hits[i];
-        h.mesh = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID;
-        h.triangle = rh.hit.primID;
-        h.t = rh.ray.tfar;
-        h.u = rh.hit.u;
-        h.v = rh.hit.v;
+        hits[i] = hit_of(rh);
       }
     });
     return;
