@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # run.sh of a bundle made by tools/gpu_bundle.sh: the OpenCL tests, then the guiding kernels'
 # roofline benchmark, on RTPG_DEVICE (default gpu); the binaries embed the kernels and read no
-# other file. Logs go to OUT (default DIR/out): tests.log, bench.log, bench.json, devices.log. TESTS (binary names) narrows the tests; NO_BENCH=1 skips the benchmark.
+# other file. Logs go to OUT (default DIR/out): tests.log, bench.log, bench.json, devices.log.
+# TESTS (binary names) narrows the tests; NO_BENCH=1 skips the benchmark.
 # Exit status: the number of test binaries that failed, 0 if none.
 set -uo pipefail
 dir=$(cd "$(dirname "$0")" && pwd)
