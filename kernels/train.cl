@@ -2,7 +2,10 @@
  * 4.2). Built in two variants (build option PG_TRAIN_LOCAL_TILE): 1 loads the work-group's
  * VPL tile plus an apron of `apron` pixels into local memory first (what GPUs need); 0 reads
  * the same VPLs straight from global memory (faster on PoCL's CPU device, docs/guiding.md).
- * Both give identical results. trained[i] is 1 where the state changed. */
+ * Both give identical results. trained[i] is 1 where the state changed.
+ * The state is updated in place: a pixel reads and writes only its own, so a pixel that does
+ * not train this frame (no guiding, or a mature pixel off its turn) reads its flags, roughness
+ * and k and writes nothing but its trained flag (docs/guiding.md, "Training in place"). */
 #include "shared/kernel_args.h"
 #include "shared/pmm_train.h"
 
@@ -10,10 +13,10 @@
 #define PG_TRAIN_LOCAL_TILE 1
 #endif
 
-__kernel void train(
-    PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_IN_STATE PG_ARGS_OUT_STATE __global uchar* trained,
-    uint width, uint height, uint seed, uint frame, pg_kernel_settings settings,
-    __local float4* tile_position, __local float4* tile_normal, __local float4* tile_radiance) {
+__kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uchar* trained, uint width,
+                    uint height, uint seed, uint frame, pg_kernel_settings settings,
+                    __local float4* tile_position, __local float4* tile_normal,
+                    __local float4* tile_radiance) {
   int x = (int)get_global_id(0), y = (int)get_global_id(1);
   int apron = settings.apron;
 #if PG_TRAIN_LOCAL_TILE
@@ -39,48 +42,48 @@ __kernel void train(
 #endif
   if (x >= (int)width || y >= (int)height) return;
   int i = y * (int)width + x;
-  float4 s0 = in_state0[i], s1 = in_state1[i];
-  uint f = flags[i];
   float4 bcr = base_color_roughness[i];
-  uchar changed = 0;
-  if (pg_guiding_applies(f, bcr.w, settings) && pg_train_this_frame(s1.w, x, y, frame, settings)) {
-    pg_pmm_state state;
-    state.s0 = s0;
-    state.s1 = s1;
-    pg_train_pixel px;
-    px.x = position_depth[i].xyz;
-    px.frame = pg_frame_from_normal(shading_normal[i].xyz);
-    px.wo = pg_to_local(px.frame, view_dir[i].xyz);
-    px.lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), px.wo);
-    int side = 2 * apron + 1;
-    int n = min(min(pg_pmm_neighbour_count(s1.w, settings), side * side), PG_MAX_TRAIN_SAMPLES);
-    uint start = pg_train_walk_start(seed, x, y, width, frame, settings);
-    float4 samples[PG_MAX_TRAIN_SAMPLES];
-    float densities[PG_MAX_TRAIN_SAMPLES];
-    int kept = 0;
-    for (int s = 0; s < n; ++s) {
-      int w = pg_train_window_index(start, s, settings);
-      int dx = w % side - apron, dy = w / side - apron;
-#if PG_TRAIN_LOCAL_TILE
-      int t = ((int)get_local_id(1) + apron + dy) * tw + (int)get_local_id(0) + apron + dx;
-      kept += pg_train_sample_from_vpl(px, tile_position[t], tile_normal[t], tile_radiance[t],
-                                       settings, &samples[kept], &densities[kept]);
-#else
-      int sx = x + dx, sy = y + dy;
-      if (sx < 0 || sy < 0 || sx >= (int)width || sy >= (int)height) continue;
-      int j = sy * (int)width + sx;
-      kept += pg_train_sample_from_vpl(px, vpl_position[j], vpl_normal[j], vpl_radiance_info[j],
-                                       settings, &samples[kept], &densities[kept]);
-#endif
-    }
-    int updated = 0;
-    state = pg_pmm_train(state, samples, densities, kept, settings, (float)n, settings.em_passes,
-                         &updated);
-    s0 = state.s0;
-    s1 = state.s1;
-    changed = (uchar)updated;
+  if (!pg_guiding_applies(flags[i], bcr.w, settings)) {
+    trained[i] = 0;
+    return;
   }
-  out_state0[i] = s0;
-  out_state1[i] = s1;
-  trained[i] = changed;
+  if (!pg_train_this_frame(state1[i].w, x, y, frame, settings)) {
+    trained[i] = 0;
+    return;
+  }
+  pg_pmm_state state;
+  state.s0 = state0[i];
+  state.s1 = state1[i];
+  pg_train_pixel px;
+  px.x = position_depth[i].xyz;
+  px.frame = pg_frame_from_normal(shading_normal[i].xyz);
+  px.wo = pg_to_local(px.frame, view_dir[i].xyz);
+  px.lobes = pg_make_lobes(pg_material_from_gbuffer(bcr, metallic_specular[i]), px.wo);
+  int side = 2 * apron + 1;
+  int n = min(min(pg_pmm_neighbour_count(state.s1.w, settings), side * side), PG_MAX_TRAIN_SAMPLES);
+  uint start = pg_train_walk_start(seed, x, y, width, frame, settings);
+  float4 samples[PG_MAX_TRAIN_SAMPLES];
+  float densities[PG_MAX_TRAIN_SAMPLES];
+  int kept = 0;
+  for (int s = 0; s < n; ++s) {
+    int w = pg_train_window_index(start, s, settings);
+    int dx = w % side - apron, dy = w / side - apron;
+#if PG_TRAIN_LOCAL_TILE
+    int t = ((int)get_local_id(1) + apron + dy) * tw + (int)get_local_id(0) + apron + dx;
+    kept += pg_train_sample_from_vpl(px, tile_position[t], tile_normal[t], tile_radiance[t],
+                                     settings, &samples[kept], &densities[kept]);
+#else
+    int sx = x + dx, sy = y + dy;
+    if (sx < 0 || sy < 0 || sx >= (int)width || sy >= (int)height) continue;
+    int j = sy * (int)width + sx;
+    kept += pg_train_sample_from_vpl(px, vpl_position[j], vpl_normal[j], vpl_radiance_info[j],
+                                     settings, &samples[kept], &densities[kept]);
+#endif
+  }
+  int updated = 0;
+  state = pg_pmm_train(state, samples, densities, kept, settings, (float)n, settings.em_passes,
+                       &updated);
+  state0[i] = state.s0;
+  state1[i] = state.s1;
+  trained[i] = (uchar)updated;
 }

@@ -5,7 +5,9 @@
  * pixel, N neighbour VPLs of the (2*apron+1)^2 window turned into samples, then
  * pg_pmm_train's E-step passes and M-steps. Trip counts are the largest of the lanes; a lane
  * past its own count is masked. VPLs are read from global memory (no tile: a CPU device's
- * caches hold the window). trained[i] is 1 where the state changed. */
+ * caches hold the window). trained[i] is 1 where the state changed. The state is updated in
+ * place, as in train.cl: a work-item none of whose lanes trains this frame reads the lanes'
+ * flags, roughness and k and writes only their trained flags. */
 /* No fused multiply-adds, here or in the shared functions: the host reference runs them
  * unfused, and near the peak of a narrow GGX lobe (alpha 0.03) D's denominator is a difference
  * of nearly equal numbers, where one fused product moves D, and a sample's weight, by 1e-4
@@ -24,22 +26,16 @@
 #include "wide/guiding_pixel_wide.h"
 #include "wide/pmm_train_wide.h"
 
-__kernel void train_wide(
-    PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_IN_STATE PG_ARGS_OUT_STATE __global uchar* trained,
-    uint width, uint height, uint seed, uint frame, pg_kernel_settings settings) {
+__kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uchar* trained,
+                         uint width, uint height, uint seed, uint frame,
+                         pg_kernel_settings settings) {
   int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
   if (x0 >= (int)width || y >= (int)height) return;
   int w = (int)width, row_start = y * w, apron = settings.apron, side = 2 * apron + 1;
 
-  /* Per lane, as train.cl per work-item, loaded as vectors (kernels/wide/lanes.h): the state,
-   * whether the pixel trains, its N and passes, and what it knows about itself. A lane past
-   * the row's end computes on its last pixel, trains nothing and stores nothing. */
-  pg_pmm_state_w original;
-  pg_load_row_float4_rows(in_state0 + row_start, x0, w, &original.w, &original.s0, &original.sx,
-                          &original.sy);
-  pg_load_row_float4_rows(in_state1 + row_start, x0, w, &original.sxx, &original.syy, &original.sxy,
-                          &original.k);
-  pg_floatw k = original.k;
+  /* Per lane, as train.cl per work-item, loaded as vectors (kernels/wide/lanes.h): whether
+   * the pixel trains, the state, its N and passes, and what it knows about itself. A lane
+   * past the row's end computes on its last pixel, trains nothing and stores nothing. */
   pg_float3w base_color;
   pg_floatw roughness;
   pg_load_row_float4_rows(base_color_roughness + row_start, x0, w, &base_color.x, &base_color.y,
@@ -49,11 +45,25 @@ __kernel void train_wide(
   /* pg_guiding_applies and pg_train_this_frame per lane; the lanes share one run of
    * PG_TRAIN_RUN pixels, so the frame's rotation decides for all of them at once. */
   pg_intw active = (x0 + lane < w) & pg_guiding_applies_w(pixel_flags, roughness, settings);
+  if (!any(active)) {
+    pg_zero_row_uchars(trained + row_start, x0, w);
+    return;
+  }
+  pg_pmm_state_w original;
+  pg_load_row_float4_rows(state1 + row_start, x0, w, &original.sxx, &original.syy, &original.sxy,
+                          &original.k);
+  pg_floatw k = original.k;
   int run_trains =
       settings.train_interval <= 1 ||
       ((uint)x0 / PG_TRAIN_RUN + 3u * (uint)y + frame) % (uint)settings.train_interval == 0u;
   pg_intw mature = k >= 0.25f * settings.k_max;
   if (!run_trains) active &= ~mature;
+  if (!any(active)) {
+    pg_zero_row_uchars(trained + row_start, x0, w);
+    return;
+  }
+  pg_load_row_float4_rows(state0 + row_start, x0, w, &original.w, &original.s0, &original.sx,
+                          &original.sy);
   /* pg_pmm_neighbour_count, bounded by the window and the sample array. */
   pg_floatw t = clamp(1.0f - k / settings.k_max, 0.0f, 1.0f);
   pg_intw n = pg_convert_intw(t * (settings.n_max - settings.n_min) + settings.n_min + 0.5f);
@@ -64,99 +74,97 @@ __kernel void train_wide(
   pg_intw done = ~active, updated = (pg_intw)(0);
   pg_pmm_state_w result = original;
 
-  if (any(active)) {
-    pg_train_pixels_w px;
-    pg_floatw metallic, specular, unused;
-    pg_load_row_float4_rows(position_depth + row_start, x0, w, &px.x.x, &px.x.y, &px.x.z, &unused);
-    pg_float3w normal, view;
-    pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
-                            &unused);
-    pg_load_row_float4_rows(view_dir + row_start, x0, w, &view.x, &view.y, &view.z, &unused);
-    pg_load_row_float4_rows(metallic_specular + row_start, x0, w, &metallic, &specular, &unused,
-                            &unused);
-    px.frame = pg_frame_from_normal_w(normal);
-    px.wo = pg_to_local_w(px.frame, view);
-    px.lobes = pg_make_lobes_w(base_color, roughness, metallic, specular, px.wo);
-    int any_specular = any(active & (px.lobes.p_specular > 0.0f));
-    pg_pmm_model_w m = pg_pmm_model_from_state_w(original, settings);
+  pg_train_pixels_w px;
+  pg_floatw metallic, specular, unused;
+  pg_load_row_float4_rows(position_depth + row_start, x0, w, &px.x.x, &px.x.y, &px.x.z, &unused);
+  pg_float3w normal, view;
+  pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
+                          &unused);
+  pg_load_row_float4_rows(view_dir + row_start, x0, w, &view.x, &view.y, &view.z, &unused);
+  pg_load_row_float4_rows(metallic_specular + row_start, x0, w, &metallic, &specular, &unused,
+                          &unused);
+  px.frame = pg_frame_from_normal_w(normal);
+  px.wo = pg_to_local_w(px.frame, view);
+  px.lobes = pg_make_lobes_w(base_color, roughness, metallic, specular, px.wo);
+  int any_specular = any(active & (px.lobes.p_specular > 0.0f));
+  pg_pmm_model_w m = pg_pmm_model_from_state_w(original, settings);
 
-    /* The s-th neighbour of every lane's walk (pg_train_window_index, stepped without
-     * integer division per lane). The lanes lie in one run of PG_TRAIN_RUN pixels, whose walk
-     * starts in one cell (pg_train_walk_start), so their s-th neighbours are PG_LANES
-     * consecutive pixels of one row: loaded as vectors and transposed where the whole segment
-     * is inside the image, lane by lane at the left and right edges. Lanes not asked read no
-     * VPL (info 0), as train.cl skips them. */
-    pg_train_samples_w samples[PG_MAX_TRAIN_SAMPLES];
-    int walk = (int)pg_train_walk_start(seed, x0, y, width, frame, settings);
-    for (int s = 0; s < most_samples; ++s) {
-      if (s > 0) {
-        walk += settings.stride;
-        if (walk >= side * side) walk -= side * side;
-      }
-      int dy = walk / side, sy = y + dy - apron, sx0 = x0 + (walk - dy * side) - apron;
-      int row_inside = sy >= 0 && sy < (int)height;
-      pg_intw sx = sx0 + lane;
-      pg_intw asked_w = (s < counts) & (sx >= 0) & (sx < (int)width) & (pg_intw)(-row_inside);
-      pg_floatw row[12];
-      if (!row_inside) {
-        for (int f = 0; f < 12; ++f) row[f] = (pg_floatw)(0.0f);
-      } else if (sx0 >= 0 && sx0 + PG_LANES <= (int)width) {
-        int j = sy * (int)width + sx0;
-        pg_load_float4_rows(vpl_position + j, &row[0], &row[1], &row[2], &row[3]);
-        pg_load_float4_rows(vpl_normal + j, &row[4], &row[5], &row[6], &row[7]);
-        pg_load_float4_rows(vpl_radiance_info + j, &row[8], &row[9], &row[10], &row[11]);
-        for (int f = 0; f < 12; ++f) row[f] = select((pg_floatw)(0.0f), row[f], asked_w);
-      } else {
-        int asked[PG_LANES];
-        pg_vstorew(asked_w, 0, asked);
-        float vpl[12][PG_LANES];
-        for (int l = 0; l < PG_LANES; ++l) {
-          float4 position_pdf = (float4)(0.0f), normal = (float4)(0.0f);
-          float4 radiance_info = (float4)(0.0f); /* info 0: not a VPL */
-          if (asked[l]) {
-            int j = sy * (int)width + sx0 + l;
-            position_pdf = vpl_position[j];
-            normal = vpl_normal[j];
-            radiance_info = vpl_radiance_info[j];
-          }
-          pg_put4_rows(vpl, 0, l, position_pdf);
-          pg_put4_rows(vpl, 4, l, normal);
-          pg_put4_rows(vpl, 8, l, radiance_info);
+  /* The s-th neighbour of every lane's walk (pg_train_window_index, stepped without
+   * integer division per lane). The lanes lie in one run of PG_TRAIN_RUN pixels, whose walk
+   * starts in one cell (pg_train_walk_start), so their s-th neighbours are PG_LANES
+   * consecutive pixels of one row: loaded as vectors and transposed where the whole segment
+   * is inside the image, lane by lane at the left and right edges. Lanes not asked read no
+   * VPL (info 0), as train.cl skips them. */
+  pg_train_samples_w samples[PG_MAX_TRAIN_SAMPLES];
+  int walk = (int)pg_train_walk_start(seed, x0, y, width, frame, settings);
+  for (int s = 0; s < most_samples; ++s) {
+    if (s > 0) {
+      walk += settings.stride;
+      if (walk >= side * side) walk -= side * side;
+    }
+    int dy = walk / side, sy = y + dy - apron, sx0 = x0 + (walk - dy * side) - apron;
+    int row_inside = sy >= 0 && sy < (int)height;
+    pg_intw sx = sx0 + lane;
+    pg_intw asked_w = (s < counts) & (sx >= 0) & (sx < (int)width) & (pg_intw)(-row_inside);
+    pg_floatw row[12];
+    if (!row_inside) {
+      for (int f = 0; f < 12; ++f) row[f] = (pg_floatw)(0.0f);
+    } else if (sx0 >= 0 && sx0 + PG_LANES <= (int)width) {
+      int j = sy * (int)width + sx0;
+      pg_load_float4_rows(vpl_position + j, &row[0], &row[1], &row[2], &row[3]);
+      pg_load_float4_rows(vpl_normal + j, &row[4], &row[5], &row[6], &row[7]);
+      pg_load_float4_rows(vpl_radiance_info + j, &row[8], &row[9], &row[10], &row[11]);
+      for (int f = 0; f < 12; ++f) row[f] = select((pg_floatw)(0.0f), row[f], asked_w);
+    } else {
+      int asked[PG_LANES];
+      pg_vstorew(asked_w, 0, asked);
+      float vpl[12][PG_LANES];
+      for (int l = 0; l < PG_LANES; ++l) {
+        float4 position_pdf = (float4)(0.0f), normal = (float4)(0.0f);
+        float4 radiance_info = (float4)(0.0f); /* info 0: not a VPL */
+        if (asked[l]) {
+          int j = sy * (int)width + sx0 + l;
+          position_pdf = vpl_position[j];
+          normal = vpl_normal[j];
+          radiance_info = vpl_radiance_info[j];
         }
-        for (int f = 0; f < 12; ++f) row[f] = pg_vloadw(0, vpl[f]);
+        pg_put4_rows(vpl, 0, l, position_pdf);
+        pg_put4_rows(vpl, 4, l, normal);
+        pg_put4_rows(vpl, 8, l, radiance_info);
       }
-      pg_vpls_w v;
-      v.position = pg_make_float3w(row[0], row[1], row[2]);
-      v.position_pdf = row[3];
-      v.normal = pg_make_float3w(row[4], row[5], row[6]);
-      v.mixture_pdf = row[7];
-      v.radiance = pg_make_float3w(row[8], row[9], row[10]);
-      v.info = row[11];
-      samples[s] = pg_train_samples_from_vpls_w(px, v, asked_w, settings, any_specular);
+      for (int f = 0; f < 12; ++f) row[f] = pg_vloadw(0, vpl[f]);
     }
+    pg_vpls_w v;
+    v.position = pg_make_float3w(row[0], row[1], row[2]);
+    v.position_pdf = row[3];
+    v.normal = pg_make_float3w(row[4], row[5], row[6]);
+    v.mixture_pdf = row[7];
+    v.radiance = pg_make_float3w(row[8], row[9], row[10]);
+    v.info = row[11];
+    samples[s] = pg_train_samples_from_vpls_w(px, v, asked_w, settings, any_specular);
+  }
 
-    /* pg_pmm_train in the lanes: E-step passes over the samples, each followed by the
-     * M-step and the next pass's model. A lane that pg_pmm_train would have left (no update,
-     * an invalid model, its last pass) is done and keeps its result. */
-    pg_pmm_state_w base = original;
-    pg_floatw target = pg_convert_floatw(counts);
-    for (int pass = 0; !all(done); ++pass) {
-      pg_pmm_batch_w b = pg_pmm_batch_empty_w();
-      for (int s = 0; s < most_samples; ++s)
-        b = pg_pmm_batch_add_w(b, m, settings, samples[s], original.w);
-      pg_intw live = ~done, step;
-      /* A re-seed replaces the history: later passes refine the new model alone. */
-      base = pg_pmm_state_select_w(base, pg_pmm_initial_state_w(),
-                                   live & pg_pmm_batch_reseeds_w(b, settings));
-      pg_pmm_state_w next = pg_pmm_update_w(base, b, settings, target, &step);
-      updated = select(updated, step, live);
-      result = pg_pmm_state_select_w(result, pg_pmm_state_select_w(original, next, step), live);
-      pg_intw last = (pass + 1 >= lane_passes);
-      if (all(~live | last)) break; /* no lane needs the next pass's model */
-      pg_pmm_model_w next_model = pg_pmm_model_from_state_w(next, settings);
-      m = pg_pmm_model_select_w(m, next_model, live & step);
-      done |= live & (~step | ~next_model.valid | last);
-    }
+  /* pg_pmm_train in the lanes: E-step passes over the samples, each followed by the
+   * M-step and the next pass's model. A lane that pg_pmm_train would have left (no update,
+   * an invalid model, its last pass) is done and keeps its result. */
+  pg_pmm_state_w base = original;
+  pg_floatw target = pg_convert_floatw(counts);
+  for (int pass = 0; !all(done); ++pass) {
+    pg_pmm_batch_w b = pg_pmm_batch_empty_w();
+    for (int s = 0; s < most_samples; ++s)
+      b = pg_pmm_batch_add_w(b, m, settings, samples[s], original.w);
+    pg_intw live = ~done, step;
+    /* A re-seed replaces the history: later passes refine the new model alone. */
+    base = pg_pmm_state_select_w(base, pg_pmm_initial_state_w(),
+                                 live & pg_pmm_batch_reseeds_w(b, settings));
+    pg_pmm_state_w next = pg_pmm_update_w(base, b, settings, target, &step);
+    updated = select(updated, step, live);
+    result = pg_pmm_state_select_w(result, pg_pmm_state_select_w(original, next, step), live);
+    pg_intw last = (pass + 1 >= lane_passes);
+    if (all(~live | last)) break; /* no lane needs the next pass's model */
+    pg_pmm_model_w next_model = pg_pmm_model_from_state_w(next, settings);
+    m = pg_pmm_model_select_w(m, next_model, live & step);
+    done |= live & (~step | ~next_model.valid | last);
   }
 
   float st[8][PG_LANES];
@@ -174,8 +182,8 @@ __kernel void train_wide(
     int x = x0 + l;
     if (x >= w) break;
     int i = row_start + x;
-    out_state0[i] = (float4)(st[0][l], st[1][l], st[2][l], st[3][l]);
-    out_state1[i] = (float4)(st[4][l], st[5][l], st[6][l], st[7][l]);
+    state0[i] = (float4)(st[0][l], st[1][l], st[2][l], st[3][l]);
+    state1[i] = (float4)(st[4][l], st[5][l], st[6][l], st[7][l]);
     trained[i] = (uchar)changed[l];
   }
 }

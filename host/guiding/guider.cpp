@@ -219,19 +219,19 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
 #define RTPG_CHECK(name, type, bytes) check_buffer(vpls.name, bytes, "vpls." #name);
   PG_VPL_CHANNELS(RTPG_CHECK)
 #undef RTPG_CHECK
-  const State &from = state_[current_], &to = state_[1 - current_];
+  // In place (kernels/train.cl): a pixel that does not train this frame costs no state traffic.
+  const State& state = state_[current_];
   const std::size_t tile = local_tile_ ? static_cast<std::size_t>(group_x_ + 2 * settings_.apron) *
                                              (group_y_ + 2 * settings_.apron) * 16
                                        : 16;
   translate_cl_errors([&] {
     KernelArgs args(train_);
-    args << current << vpls << from.state0 << from.state1 << to.state0 << to.state1 << trained_
+    args << current << vpls << state.state0 << state.state1 << trained_
          << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
          << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame) << kernel_settings_;
     if (train_lanes_ == 1) args << cl::Local(tile) << cl::Local(tile) << cl::Local(tile);
     times_.train_ms = run(train_, train_lanes_, /*pixel_kernel=*/false);
   });
-  current_ = 1 - current_;
 }
 
 void Guider::read_state(std::vector<float>& state) {

@@ -206,7 +206,7 @@ class Guider {
   struct State {  // the mixtures of every pixel (PG_STATE_CHANNELS)
     cl::Buffer state0, state1;
   };
-  State state_[2];  // last frame's and this frame's
+  State state_[2];  // reproject's source and destination (train updates the current in place)
   cl::Buffer trained_;
   int current_ = 0;  // index of the buffers holding this frame's state
   cl::Kernel reproject_, sample_, train_;

@@ -14,6 +14,7 @@
 #define PG_ARG_IN_VPL(name, type, bytes) __global const type *vpl_##name,
 #define PG_ARG_IN_STATE(name, type, bytes) __global const type *in_##name,
 #define PG_ARG_OUT_STATE(name, type, bytes) __global type *out_##name,
+#define PG_ARG_STATE(name, type, bytes) __global type *name,
 #define PG_ARG_OUT(name, type, bytes) __global type *name,
 
 #define PG_ARGS_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_IN)           /* this frame's G-buffer */
@@ -21,6 +22,8 @@
 #define PG_ARGS_VPLS PG_VPL_CHANNELS(PG_ARG_IN_VPL)
 #define PG_ARGS_IN_STATE PG_STATE_CHANNELS(PG_ARG_IN_STATE)
 #define PG_ARGS_OUT_STATE PG_STATE_CHANNELS(PG_ARG_OUT_STATE)
+/* The state updated in place (train: each work-item reads and writes only its own pixels). */
+#define PG_ARGS_STATE PG_STATE_CHANNELS(PG_ARG_STATE)
 #define PG_ARGS_SAMPLES PG_SAMPLE_CHANNELS(PG_ARG_OUT)
 
 #endif

@@ -15,11 +15,22 @@
 #define PG_LANES 8
 #endif
 
+/* The row loads below are small, but PoCL's compiler (clang) kept them out of line, with their
+ * output rows passed through memory: 8% of train_wide's time, 12% of sample_wide's
+ * (docs/guiding.md, "Training in place; row loads inlined"). Forced inline where the compiler
+ * is clang; elsewhere the compiler decides. */
+#ifdef __clang__
+#define PG_ROW_LOAD static inline __attribute__((always_inline))
+#else
+#define PG_ROW_LOAD static inline
+#endif
+
 #define PG_PASTE2(a, b) a##b
 #define PG_PASTE(a, b) PG_PASTE2(a, b)
 #define pg_floatw PG_PASTE(float, PG_LANES)
 #define pg_intw PG_PASTE(int, PG_LANES)
 #define pg_uintw PG_PASTE(uint, PG_LANES)
+#define pg_ucharw PG_PASTE(uchar, PG_LANES)
 #define pg_vloadw PG_PASTE(vload, PG_LANES)
 #define pg_vstorew PG_PASTE(vstore, PG_LANES)
 #define pg_convert_uintw PG_PASTE(convert_uint, PG_LANES)
@@ -63,8 +74,8 @@ static inline void pg_put4_rows(__private float (*rows)[PG_LANES], int field, in
 
 /* PG_LANES consecutive float4 (one per lane, as a channel of consecutive pixels) turned into
  * four rows: the x, y, z and w of every lane (a transposition by swizzles, no scalar code). */
-static inline void pg_load_float4_rows(__global const float4* p, pg_floatw* x, pg_floatw* y,
-                                       pg_floatw* z, pg_floatw* w) {
+PG_ROW_LOAD void pg_load_float4_rows(__global const float4* p, pg_floatw* x, pg_floatw* y,
+                                     pg_floatw* z, pg_floatw* w) {
   __global const float* f = (__global const float*)p;
 #if PG_LANES == 16
   float16 a = vload16(0, f), b = vload16(1, f), c = vload16(2, f), d = vload16(3, f);
@@ -103,8 +114,8 @@ static inline void pg_load_float4_rows(__global const float4* p, pg_floatw* x, p
  * four rows: vector loads where every lane lies inside the row; at either end of the row lane
  * by lane, a lane outside it reading the nearest pixel of the row (callers mask it). x0 may be
  * negative (the a-trous filter's taps left of the image). */
-static inline void pg_load_row_float4_rows(__global const float4* row, int x0, int width,
-                                           pg_floatw* x, pg_floatw* y, pg_floatw* z, pg_floatw* w) {
+PG_ROW_LOAD void pg_load_row_float4_rows(__global const float4* row, int x0, int width,
+                                         pg_floatw* x, pg_floatw* y, pg_floatw* z, pg_floatw* w) {
   if (x0 >= 0 && x0 + PG_LANES <= width) {
     pg_load_float4_rows(row + x0, x, y, z, w);
     return;
@@ -158,6 +169,16 @@ static inline void pg_store_row_floats(__global float* row, int x0, int width, p
   float lanes[PG_LANES];
   pg_vstorew(v, 0, lanes);
   for (int l = 0; x0 + l < width; ++l) row[x0 + l] = lanes[l];
+}
+
+/* Zeroes the pixels x0 .. x0 + PG_LANES - 1 of a uchar row (x0 >= 0) up to the row's end: one
+ * vector store where every lane lies inside the row. */
+static inline void pg_zero_row_uchars(__global uchar* row, int x0, int width) {
+  if (x0 + PG_LANES <= width) {
+    pg_vstorew((pg_ucharw)(0), 0, row + x0);
+    return;
+  }
+  for (int l = 0; x0 + l < width; ++l) row[x0 + l] = 0;
 }
 
 /* The largest lane of an int vector. */
