@@ -7,7 +7,7 @@
 //
 // Counters (means over the iterations of a repetition; the aggregates give their medians):
 //   frame_ms              FrameStats "total" (also the manual time of the iteration)
-//   primary_ms, gbuffer_ms, first_bounce_ms, trace_ms, shade_ms   stages of the frame
+//   primary_ms, gbuffer_ms, first_bounce_ms, trace_ms, shade_ms, compact_ms   stages of the frame
 //   guiding_ms            pmm: begin_frame (upload, reproject, state readback) + sample +
 //                         end_frame (VPL upload, train); reproject/sample/train_kernel_ms are
 //                         their kernels' profiling-event times
@@ -103,7 +103,7 @@ void BM_Frame(benchmark::State& state, const std::string& scene_name, int w, int
     const double total = stage(st, "total");
     state.SetIterationTime(total * 1e-3);
     sum["frame_ms"] += total;
-    for (const char* k : {"primary", "gbuffer", "first_bounce", "trace", "shade"})
+    for (const char* k : {"primary", "gbuffer", "first_bounce", "trace", "shade", "compact"})
       sum[std::string(k) + "_ms"] += stage(st, k);
     if (guided) {
       sum["guiding_ms"] +=

@@ -5,7 +5,8 @@
  * Both give identical results. trained[i] is 1 where the state changed.
  * The state is updated in place: a pixel reads and writes only its own, so a pixel that does
  * not train this frame (no guiding, or a mature pixel off its turn) reads its flags, roughness
- * and k and writes nothing but its trained flag (docs/guiding.md, "Training in place"). */
+ * and k and writes nothing but its trained flag (docs/guiding.md, "Training in place; row loads
+ * inlined"). */
 #include "shared/kernel_args.h"
 #include "shared/pmm_train.h"
 

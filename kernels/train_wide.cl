@@ -18,7 +18,8 @@
  * P = 3 with GGX (each M^-1 9 flops fewer since it lost its disk detour, two of them square
  * roots and one a division); with pi_learning 8 flops and 2 divisions more per neighbour and
  * pass. Bytes: 116 of its own + 48 N of neighbour VPLs read (each VPL once per
- * image from memory, the rest from cache), 33 written: compute-bound. */
+ * image from memory, the rest from cache), 33 written: compute-bound. A pixel that does not
+ * train this frame: 36 read (20 where guiding does not apply), 1 written. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"

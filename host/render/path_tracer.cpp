@@ -79,8 +79,9 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
   start_paths(g, first, sampler, at, vpls);
   times.shade_ms += ms_since(start);
   run_shadow_rays(n, rays, times);
-  apply_shadow_rays(n, nullptr);
-  compact(n, nullptr);
+  start = Clock::now();
+  apply_shadow_rays_and_compact(n, nullptr);
+  times.compact_ms += ms_since(start);
 
   for (int depth = 1; depth <= settings_.max_bounces && !active_.empty(); ++depth) {
     const std::size_t m = active_.size();
@@ -93,10 +94,13 @@ void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>& f
     shade_bounce(depth, m, vpls, rays);
     times.shade_ms += ms_since(start);
     run_shadow_rays(m, rays, times);
-    apply_shadow_rays(m, &active_);
-    compact(m, &active_);
+    start = Clock::now();
+    apply_shadow_rays_and_compact(m, &active_);
+    times.compact_ms += ms_since(start);
   }
+  start = Clock::now();
   gather(radiance, vpls, nonfinite);
+  times.compact_ms += ms_since(start);
 }
 
 void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
@@ -104,6 +108,7 @@ void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
   if (vpls) vpls->resize(n);
   shadow_rays_.resize(n);
   shadow_work_.resize(n);
+  has_shadow_.resize(n);
   rays_.resize(n);
   hits_.resize(n);
   alive_.assign(n, 0);
@@ -140,6 +145,7 @@ void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSamp
           p.throughput = glm::vec3(0.0f);
           p.vpl_throughput = glm::vec3(1.0f);
           shadow_rays_[i] = inactive_ray();
+          has_shadow_[i] = 0;
           rays_[i] = inactive_ray();
           alive_[i] = 0;
           if (!g.has_surface(i)) continue;
@@ -165,6 +171,7 @@ void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSamp
             shadow_work_[i].contribution = c;
             shadow_work_[i].vpl_contribution = glm::vec3(0.0f);
             shadow_rays_[i] = shadow;
+            has_shadow_[i] = 1;
           }
 
           const FirstBounceSample& fs = first[i];
@@ -214,6 +221,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       const Ray ray = rays_[j];
       const Hit& hit = hits_[j];
       shadow_rays_[j] = inactive_ray();
+      has_shadow_[j] = 0;
       alive_[j] = 0;
       const glm::vec3 dir = glm::normalize(ray.direction);
       if (!hit.valid()) {
@@ -290,6 +298,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         shadow_work_[j].contribution = p.throughput * c;
         shadow_work_[j].vpl_contribution = vpl_throughput * c;
         shadow_rays_[j] = shadow;
+        has_shadow_[j] = 1;
       }
 
       const float u_lobe = shared::pg_rng_next(&rng), v1 = shared::pg_rng_next(&rng),
@@ -412,22 +421,14 @@ void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& 
   times.trace_ms += ms_since(start);
 }
 
-void PathTracer::apply_shadow_rays(std::size_t count, const std::vector<std::uint32_t>* owners) {
-  // Every slot belongs to a different path: no two iterations touch one PathState.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
-    for (std::size_t j = range.begin(); j != range.end(); ++j) {
-      if (occluded_[j] || shadow_rays_[j].tmin > shadow_rays_[j].tmax) continue;
-      PathState& p = paths_[owners ? (*owners)[j] : j];
-      p.radiance += shadow_work_[j].contribution;
-      p.vpl_radiance += shadow_work_[j].vpl_contribution;
-    }
-  });
-}
-
-void PathTracer::compact(std::size_t count, const std::vector<std::uint32_t>* owners) {
+void PathTracer::apply_shadow_rays_and_compact(std::size_t count,
+                                               const std::vector<std::uint32_t>* owners) {
   // A parallel prefix sum of the alive flags gives each survivor its slot, in the serial
   // order (so the frame is the same whatever the thread count); rays move to a second buffer,
-  // as an in-place parallel move could overwrite a ray before it is read.
+  // as an in-place parallel move could overwrite a ray before it is read. The same pass over
+  // the slots adds each unoccluded shadow ray's contribution to its path (every slot belongs
+  // to a different path: no two iterations touch one PathState), so the slots' owners, flags
+  // and shadow results are read once (docs/host-path-tracer.md, "One pass after each vertex").
   slot_.resize(count);
   const std::size_t alive = tbb::parallel_scan(
       tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
@@ -442,11 +443,18 @@ void PathTracer::compact(std::size_t count, const std::vector<std::uint32_t>* ow
   next_active_.resize(alive);
   next_rays_.resize(rays_.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
-    for (std::size_t j = range.begin(); j != range.end(); ++j)
+    for (std::size_t j = range.begin(); j != range.end(); ++j) {
+      const std::uint32_t owner = owners ? (*owners)[j] : static_cast<std::uint32_t>(j);
+      if (has_shadow_[j] && !occluded_[j]) {
+        PathState& p = paths_[owner];
+        p.radiance += shadow_work_[j].contribution;
+        p.vpl_radiance += shadow_work_[j].vpl_contribution;
+      }
       if (alive_[j]) {
         next_rays_[slot_[j]] = rays_[j];
-        next_active_[slot_[j]] = owners ? (*owners)[j] : static_cast<std::uint32_t>(j);
+        next_active_[slot_[j]] = owner;
       }
+    }
   });
   rays_.swap(next_rays_);
   active_.swap(next_active_);

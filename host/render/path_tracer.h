@@ -52,6 +52,9 @@ struct RayCounts {
 
 struct PassTimes {
   double trace_ms = 0.0, shade_ms = 0.0;
+  // Between the passes: shadow rays' results added to their paths, live paths compacted, the
+  // pixel estimates and VPL radiance gathered at the end.
+  double compact_ms = 0.0;
 };
 
 class PathTracer {
@@ -102,10 +105,10 @@ class PathTracer {
                   const glm::vec3& origin, float u_select, float u1, float u2,
                   const CompetingPdf& competing_pdf, glm::vec3& contribution, Ray& shadow) const;
   void run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times);
-  void apply_shadow_rays(std::size_t count, const std::vector<std::uint32_t>* owners);
-  // Keeps the rays of the paths still alive at the front of rays_; active_ becomes their
-  // pixels (owners[j] of slot j, or j itself when owners is null).
-  void compact(std::size_t count, const std::vector<std::uint32_t>* owners);
+  // Adds each unoccluded shadow ray's contribution to its path, and keeps the rays of the
+  // paths still alive at the front of rays_; active_ becomes their pixels (owners[j] of slot
+  // j, or j itself when owners is null).
+  void apply_shadow_rays_and_compact(std::size_t count, const std::vector<std::uint32_t>* owners);
   // What borrow_guide() reads of the pixel a later vertex projects to, in one cache line:
   // the vertices land all over the image, and the G-buffer's channels and the sampler's
   // mixture, read apart, cost a cache miss each (docs/guiding.md, "Later vertices, revisited").
@@ -150,6 +153,7 @@ class PathTracer {
   std::vector<Ray> rays_, shadow_rays_;
   std::vector<Hit> hits_;
   std::vector<std::uint8_t> occluded_;
+  std::vector<std::uint8_t> has_shadow_;  // per slot: 1 where shadow_rays_ holds a segment
   std::vector<ShadowWork> shadow_work_;
   std::vector<BorrowablePixel> borrowable_;  // per pixel, with guide_secondary
 };

@@ -205,6 +205,7 @@ FrameStats Renderer::render_frame(int index) {
   }
   stats.time_ms["trace"] = times.trace_ms;
   stats.time_ms["shade"] = times.shade_ms;
+  stats.time_ms["compact"] = times.compact_ms;
   stats.secondary_rays = rays.secondary;
   stats.shadow_rays = rays.shadow;
   stats.guided_vertices = rays.guided_vertices;

@@ -33,8 +33,8 @@ struct RenderSettings {
 
 struct FrameStats {
   int index = 0;
-  std::map<std::string, double>
-      time_ms;  // "total", "primary", "gbuffer", "sample", "trace", "shade", kernels
+  std::map<std::string, double> time_ms;  // "total", "primary", "gbuffer", "first_bounce", "trace",
+                                          // "shade", "compact" (PassTimes), kernels
   std::uint64_t nonfinite_samples = 0;
   std::uint64_t primary_rays = 0, secondary_rays = 0, shadow_rays = 0;
   std::uint64_t guided_vertices = 0;    // later path vertices that sampled a borrowed guide

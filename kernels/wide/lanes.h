@@ -15,10 +15,11 @@
 #define PG_LANES 8
 #endif
 
-/* The row loads below are small, but PoCL's compiler (clang) kept them out of line, with their
- * output rows passed through memory: 8% of train_wide's time, 12% of sample_wide's
- * (docs/guiding.md, "Training in place; row loads inlined"). Forced inline where the compiler
- * is clang; elsewhere the compiler decides. */
+/* The float4 row loads below (pg_load_float4_rows, pg_load_row_float4_rows) are small, but
+ * PoCL's compiler (clang) kept them out of line, their output rows passed through memory: train
+ * and sample kernels 17% and 11% slower (docs/guiding.md, "Training in place; row loads
+ * inlined"). Forced inline where the compiler is clang, elsewhere its choice. Not the float row
+ * loads: forced inline in the a-trous filter's 25 taps, they made it 30% slower. */
 #ifdef __clang__
 #define PG_ROW_LOAD static inline __attribute__((always_inline))
 #else
