@@ -147,8 +147,8 @@ class PathTracer {
   std::vector<PathState> paths_;
   bool next_event_on_ = true;  // next-event estimation this frame (settings and lights)
   std::vector<std::uint32_t> active_, next_active_;
-  std::vector<std::uint32_t> slot_;  // compact(): each survivor's new slot
-  std::vector<Ray> next_rays_;       // compact(): the survivors' rays, then swapped in
+  std::vector<std::uint32_t> slot_;  // apply_shadow_rays_and_compact(): each survivor's new slot
+  std::vector<Ray> next_rays_;       // the same: the survivors' rays, then swapped in
   std::vector<std::uint8_t> alive_;  // per slot: the path goes on after this vertex
   std::vector<Ray> rays_, shadow_rays_;
   std::vector<Hit> hits_;
