@@ -1,6 +1,7 @@
 /* Guiding state of the previous frame -> this frame (paper 3.1): nearest-neighbour fetch
  * through the motion vector, rejected on position (depth), normal and material differences
- * (pg_same_surface, as SVGF does), and carried into this pixel's hemisphere frame when the
+ * (pg_same_surface, as SVGF does) unless one of that pixel's eight neighbours passes
+ * (pg_history_candidate), and carried into this pixel's hemisphere frame when the
  * normals differ; under a moving camera a glossy pixel's model ages as its view turns
  * (pg_pmm_view_aged_k). Rejected, disoccluded and skipped pixels restart from the initial
  * state (k = 0). */
@@ -25,26 +26,34 @@ __kernel void reproject(PG_ARGS_GBUFFER PG_ARGS_PREV_GBUFFER PG_ARGS_IN_STATE PG
     float2 mv = motion[i];
     int px = (int)floor((float)x + 0.5f + mv.x);
     int py = (int)floor((float)y + 0.5f + mv.y);
-    if (px >= 0 && py >= 0 && px < (int)width && py < (int)height) {
-      uint j = (uint)py * width + (uint)px;
-      float3 n = pg_float4_xyz(shading_normal[i]), m = pg_float4_xyz(prev_shading_normal[j]);
-      if (pg_same_surface(position_depth[i], n, material[i], prev_position_depth[j], m,
-                          prev_material[j], settings.reproject_position,
-                          settings.reproject_normal)) {
-        pg_pmm_state s;
-        s.s0 = in_state0[j];
-        s.s1 = in_state1[j];
-        pg_frame from = pg_frame_from_normal(m), to = pg_frame_from_normal(n);
-        if (pg_pmm_needs_reframe(from, to)) s = pg_pmm_reframe(s, from, to);
-        /* A still camera has motion exactly 0 (docs/design.md); its view directions differ
-         * only by the sub-pixel jitter, which is no change of view. */
-        if (mv.x != 0.0f || mv.y != 0.0f)
-          s.s1.w = pg_pmm_view_aged_k(
-              s.s1.w, pg_float4_xyz(view_dir[i]), pg_float4_xyz(prev_view_dir[j]),
-              pg_material_from_gbuffer(base_color_roughness[i], metallic_specular[i]),
-              settings.reproject_view_memory);
-        if (pg_pmm_state_finite(s)) out = s;
-      }
+    float3 n = pg_float4_xyz(shading_normal[i]), m = (float3)(0.0f);
+    int found = 0;
+    uint j = 0;
+    for (int t = 0; t < PG_HISTORY_CANDIDATES && !found; ++t) {
+      int dx, dy;
+      pg_history_candidate(t, &dx, &dy);
+      int qx = px + dx, qy = py + dy;
+      if (qx < 0 || qy < 0 || qx >= (int)width || qy >= (int)height) continue;
+      j = (uint)qy * width + (uint)qx;
+      m = pg_float4_xyz(prev_shading_normal[j]);
+      found =
+          pg_same_surface(position_depth[i], n, material[i], prev_position_depth[j], m,
+                          prev_material[j], settings.reproject_position, settings.reproject_normal);
+    }
+    if (found) {
+      pg_pmm_state s;
+      s.s0 = in_state0[j];
+      s.s1 = in_state1[j];
+      pg_frame from = pg_frame_from_normal(m), to = pg_frame_from_normal(n);
+      if (pg_pmm_needs_reframe(from, to)) s = pg_pmm_reframe(s, from, to);
+      /* A still camera has motion exactly 0 (docs/design.md); its view directions differ
+       * only by the sub-pixel jitter, which is no change of view. */
+      if (mv.x != 0.0f || mv.y != 0.0f)
+        s.s1.w = pg_pmm_view_aged_k(
+            s.s1.w, pg_float4_xyz(view_dir[i]), pg_float4_xyz(prev_view_dir[j]),
+            pg_material_from_gbuffer(base_color_roughness[i], metallic_specular[i]),
+            settings.reproject_view_memory);
+      if (pg_pmm_state_finite(s)) out = s;
     }
   }
   out_state0[i] = out.s0;

@@ -22,6 +22,26 @@ PG_FN int pg_same_surface(float4 position_depth, float3 normal, uint material,
          prev_position_depth.w > 0.0f;
 }
 
+/* Where guiding's reprojection looks for last frame's pixel showing this pixel's surface, t = 0
+ * .. PG_HISTORY_CANDIDATES - 1, first match wins: the pixel the motion vector lands on, then its
+ * four edge neighbours, then its diagonal ones. The camera's sub-pixel jitter makes a pixel on a
+ * geometric edge see one surface in one frame and the other in the next; the nearest pixel alone
+ * would reject its history every frame there (docs/guiding.md, "History from the neighbourhood").
+ */
+#define PG_HISTORY_CANDIDATES 9
+PG_FN void pg_history_candidate(int t, PG_PRIVATE int* dx, PG_PRIVATE int* dy) {
+  if (t == 0) {
+    *dx = 0;
+    *dy = 0;
+  } else if (t <= 4) { /* (0,-1), (-1,0), (1,0), (0,1) */
+    *dx = t == 2 ? -1 : (t == 3 ? 1 : 0);
+    *dy = t == 1 ? -1 : (t == 4 ? 1 : 0);
+  } else { /* (-1,-1), (1,-1), (-1,1), (1,1) */
+    *dx = ((t - 5) & 1) != 0 ? 1 : -1;
+    *dy = ((t - 5) & 2) != 0 ? 1 : -1;
+  }
+}
+
 PG_NAMESPACE_END
 
 #endif
