@@ -6,7 +6,8 @@
 // 20% guide-strategy and 10% escaped ones) and trained-like states (k spread over 0..kMax).
 //
 //   bench_guiding_kernels               1280x720 local-size sweep, 1920x1080 at 16x16 and auto,
-//                                       TBB train at 1280x720
+//                                       TBB train at 1280x720, one frame's host-device copies
+//                                       at 960x540 and 1920x1080
 //   bench_guiding_kernels --rtpg_full   also the local-size sweep and TBB train at 1920x1080
 //
 // Time is the kernel's OpenCL profiling-event time (manual time); every configuration's first
@@ -44,6 +45,9 @@
 //              metallic 4x16; guided + state 32
 //   train      state in 32 + out 32 + flags 4 + bcr 16 + trained 1 + VPLs 48; guided +
 //              position, normal, view, metallic 4x16
+// FrameTraffic/WxH/{pageable,pinned}: one guided frame's copies between host and device when
+// they do not share memory (G-buffer and VPLs up, samples down: bytes_per_pixel) and the rate
+// they reach (host_device_GBps), from std::vector or from pinned staging memory.
 // TrainTbb runs train.cl's loop (global-memory variant) as plain C++ over TBB on the same
 // inputs, calling the same shared functions, and reports kernel_over_tbb = kernel ms / TBB ms
 // from both run in every iteration.
@@ -574,6 +578,131 @@ void BM_TrainTbb(benchmark::State& state, int w, int h) {
   state.counters["tbb_threads"] = tbb::this_task_arena::max_concurrency();
 }
 
+// ---- host-device traffic of one guided frame ------------------------------------------------
+
+// What crosses the bus each frame when the device does not share host memory
+// (host/render/guided_first_bounce.cpp): the G-buffer and the VPLs up, the samples down, through
+// the library's own enqueue_upload/enqueue_download. `pageable`: from and into std::vector, as
+// the renderer does today; `pinned`: the same copies from and into mapped CL_MEM_ALLOC_HOST_PTR
+// staging memory, the way a discrete GPU's driver copies fastest (the number to plan the packing
+// of issue 10 against). Wall time from the first enqueue to the queue's finish.
+#define RTPG_BENCH_CHANNEL(name, type, bytes) std::vector<sh::type> name;
+struct HostSamples {
+  PG_SAMPLE_CHANNELS(RTPG_BENCH_CHANNEL)
+};
+#undef RTPG_BENCH_CHANNEL
+
+// A channel's host memory viewed as the container enqueue_write/enqueue_read take.
+template <class T>
+struct MappedChannel {
+  using value_type = T;
+  T* ptr = nullptr;
+  std::size_t count = 0;
+  std::size_t size() const { return count; }
+  T* data() const { return ptr; }
+};
+
+struct PinnedFrame {
+  std::vector<cl::Buffer> staging;  // kept alive (and mapped) while the views point into them
+#define RTPG_BENCH_MAPPED(name, type, bytes) MappedChannel<sh::type> name;
+  struct G {
+    PG_GBUFFER_CHANNELS(RTPG_BENCH_MAPPED)
+  } gbuffer;
+  struct V {
+    PG_VPL_CHANNELS(RTPG_BENCH_MAPPED)
+  } vpls;
+  struct S {
+    PG_SAMPLE_CHANNELS(RTPG_BENCH_MAPPED)
+  } samples;
+#undef RTPG_BENCH_MAPPED
+  template <class T>
+  void map(MappedChannel<T>& c, std::size_t n) {
+    staging.emplace_back(runtime().context(), CL_MEM_ALLOC_HOST_PTR, n * sizeof(T));
+    c.ptr = static_cast<T*>(runtime().queue().enqueueMapBuffer(
+        staging.back(), CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, n * sizeof(T)));
+    c.count = n;
+  }
+  PinnedFrame(const Inputs& in) {
+#define RTPG_BENCH_FILL(name, type, bytes) \
+  map(gbuffer.name, in.n);                 \
+  std::copy(in.cur.name.begin(), in.cur.name.end(), gbuffer.name.ptr);
+    PG_GBUFFER_CHANNELS(RTPG_BENCH_FILL)
+#undef RTPG_BENCH_FILL
+#define RTPG_BENCH_FILL(name, type, bytes) \
+  map(vpls.name, in.n);                    \
+  std::copy(in.vpls.name.begin(), in.vpls.name.end(), vpls.name.ptr);
+    PG_VPL_CHANNELS(RTPG_BENCH_FILL)
+#undef RTPG_BENCH_FILL
+#define RTPG_BENCH_FILL(name, type, bytes) map(samples.name, in.n);
+    PG_SAMPLE_CHANNELS(RTPG_BENCH_FILL)
+#undef RTPG_BENCH_FILL
+  }
+  ~PinnedFrame() {
+    try {
+      std::size_t i = 0;
+      auto unmap = [&](void* p) { runtime().queue().enqueueUnmapMemObject(staging.at(i++), p); };
+#define RTPG_BENCH_UNMAP(name, type, bytes) unmap(gbuffer.name.ptr);
+      PG_GBUFFER_CHANNELS(RTPG_BENCH_UNMAP)
+#undef RTPG_BENCH_UNMAP
+#define RTPG_BENCH_UNMAP(name, type, bytes) unmap(vpls.name.ptr);
+      PG_VPL_CHANNELS(RTPG_BENCH_UNMAP)
+#undef RTPG_BENCH_UNMAP
+#define RTPG_BENCH_UNMAP(name, type, bytes) unmap(samples.name.ptr);
+      PG_SAMPLE_CHANNELS(RTPG_BENCH_UNMAP)
+#undef RTPG_BENCH_UNMAP
+      runtime().queue().finish();
+    } catch (...) {  // teardown of a benchmark: nothing left to protect
+    }
+  }
+};
+
+template <class G, class V, class S>
+double frame_traffic(Inputs& in, const G& gbuffer, const V& vpls, S& samples) {
+  const auto start = std::chrono::steady_clock::now();
+  cl::CommandQueue& q = runtime().queue();
+  enqueue_upload(q, gbuffer, in.d_cur);
+  enqueue_upload(q, vpls, in.d_vpls);
+  enqueue_download(q, in.d_samples, samples);
+  q.finish();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+void BM_FrameTraffic(benchmark::State& state, int w, int h, bool pinned) {
+  Inputs& in = inputs_for(w, h);
+  constexpr std::size_t kBytes =
+#define RTPG_BENCH_ADD(name, type, bytes) +(bytes)
+      0 PG_GBUFFER_CHANNELS(RTPG_BENCH_ADD) PG_VPL_CHANNELS(RTPG_BENCH_ADD)
+          PG_SAMPLE_CHANNELS(RTPG_BENCH_ADD);
+#undef RTPG_BENCH_ADD
+  std::unique_ptr<PinnedFrame> staged;
+  HostSamples host_samples;
+  if (pinned) {
+    staged = std::make_unique<PinnedFrame>(in);
+  } else {
+#define RTPG_BENCH_RESIZE(name, type, bytes) host_samples.name.resize(in.n);
+    PG_SAMPLE_CHANNELS(RTPG_BENCH_RESIZE)
+#undef RTPG_BENCH_RESIZE
+  }
+  auto once = [&] {
+    return pinned ? frame_traffic(in, staged->gbuffer, staged->vpls, staged->samples)
+                  : frame_traffic(in, in.cur, in.vpls, host_samples);
+  };
+  once();  // first copies: the driver's page locking and staging allocations, untimed
+  double ms_total = 0.0;
+  for (auto _ : state) {
+    const double ms = once();
+    state.SetIterationTime(ms * 1e-3);
+    ms_total += ms;
+  }
+  const double it = static_cast<double>(state.iterations());
+  state.SetItemsProcessed(static_cast<std::int64_t>(in.n) * state.iterations());
+  state.SetBytesProcessed(static_cast<std::int64_t>(kBytes * in.n) * state.iterations());
+  state.counters["bytes_per_pixel"] = static_cast<double>(kBytes);
+  state.counters["host_device_GBps"] =
+      static_cast<double>(kBytes * in.n) * it / (ms_total * 1e-3) * 1e-9;
+}
+
 // ---- registration ----------------------------------------------------------------------------
 
 void register_all(bool full) {
@@ -618,6 +747,17 @@ void register_all(bool full) {
               Kernel::Train, M::Global, lanes);
     }
   }
+  // The bus at the suite's resolution and at 1080p; on a device that shares host memory this is
+  // what the renderer avoids by reading the host's buffers in place.
+  for (auto [w, h] : std::vector<std::pair<int, int>>{{960, 540}, {1920, 1080}})
+    for (bool pinned : {false, true})
+      benchmark::RegisterBenchmark(("FrameTraffic/" + std::to_string(w) + "x" + std::to_string(h) +
+                                    (pinned ? "/pinned" : "/pageable"))
+                                       .c_str(),
+                                   BM_FrameTraffic, w, h, pinned)
+          ->UseManualTime()
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(0.2);
   for (auto [w, h] : sizes) {
     if (w != 1280 && !full) continue;
     benchmark::RegisterBenchmark(

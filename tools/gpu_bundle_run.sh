@@ -2,7 +2,8 @@
 # run.sh of a bundle made by tools/gpu_bundle.sh: the OpenCL tests, then the guiding kernels'
 # roofline benchmark, on RTPG_DEVICE (default gpu); the binaries embed the kernels and read no
 # other file. Logs go to OUT (default DIR/out): tests.log, bench.log, bench.json, devices.log.
-# TESTS (binary names) narrows the tests; NO_BENCH=1 skips the benchmark.
+# TESTS (binary names) narrows the tests; NO_BENCH=1 skips the benchmark; BENCH_FILTER replaces
+# its default filter (the yardsticks, the three kernels at 1280x720 and one frame's bus traffic).
 # Exit status: the number of test binaries that failed, 0 if none.
 set -uo pipefail
 dir=$(cd "$(dirname "$0")" && pwd)
@@ -35,8 +36,8 @@ grep -E '^\[  FAILED  \] [A-Za-z]' "$out/tests.log" | sort -u
 if [ -z "${NO_BENCH:-}" ]; then
   # One repetition: on a GPU each configuration is already the mean of thousands of launches.
   "$dir/bin/bench_guiding_kernels" --benchmark_repetitions=1 \
-    --benchmark_filter='^(CopyFloat4|FmaPeak|(Reproject|Sample|Train)/1280x720/local:auto(/memory:global)?/min)' \
+    --benchmark_filter="${BENCH_FILTER:-^(CopyFloat4|FmaPeak|(Reproject|Sample|Train)/1280x720/local:auto(/memory:global)?/min|FrameTraffic/960x540)}" \
     --benchmark_out="$out/bench.json" --benchmark_out_format=json > "$out/bench.log" 2>&1
-  grep -E 'manual_time' "$out/bench.log"
+  grep -E 'manual_time|ERROR' "$out/bench.log"
 fi
 exit "$failed"
