@@ -11,7 +11,7 @@
 namespace rtpg {
 namespace {
 
-static_assert(sizeof(shared::pg_svgf_settings) == 10 * 4, "pg_svgf_settings: 4-byte fields only");
+static_assert(sizeof(shared::pg_svgf_settings) == 11 * 4, "pg_svgf_settings: 4-byte fields only");
 static_assert(sizeof(glm::vec4) == sizeof(cl_float4), "glm::vec4 must match cl_float4");
 
 // Bytes per pixel the upload of one frame copies: colour, emission, position_depth,
@@ -40,15 +40,22 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
     throw InputError("svgf", "image size must be positive, got " + std::to_string(width) + "x" +
                                  std::to_string(height));
   kernel_settings_ = to_kernel_settings(settings);
-  temporal_ = runtime.kernel("svgf_temporal.cl", "svgf_temporal");
+  // The filters' edge-stopping weights run through exp() down into float's denormal range (a
+  // tap's weight ~1e-20 squared for the variance), where x86 cores take a slow path per
+  // operation: denormals flushed to zero made the a-trous pass 3.9x faster on Sponza and change
+  // no output above 1e-37 (docs/denoising.md, "Denormals"). An OpenCL 1.2 build option, a hint
+  // any device may ignore; the guiding kernels keep denormals (their host references carry a
+  // decaying sample count through that range).
+  const std::string options = "-cl-denorms-are-zero";
+  temporal_ = runtime.kernel("svgf_temporal.cl", "svgf_temporal", options);
   lanes_ = settings.lanes != 0 ? settings.lanes : runtime.info().simd_lanes();
-  const std::string lanes_option = "-DPG_LANES=" + std::to_string(lanes_);
+  const std::string wide_options = options + " -DPG_LANES=" + std::to_string(lanes_);
   variance_ = lanes_ > 1
-                  ? runtime.kernel("svgf_variance_wide.cl", "svgf_variance_wide", lanes_option)
-                  : runtime.kernel("svgf_variance.cl", "svgf_variance");
-  atrous_ = lanes_ > 1 ? runtime.kernel("svgf_atrous_wide.cl", "svgf_atrous_wide", lanes_option)
-                       : runtime.kernel("svgf_atrous.cl", "svgf_atrous");
-  remodulate_ = runtime.kernel("svgf_remodulate.cl", "svgf_remodulate");
+                  ? runtime.kernel("svgf_variance_wide.cl", "svgf_variance_wide", wide_options)
+                  : runtime.kernel("svgf_variance.cl", "svgf_variance", options);
+  atrous_ = lanes_ > 1 ? runtime.kernel("svgf_atrous_wide.cl", "svgf_atrous_wide", wide_options)
+                       : runtime.kernel("svgf_atrous.cl", "svgf_atrous", options);
+  remodulate_ = runtime.kernel("svgf_remodulate.cl", "svgf_remodulate", options);
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   translate_cl_errors([&] {
     const std::vector<std::size_t> max_items =

@@ -131,6 +131,24 @@ void SvgfReference::temporal(const std::vector<glm::vec4>& colour, const GBuffer
           sum_moments += w * prev_moments_[j];
           sum_weight += w;
         }
+        if (sum_weight < PG_SVGF_MIN_TAP_WEIGHT && s.history_fallback != 0u) {
+          sum_history = glm::vec3(0.0f);
+          sum_moments = glm::vec4(0.0f);
+          sum_weight = 0.0f;
+          for (int t = 0; t < PG_HISTORY_CANDIDATES; ++t) {
+            int px = 0, py = 0;
+            sh::pg_svgf_neighbourhood_tap(position, t, &px, &py);
+            if (px < 0 || py < 0 || px >= width_ || py >= height_) continue;
+            const std::size_t j = static_cast<std::size_t>(py) * width_ + px;
+            if (!sh::pg_same_surface(pd, n, g.material[i], prev_position_depth_[j],
+                                     xyz(prev_normal_[j]), prev_material_[j], s.reproject_position,
+                                     s.reproject_normal))
+              continue;
+            sum_history += xyz(history_[j]);
+            sum_moments += prev_moments_[j];
+            sum_weight += 1.0f;
+          }
+        }
       }
       float length = 1.0f;
       glm::vec3 c = illumination;

@@ -35,6 +35,9 @@ const std::vector<SvgfSettingInfo>& svgf_settings_table() {
            "Normal cosine below which history is rejected"),
       real("albedo_floor", &S::albedo_floor, 0, 1, true, false,
            "Demodulation divides by max(albedo, this)"),
+      integer("history_fallback", &S::history_fallback, 0, 1,
+              "1: where no bilinear tap keeps history, the 3x3 neighbourhood's same-surface pixels "
+              "(SVGF's reference implementation); 0: the history restarts there"),
       integer("iterations", &S::iterations, 1, 12, "A-trous iterations (steps 1, 2, 4, ...)"),
       integer("history_iteration", &S::history_iteration, 0, 11,
               "The a-trous iteration (from 0) whose output is the next frame's history"),
@@ -81,6 +84,7 @@ shared::pg_svgf_settings to_kernel_settings(const SvgfSettings& c) {
   p.reproject_position = c.reproject_position;
   p.reproject_normal = c.reproject_normal;
   p.albedo_floor = c.albedo_floor;
+  p.history_fallback = static_cast<std::uint32_t>(c.history_fallback);
   return p;
 }
 

@@ -23,11 +23,16 @@ struct SvgfSettings {
   float reproject_position = 0.05f;  // history test, as guiding's: relative position change
   float reproject_normal = 0.9f;     // ... and normal cosine
   float albedo_floor = 1e-3f;        // demodulation divides by max(albedo, albedo_floor)
-  int iterations = 5;                // a-trous iterations (steps 1, 2, 4, ...)
-  int history_iteration = 0;         // the iteration whose output is next frame's history
-  int local_x = 0, local_y = 0;      // work-group size of the kernels; 0 and 0 = per device:
-                                     // on CPUs temporal and remodulate in rows, the filters in
-                                     // 16x16; 16x16 elsewhere (host/cl/work_groups.h)
+  // 1: where none of the bilinear taps of last frame shows this pixel's surface, the same-surface
+  // pixels of the 3x3 around the back-projected one, equally weighted (the fallback of SVGF's
+  // reference implementation; docs/denoising.md, "History from the neighbourhood"); 0: the
+  // history restarts there.
+  int history_fallback = 1;
+  int iterations = 5;            // a-trous iterations (steps 1, 2, 4, ...)
+  int history_iteration = 0;     // the iteration whose output is next frame's history
+  int local_x = 0, local_y = 0;  // work-group size of the kernels; 0 and 0 = per device:
+                                 // on CPUs temporal and remodulate in rows, the filters in
+                                 // 16x16; 16x16 elsewhere (host/cl/work_groups.h)
   // Pixels per work-item of the variance and a-trous kernels: 1 (svgf_variance.cl,
   // svgf_atrous.cl), or 2, 4, 8, 16 in vector lanes (svgf_variance_wide.cl,
   // svgf_atrous_wide.cl); 0 = the device's SIMD width on CPUs, 1 elsewhere

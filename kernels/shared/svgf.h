@@ -42,6 +42,7 @@ typedef struct pg_svgf_settings {
   float reproject_position; /* history test (shared/same_surface.h): relative distance */
   float reproject_normal;   /* ... and normal cosine */
   float albedo_floor;       /* demodulation divides by max(albedo, albedo_floor) */
+  uint history_fallback;    /* 1: the 3x3 neighbourhood where no bilinear tap keeps history */
 } pg_svgf_settings;
 
 /* Below this a depth slope counts as flat: keeps phi_z above 0 for surfaces facing the camera,
@@ -110,6 +111,20 @@ PG_FN float pg_svgf_bilinear_tap(float2 position, int t, PG_PRIVATE int* px, PG_
   *px = (int)fx + dx;
   *py = (int)fy + dy;
   return (dx != 0 ? ax : 1.0f - ax) * (dy != 0 ? ay : 1.0f - ay);
+}
+
+/* Where no bilinear tap shows this pixel's surface, SVGF's reference implementation filters the
+ * 3x3 pixels around the back-projected position instead, each same-surface one with weight 1:
+ * under the camera's sub-pixel jitter a pixel on a silhouette or crease sees the other surface
+ * at its bilinear taps in about half the frames, and would restart its history each time
+ * (docs/denoising.md, "History from the neighbourhood"). Tap t (0 .. PG_HISTORY_CANDIDATES - 1,
+ * the order of guiding's reprojection) around the nearest pixel. */
+PG_FN void pg_svgf_neighbourhood_tap(float2 position, int t, PG_PRIVATE int* px,
+                                     PG_PRIVATE int* py) {
+  int dx = 0, dy = 0;
+  pg_history_candidate(t, &dx, &dy);
+  *px = (int)floor(position.x + 0.5f) + dx;
+  *py = (int)floor(position.y + 0.5f) + dy;
 }
 
 /* The blend weight of the new frame: the running mean while the history is short (1 / length),

@@ -326,43 +326,61 @@ TEST(SvgfKernels, ZeroCopyEqualsCopying) {
 // Boxes that moved 3 pixels over a still floor: history is kept where last frame showed the
 // same surface at the back-projected position (length 2 after two frames) and dropped where it
 // did not (floor the boxes uncovered, box pixels that came in across the image border: 1).
+// History is kept where last frame's pixel under the motion vector shows the same surface; where
+// it does not, with history_fallback (the default) where one of its 3x3 neighbours does, and
+// nowhere else.
 TEST(SvgfKernels, ReprojectionKeepsHistoryOnlyOnTheSameSurface) {
   ClRuntime rt;
   const int w = simulated(rt) ? 24 : 64, h = simulated(rt) ? 12 : 32;
-  std::mt19937 rng(5);
-  const GBuffer g0 = scene_gbuffer(w, h, 0.0f, rng);
-  const GBuffer g1 = scene_gbuffer(w, h, 3.0f, rng);
-  SvgfDenoiser device(rt, w, h);
-  SvgfReference host(w, h);
-  for (const GBuffer* g : {&g0, &g1}) {
-    const std::vector<glm::vec4> colour = noisy_colour(*g, rng);
-    device.denoise(colour, *g);
-    host.denoise(colour, *g);
-  }
-  const std::vector<glm::vec4> moments = device.read(SvgfStage::Moments);
-  int kept = 0, dropped = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      if (!g1.has_surface(i)) {
-        EXPECT_EQ(moments[i].z, 0.0f);
-        continue;
-      }
-      // Motion is a whole number of pixels (0 or -3): one bilinear tap, the pixel it points at.
-      const int px = x + static_cast<int>(g1.motion[i].x);
-      bool same = px >= 0;
-      if (same) {
-        const std::size_t j = static_cast<std::size_t>(y) * w + px;
-        same = g0.has_surface(j) && g0.material[j] == g1.material[i] &&
-               std::fabs(g0.position_depth[j].w - g1.position_depth[i].w) <
-                   0.05f * g1.position_depth[i].w;
-      }
-      EXPECT_EQ(moments[i].z, same ? 2.0f : 1.0f) << "pixel " << x << "," << y;
-      (same ? kept : dropped)++;
+  for (int fallback : {0, 1}) {
+    SCOPED_TRACE("history_fallback " + std::to_string(fallback));
+    std::mt19937 rng(5);
+    const GBuffer g0 = scene_gbuffer(w, h, 0.0f, rng);
+    const GBuffer g1 = scene_gbuffer(w, h, 3.0f, rng);
+    SvgfSettings settings;
+    settings.history_fallback = fallback;
+    SvgfDenoiser device(rt, w, h, settings);
+    SvgfReference host(w, h, settings);
+    for (const GBuffer* g : {&g0, &g1}) {
+      const std::vector<glm::vec4> colour = noisy_colour(*g, rng);
+      device.denoise(colour, *g);
+      host.denoise(colour, *g);
     }
-  EXPECT_GT(kept, 0);
-  EXPECT_GT(dropped, 0);
-  expect_close(moments, host.stage(SvgfStage::Moments), "moments", 2e-4f);
+    const std::vector<glm::vec4> moments = device.read(SvgfStage::Moments);
+    // Does frame 0's pixel (px, py) show frame 1's pixel i's surface?
+    const auto same_at = [&](std::size_t i, int px, int py) {
+      if (px < 0 || py < 0 || px >= w || py >= h) return false;
+      const std::size_t j = static_cast<std::size_t>(py) * w + px;
+      return g0.has_surface(j) && g0.material[j] == g1.material[i] &&
+             std::fabs(g0.position_depth[j].w - g1.position_depth[i].w) <
+                 0.05f * g1.position_depth[i].w;
+    };
+    int kept = 0, dropped = 0, from_neighbours = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * w + x;
+        if (!g1.has_surface(i)) {
+          EXPECT_EQ(moments[i].z, 0.0f);
+          continue;
+        }
+        // Motion is a whole number of pixels (0 or -3): one bilinear tap, the pixel it points at.
+        const int px = x + static_cast<int>(g1.motion[i].x);
+        bool same = same_at(i, px, y);
+        if (!same && fallback != 0) {
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) same = same || same_at(i, px + dx, y + dy);
+          from_neighbours += same;
+        }
+        EXPECT_EQ(moments[i].z, same ? 2.0f : 1.0f) << "pixel " << x << "," << y;
+        (same ? kept : dropped)++;
+      }
+    EXPECT_GT(kept, 0);
+    EXPECT_GT(dropped, 0);
+    if (fallback != 0) {
+      EXPECT_GT(from_neighbours, 0);
+    }
+    expect_close(moments, host.stage(SvgfStage::Moments), "moments", 2e-4f);
+  }
 }
 
 TEST(SvgfKernels, BadInputIsAClearError) {
