@@ -592,19 +592,9 @@ struct HostSamples {
 };
 #undef RTPG_BENCH_CHANNEL
 
-// A channel's host memory viewed as the container enqueue_write/enqueue_read take.
-template <class T>
-struct MappedChannel {
-  using value_type = T;
-  T* ptr = nullptr;
-  std::size_t count = 0;
-  std::size_t size() const { return count; }
-  T* data() const { return ptr; }
-};
-
 struct PinnedFrame {
   std::vector<cl::Buffer> staging;  // kept alive (and mapped) while the views point into them
-#define RTPG_BENCH_MAPPED(name, type, bytes) MappedChannel<sh::type> name;
+#define RTPG_BENCH_MAPPED(name, type, bytes) HostChannelView<sh::type> name;
   struct G {
     PG_GBUFFER_CHANNELS(RTPG_BENCH_MAPPED)
   } gbuffer;
@@ -616,21 +606,21 @@ struct PinnedFrame {
   } samples;
 #undef RTPG_BENCH_MAPPED
   template <class T>
-  void map(MappedChannel<T>& c, std::size_t n) {
+  void map(HostChannelView<T>& c, std::size_t n) {
     staging.emplace_back(runtime().context(), CL_MEM_ALLOC_HOST_PTR, n * sizeof(T));
-    c.ptr = static_cast<T*>(runtime().queue().enqueueMapBuffer(
+    c.pointer = static_cast<T*>(runtime().queue().enqueueMapBuffer(
         staging.back(), CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, n * sizeof(T)));
     c.count = n;
   }
   PinnedFrame(const Inputs& in) {
 #define RTPG_BENCH_FILL(name, type, bytes) \
   map(gbuffer.name, in.n);                 \
-  std::copy(in.cur.name.begin(), in.cur.name.end(), gbuffer.name.ptr);
+  std::copy(in.cur.name.begin(), in.cur.name.end(), gbuffer.name.pointer);
     PG_GBUFFER_CHANNELS(RTPG_BENCH_FILL)
 #undef RTPG_BENCH_FILL
 #define RTPG_BENCH_FILL(name, type, bytes) \
   map(vpls.name, in.n);                    \
-  std::copy(in.vpls.name.begin(), in.vpls.name.end(), vpls.name.ptr);
+  std::copy(in.vpls.name.begin(), in.vpls.name.end(), vpls.name.pointer);
     PG_VPL_CHANNELS(RTPG_BENCH_FILL)
 #undef RTPG_BENCH_FILL
 #define RTPG_BENCH_FILL(name, type, bytes) map(samples.name, in.n);
@@ -641,13 +631,13 @@ struct PinnedFrame {
     try {
       std::size_t i = 0;
       auto unmap = [&](void* p) { runtime().queue().enqueueUnmapMemObject(staging.at(i++), p); };
-#define RTPG_BENCH_UNMAP(name, type, bytes) unmap(gbuffer.name.ptr);
+#define RTPG_BENCH_UNMAP(name, type, bytes) unmap(gbuffer.name.pointer);
       PG_GBUFFER_CHANNELS(RTPG_BENCH_UNMAP)
 #undef RTPG_BENCH_UNMAP
-#define RTPG_BENCH_UNMAP(name, type, bytes) unmap(vpls.name.ptr);
+#define RTPG_BENCH_UNMAP(name, type, bytes) unmap(vpls.name.pointer);
       PG_VPL_CHANNELS(RTPG_BENCH_UNMAP)
 #undef RTPG_BENCH_UNMAP
-#define RTPG_BENCH_UNMAP(name, type, bytes) unmap(samples.name.ptr);
+#define RTPG_BENCH_UNMAP(name, type, bytes) unmap(samples.name.pointer);
       PG_SAMPLE_CHANNELS(RTPG_BENCH_UNMAP)
 #undef RTPG_BENCH_UNMAP
       runtime().queue().finish();

@@ -40,11 +40,30 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
   }
   samples_ =
       make_guider_samples(runtime.context(), width, height, zero_copy_ ? CL_MEM_ALLOC_HOST_PTR : 0);
+  if (!zero_copy_) {
+    staging_ = make_guider_samples(runtime.context(), width, height, CL_MEM_ALLOC_HOST_PTR);
+    translate_cl_errors([&] {
+      cl::CommandQueue& q = runtime_.queue();
+#define RTPG_MAP_STAGING(name, type, bytes)                                              \
+  staged_.name.count = pixels_;                                                          \
+  staged_.name.pointer = static_cast<decltype(staged_.name.pointer)>(q.enqueueMapBuffer( \
+      staging_.name, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, pixels_ * (bytes)));
+      PG_SAMPLE_CHANNELS(RTPG_MAP_STAGING)
+#undef RTPG_MAP_STAGING
+    });
+  }
 }
 
 GuidedFirstBounce::~GuidedFirstBounce() {
   try {
     unmap_samples();
+    if (!zero_copy_) {
+      cl::CommandQueue& q = runtime_.queue();
+#define RTPG_UNMAP_STAGING(name, type, bytes) \
+  q.enqueueUnmapMemObject(staging_.name, staged_.name.pointer);
+      PG_SAMPLE_CHANNELS(RTPG_UNMAP_STAGING)
+#undef RTPG_UNMAP_STAGING
+    }
     runtime_.queue().finish();
   } catch (...) {  // a failing queue at teardown has nothing left to corrupt
   }
@@ -116,17 +135,13 @@ void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
       q.finish();
     });
   } else {
-    host_samples_.direction_pdf.resize(n);
-    host_samples_.strategy.resize(n);
-    host_samples_.mixture_a.resize(n);
-    host_samples_.mixture_b.resize(n);
-    enqueue_download(runtime_.queue(), samples_, host_samples_);
+    enqueue_download(runtime_.queue(), samples_, staged_);
     translate_cl_errors([&] { runtime_.queue().finish(); });
     bytes_ += kSampleBytes * n;
-    view_.direction_pdf = host_samples_.direction_pdf.data();
-    view_.strategy = host_samples_.strategy.data();
-    view_.mixture_a = host_samples_.mixture_a.data();
-    view_.mixture_b = host_samples_.mixture_b.data();
+    view_.direction_pdf = staged_.direction_pdf.data();
+    view_.strategy = staged_.strategy.data();
+    view_.mixture_a = staged_.mixture_a.data();
+    view_.mixture_b = staged_.mixture_b.data();
   }
   readback_ms_ += ms_since(t);
   out.resize(n);

@@ -59,16 +59,20 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   GuiderVpls owned_vpls_;
   GuiderSamples samples_;
   // Where the device shares host memory the samples are read in place (mapped from the time
-  // sample() returns until the next sample() or the end), else copied into host_samples_.
+  // sample() returns until the next sample() or the end). Elsewhere they are copied into
+  // staging_, host memory the OpenCL runtime allocates (CL_MEM_ALLOC_HOST_PTR) and that stays
+  // mapped: a discrete GPU's driver copies into such (pinned) memory about 5x faster than into
+  // pageable memory (docs/guiding.md, "On a GPU"). Its mapped pointers are staged_.
   void unmap_samples();
   bool zero_copy_ = false, mapped_ = false;
-  struct HostSamples {  // PG_SAMPLE_CHANNELS on the host
-    std::vector<glm::vec4> direction_pdf;
-    std::vector<std::uint32_t> strategy;
-    std::vector<glm::vec4> mixture_a;  // what pdf() evaluates
-    std::vector<glm::vec2> mixture_b;
-  } host_samples_;
-  struct SampleView {  // this frame's samples, in host_samples_ or mapped
+  GuiderSamples staging_;
+  struct HostSamples {  // PG_SAMPLE_CHANNELS in staging_
+    HostChannelView<glm::vec4> direction_pdf;
+    HostChannelView<std::uint32_t> strategy;
+    HostChannelView<glm::vec4> mixture_a;  // what pdf() evaluates
+    HostChannelView<glm::vec2> mixture_b;
+  } staged_;
+  struct SampleView {  // this frame's samples, in staging_ or mapped
     const glm::vec4* direction_pdf = nullptr;
     const std::uint32_t* strategy = nullptr;
     const glm::vec4* mixture_a = nullptr;

@@ -88,8 +88,20 @@ void enqueue_read(cl::CommandQueue& queue, const cl::Buffer& buffer, Channel& ho
 }
 }  // namespace detail
 
+// A channel in host memory the caller owns (mapped staging, say): what enqueue_upload and
+// enqueue_download take besides std::vector.
+template <class T>
+struct HostChannelView {
+  using value_type = T;
+  T* pointer = nullptr;
+  std::size_t count = 0;
+  std::size_t size() const { return count; }
+  T* data() const { return pointer; }
+};
+
 // Host <-> device copies of every channel, for any host struct whose members are named as the
-// channels and hold them contiguously (std::vector<glm::vec4>, std::vector<uint32_t>, ...).
+// channels and hold them contiguously (std::vector<glm::vec4>, std::vector<uint32_t>,
+// HostChannelView, ...).
 // Non-blocking: the host data must live until the queue has finished them.
 template <class HostGBuffer>
 void enqueue_upload(cl::CommandQueue& queue, const HostGBuffer& host, const GuiderGBuffer& dev) {
