@@ -301,11 +301,20 @@ def denoised(ctx, scene):
             flicker = [f["flicker_mse"] for f in stats["frames"] if "flicker_mse" in f]
             flicker_noisy = [f["flicker_mse_noisy"] for f in stats["frames"] if "flicker_mse_noisy" in f]
             fm, fs = runner.mean_sem(flicker)
+            # Through the motion vectors, on the displayed values (docs/design.md, "Metrics"): the
+            # plain consecutive-frame MSE above is mostly the picture moving.
+            tracked = [f for f in stats["frames"] if "flicker_reprojected" in f]
+            rm, rs = runner.mean_sem(f["flicker_reprojected"] for f in tracked)
             result["path"][method] = {"frames": frames,
                                       "relmse": [metrics.relmse(imgs[f], refs[f]) for f in frames],
                                       "flip_ldr": [metrics.flip_ldr(imgs[f], refs[f], exposure) for f in frames],
                                       "flicker_mse": fm, "flicker_sem": fs,
-                                      "flicker_mse_noisy": runner.mean_sem(flicker_noisy)[0]}
+                                      "flicker_mse_noisy": runner.mean_sem(flicker_noisy)[0],
+                                      "flicker_reprojected": rm, "flicker_reprojected_sem": rs,
+                                      "flicker_reprojected_noisy":
+                                          runner.mean_sem(f["flicker_reprojected_noisy"] for f in tracked)[0],
+                                      "flicker_tracked_fraction":
+                                          runner.mean_sem(f["flicker_tracked_fraction"] for f in tracked)[0]}
     flips = {k: result["static"][k]["flip_ldr"] for k in METHODS}
     result["figure"] = comparison_figure(
         ref, images, ("Reference", f"PT+SVGF  FLIP {flips['off']:.3f}", f"PG+SVGF  FLIP {flips['pmm']:.3f}"),

@@ -169,8 +169,10 @@ def _denoised(ex, report_dir, settings):
                      f"| {pt['flip_ldr_noisy']:.3f} / {pg['flip_ldr_noisy']:.3f} |")
     lines += ["", f"Along the camera path ({settings['path_res']}, frames {settings['path_frames']}, per-frame references "
               f"of {settings['path_ref_spp']} spp): LDR-FLIP PG/PT per checkpoint, and the flicker of the denoised "
-              "sequence (mean MSE between consecutive frames; it includes the change the camera's motion causes, the "
-              "same for both methods).", "",
+              "sequence: the mean squared change of each pixel's displayed value (the PNG transform at the scene's "
+              "exposure) from last frame's pixel that shows the same surface, through the motion vectors "
+              "(`flicker_reprojected`; docs/design.md, \"Metrics\"; results without it show the plain MSE between "
+              "consecutive frames, which is mostly the camera's motion).", "",
               "| scene | path | FLIP PG/PT per checkpoint | flicker PT+SVGF | flicker PG+SVGF | PG/PT | PG/PT without SVGF |",
               "|---|---|---|---|---|---|---|"]
     for scene, r in ex.items():
@@ -181,9 +183,12 @@ def _denoised(ex, report_dir, settings):
         ratios = ", ".join(f"f{f}: {g / max(o, 1e-12):.2f}"
                            for f, o, g in zip(p["off"]["frames"], p["off"]["flip_ldr"], p["pmm"]["flip_ldr"]))
         o, g = p["off"], p["pmm"]
-        lines.append(f"| {scene} | {r['path_name']} | {ratios} | {o['flicker_mse']:.4g} ± {o['flicker_sem']:.2g} "
-                     f"| {g['flicker_mse']:.4g} ± {g['flicker_sem']:.2g} | {g['flicker_mse'] / max(o['flicker_mse'], 1e-30):.2f} "
-                     f"| {g['flicker_mse_noisy'] / max(o['flicker_mse_noisy'], 1e-30):.2f} |")
+        key = "flicker_reprojected" if "flicker_reprojected" in o else "flicker_mse"
+        sem = "flicker_reprojected_sem" if key == "flicker_reprojected" else "flicker_sem"
+        noisy = key + "_noisy" if key == "flicker_reprojected" else "flicker_mse_noisy"
+        lines.append(f"| {scene} | {r['path_name']} | {ratios} | {o[key]:.4g} ± {o[sem]:.2g} "
+                     f"| {g[key]:.4g} ± {g[sem]:.2g} | {g[key] / max(o[key], 1e-30):.2f} "
+                     f"| {g[noisy] / max(o[noisy], 1e-30):.2f} |")
     lines += ["", "SVGF's time per frame (medians; upload, kernels and download) against the path-traced frame it filters:", "",
               "| scene | resolution | SVGF | PT frame | fraction | a-trous (5 iterations) |", "|---|---|---|---|---|---|"]
     for scene, r in ex.items():

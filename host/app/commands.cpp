@@ -16,6 +16,7 @@
 #include "rtpg/cl_runtime.h"
 #include "cl/device.h"
 #include "denoise/svgf_denoiser.h"
+#include "render/temporal_flicker.h"
 #include "render/image_kernels.h"
 #include "render/guided_first_bounce.h"
 #include "render/image_io.h"
@@ -226,8 +227,10 @@ int run_render(const RenderCommand& command) {
   std::unique_ptr<Accumulator> accumulator;
   if (command.accumulate)
     accumulator = std::make_unique<Accumulator>(cl, settings.width, settings.height);
-  // Last frame's output and unfiltered image, for the temporal flicker metric.
+  // Last frame's output and unfiltered image, for the temporal flicker metric; the same through
+  // the motion vectors, for a moving camera.
   std::vector<glm::vec3> previous, previous_noisy;
+  ReprojectedFlicker reprojected_flicker, reprojected_flicker_noisy;
   std::vector<glm::vec4> frame_rgba;
   std::vector<glm::vec3> shown;  // this frame's output: the denoised image with --denoise
   ImageRgb accumulated{settings.width, settings.height, {}};
@@ -276,6 +279,11 @@ int run_render(const RenderCommand& command) {
     totals.push_back(stats.time_ms["total"]);
     const double flicker = flicker_mse(shown, previous);
     const double flicker_noisy = denoiser ? flicker_mse(image, previous_noisy) : -1.0;
+    const ReprojectedFlicker::Frame tracked =
+        reprojected_flicker.add(shown, renderer.gbuffer(), scene.exposure);
+    const ReprojectedFlicker::Frame tracked_noisy =
+        denoiser ? reprojected_flicker_noisy.add(image, renderer.gbuffer(), scene.exposure)
+                 : ReprojectedFlicker::Frame{};
     previous = shown;
     if (denoiser) previous_noisy = image;
     if (accumulator) {
@@ -298,6 +306,11 @@ int run_render(const RenderCommand& command) {
     for (const auto& [key, value] : stats.extra) frame[key] = value;
     if (flicker >= 0.0) frame["flicker_mse"] = flicker;
     if (flicker_noisy >= 0.0) frame["flicker_mse_noisy"] = flicker_noisy;
+    if (tracked.mse >= 0.0) {
+      frame["flicker_reprojected"] = tracked.mse;
+      frame["flicker_tracked_fraction"] = tracked.tracked_fraction;
+    }
+    if (tracked_noisy.mse >= 0.0) frame["flicker_reprojected_noisy"] = tracked_noisy.mse;
     if (denoiser) frame["svgf_host_device_bytes_per_pixel"] = svgf_bytes;
     if (!command.reference.empty()) {
       last_relmse = relative_mse(to_image(renderer, shown), reference);
