@@ -279,11 +279,15 @@ int run_render(const RenderCommand& command) {
     totals.push_back(stats.time_ms["total"]);
     const double flicker = flicker_mse(shown, previous);
     const double flicker_noisy = denoiser ? flicker_mse(image, previous_noisy) : -1.0;
+    // Only for the stats JSON, where it goes: a tonemap and a copy of the G-buffer per frame.
+    const bool want_stats = !command.stats_json.empty();
     const ReprojectedFlicker::Frame tracked =
-        reprojected_flicker.add(shown, renderer.gbuffer(), scene.exposure);
+        want_stats ? reprojected_flicker.add(shown, renderer.gbuffer(), scene.exposure)
+                   : ReprojectedFlicker::Frame{};
     const ReprojectedFlicker::Frame tracked_noisy =
-        denoiser ? reprojected_flicker_noisy.add(image, renderer.gbuffer(), scene.exposure)
-                 : ReprojectedFlicker::Frame{};
+        want_stats && denoiser
+            ? reprojected_flicker_noisy.add(image, renderer.gbuffer(), scene.exposure)
+            : ReprojectedFlicker::Frame{};
     previous = shown;
     if (denoiser) previous_noisy = image;
     if (accumulator) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include "rtpg/guiding_settings.h"
@@ -34,7 +35,11 @@ ReprojectedFlicker::Frame ReprojectedFlicker::add(const std::vector<glm::vec3>& 
     throw std::invalid_argument("flicker: image of " + std::to_string(image.size()) +
                                 " pixels for a G-buffer of " + std::to_string(n));
   std::vector<glm::vec3> shown(n);
-  for (std::size_t i = 0; i < n; ++i) shown[i] = displayed(image[i], exposure);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        shown[i] = displayed(image[i], exposure);
+                    });
   Frame out;
   const bool have_previous = previous_.size() == n && width_ == g.width && height_ == g.height;
   if (have_previous) {
