@@ -2,7 +2,7 @@
  * colour by the primary hit's albedo, reprojects last frame's filtered illumination and
  * luminance moments through the motion vector (2x2 bilinear taps, each kept only where
  * pg_same_surface holds: the test guiding's reprojection uses; where none holds, the 3x3
- * neighbourhood's same-surface pixels, pg_svgf_neighbourhood_tap), and blends them with this
+ * neighbourhood's same-surface pixels, pg_svgf_history_tap), and blends them with this
  * frame's. Also writes the surface and depth slope the later passes read.
  * Per pixel (hand count; the rules: docs/guiding.md, "The roofline"; bench/bench_svgf.cpp counts
  * with it): 41 flops without history; with it 8 per bilinear tap, 34 per tap tested for the same
@@ -61,35 +61,25 @@ __kernel void svgf_temporal(__global const float4* colour, __global const float4
   if (has_history != 0u) {
     float2 position = (float2)((float)x, (float)y) + motion[i];
     uint m = material[i];
-    for (int t = 0; t < 4; ++t) {
-      int px, py;
-      float w = pg_svgf_bilinear_tap(position, t, &px, &py);
-      if (w <= 0.0f || px < 0 || py < 0 || px >= (int)width || py >= (int)height) continue;
-      uint j = (uint)py * width + (uint)px;
-      if (!pg_same_surface(pd, normal, m, prev_position_depth[j], prev_shading_normal[j].xyz,
-                           prev_material[j], settings.reproject_position,
-                           settings.reproject_normal))
-        continue;
-      sum_history += w * pg_planar_get(prev_history, n, j).xyz;
-      sum_moments += w * pg_planar_get(prev_moments, n, j);
-      sum_weight += w;
-    }
-    if (sum_weight < PG_SVGF_MIN_TAP_WEIGHT && settings.history_fallback != 0u) {
-      sum_history = (float3)(0.0f);
-      sum_moments = (float4)(0.0f);
-      sum_weight = 0.0f;
-      for (int t = 0; t < PG_HISTORY_CANDIDATES; ++t) {
+    for (int pass = 0; pass < 2; ++pass) {
+      if (pass == 1) {
+        if (sum_weight >= PG_SVGF_MIN_TAP_WEIGHT || settings.history_fallback == 0u) break;
+        sum_history = (float3)(0.0f);
+        sum_moments = (float4)(0.0f);
+        sum_weight = 0.0f;
+      }
+      for (int t = 0; t < pg_svgf_history_taps(pass); ++t) {
         int px, py;
-        pg_svgf_neighbourhood_tap(position, t, &px, &py);
-        if (px < 0 || py < 0 || px >= (int)width || py >= (int)height) continue;
+        float w = pg_svgf_history_tap(position, pass, t, &px, &py);
+        if (w <= 0.0f || px < 0 || py < 0 || px >= (int)width || py >= (int)height) continue;
         uint j = (uint)py * width + (uint)px;
         if (!pg_same_surface(pd, normal, m, prev_position_depth[j], prev_shading_normal[j].xyz,
                              prev_material[j], settings.reproject_position,
                              settings.reproject_normal))
           continue;
-        sum_history += pg_planar_get(prev_history, n, j).xyz;
-        sum_moments += pg_planar_get(prev_moments, n, j);
-        sum_weight += 1.0f;
+        sum_history += w * pg_planar_get(prev_history, n, j).xyz;
+        sum_moments += w * pg_planar_get(prev_moments, n, j);
+        sum_weight += w;
       }
     }
   }

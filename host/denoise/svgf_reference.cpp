@@ -118,35 +118,25 @@ void SvgfReference::temporal(const std::vector<glm::vec4>& colour, const GBuffer
       if (has_history_) {
         const glm::vec2 position =
             glm::vec2(static_cast<float>(x), static_cast<float>(y)) + g.motion[i];
-        for (int t = 0; t < 4; ++t) {
-          int px = 0, py = 0;
-          const float w = sh::pg_svgf_bilinear_tap(position, t, &px, &py);
-          if (w <= 0.0f || px < 0 || py < 0 || px >= width_ || py >= height_) continue;
-          const std::size_t j = static_cast<std::size_t>(py) * width_ + px;
-          if (!sh::pg_same_surface(pd, n, g.material[i], prev_position_depth_[j],
-                                   xyz(prev_normal_[j]), prev_material_[j], s.reproject_position,
-                                   s.reproject_normal))
-            continue;
-          sum_history += w * xyz(history_[j]);
-          sum_moments += w * prev_moments_[j];
-          sum_weight += w;
-        }
-        if (sum_weight < PG_SVGF_MIN_TAP_WEIGHT && s.history_fallback != 0u) {
-          sum_history = glm::vec3(0.0f);
-          sum_moments = glm::vec4(0.0f);
-          sum_weight = 0.0f;
-          for (int t = 0; t < PG_HISTORY_CANDIDATES; ++t) {
+        for (int pass = 0; pass < 2; ++pass) {
+          if (pass == 1) {
+            if (sum_weight >= PG_SVGF_MIN_TAP_WEIGHT || s.history_fallback == 0u) break;
+            sum_history = glm::vec3(0.0f);
+            sum_moments = glm::vec4(0.0f);
+            sum_weight = 0.0f;
+          }
+          for (int t = 0; t < sh::pg_svgf_history_taps(pass); ++t) {
             int px = 0, py = 0;
-            sh::pg_svgf_neighbourhood_tap(position, t, &px, &py);
-            if (px < 0 || py < 0 || px >= width_ || py >= height_) continue;
+            const float w = sh::pg_svgf_history_tap(position, pass, t, &px, &py);
+            if (w <= 0.0f || px < 0 || py < 0 || px >= width_ || py >= height_) continue;
             const std::size_t j = static_cast<std::size_t>(py) * width_ + px;
             if (!sh::pg_same_surface(pd, n, g.material[i], prev_position_depth_[j],
                                      xyz(prev_normal_[j]), prev_material_[j], s.reproject_position,
                                      s.reproject_normal))
               continue;
-            sum_history += xyz(history_[j]);
-            sum_moments += prev_moments_[j];
-            sum_weight += 1.0f;
+            sum_history += w * xyz(history_[j]);
+            sum_moments += w * prev_moments_[j];
+            sum_weight += w;
           }
         }
       }

@@ -127,6 +127,19 @@ PG_FN void pg_svgf_neighbourhood_tap(float2 position, int t, PG_PRIVATE int* px,
   *py = (int)floor(position.y + 0.5f) + dy;
 }
 
+/* The temporal pass's two sets of history taps: pass 0 the bilinear ones, pass 1 (only where
+ * pass 0 kept less than PG_SVGF_MIN_TAP_WEIGHT and history_fallback is on) the neighbourhood,
+ * each with weight 1. Writes tap t's pixel and returns its weight. */
+PG_FN int pg_svgf_history_taps(int pass) {
+  return pass == 0 ? 4 : PG_HISTORY_CANDIDATES;
+}
+PG_FN float pg_svgf_history_tap(float2 position, int pass, int t, PG_PRIVATE int* px,
+                                PG_PRIVATE int* py) {
+  if (pass == 0) return pg_svgf_bilinear_tap(position, t, px, py);
+  pg_svgf_neighbourhood_tap(position, t, px, py);
+  return 1.0f;
+}
+
 /* The blend weight of the new frame: the running mean while the history is short (1 / length),
  * then alpha (SVGF 4.1). length counts the new frame. */
 PG_FN float pg_svgf_blend_weight(float alpha, float length) {
