@@ -324,12 +324,13 @@ void count_flops(Inputs& in, const pg_kernel_settings& p) {
       // sample: BSDF sampling and its density (232), the GGX lobe (181), a trained model's
       // density (81) and the Gaussian's sampler (59, counted for every trained pixel).
       in.sample_flops += 232 + (ggx ? 181 : 0) + (k > 0.0f ? 81 + 59 : 0);
-      // train: 162 + b N + 67 N P + 176 P (b = 137, 243 with GGX; P passes; N neighbours).
+      // train: 162 + b N + 63 N P + 182 P (b = 128, 234 with GGX; P passes; N neighbours), the
+      // count beside kernels/train_wide.cl.
       const int n_samples =
           std::min(std::min(sh::pg_pmm_neighbour_count(k, p), side * side), PG_MAX_TRAIN_SAMPLES);
       const int passes = k >= 0.25f * p.k_max ? 1 : p.em_passes;
       in.train_flops +=
-          162.0 + (ggx ? 243.0 : 137.0) * n_samples + 67.0 * n_samples * passes + 176.0 * passes;
+          162.0 + (ggx ? 234.0 : 128.0) * n_samples + 63.0 * n_samples * passes + 182.0 * passes;
     }
 }
 

@@ -12,9 +12,9 @@
  * unfused, and near the peak of a narrow GGX lobe (alpha 0.03) D's denominator is a difference
  * of nearly equal numbers, where one fused product moves D, and a sample's weight, by 1e-4
  * relative (tests/guiding/test_guiding_kernels.cpp). */
-/* Per pixel (hand count; docs/guiding.md, "The roofline"): 162 + b N + 67 N P + 176 P flops for
+/* Per pixel (hand count; docs/guiding.md, "The roofline"): 162 + b N + 63 N P + 182 P flops for
  * N neighbours and P E-step passes (a lane runs to its work-item's largest N and P), b = 128 for
- * Lambert lobes, 234 where a lane has a GGX lobe: 1313-1843 at N = 5, P = 1; 9390 at N = 20,
+ * Lambert lobes, 234 where a lane has a GGX lobe: 1299-1829 at N = 5, P = 1; 9168 at N = 20,
  * P = 3 with GGX (each M^-1 9 flops fewer since it lost its disk detour, two of them square
  * roots and one a division); with pi_learning 8 flops and 2 divisions more per neighbour and
  * pass. Bytes: 116 of its own + 48 N of neighbour VPLs read (each VPL once per
@@ -152,8 +152,9 @@ __kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uch
   pg_floatw target = pg_convert_floatw(counts);
   for (int pass = 0; !all(done); ++pass) {
     pg_pmm_batch_w b = pg_pmm_batch_empty_w();
+    pg_pmm_e_terms_w terms = pg_pmm_e_terms_of_w(m);
     for (int s = 0; s < most_samples; ++s)
-      b = pg_pmm_batch_add_w(b, m, settings, samples[s], original.w);
+      b = pg_pmm_batch_add_w(b, m, terms, settings, samples[s], original.w);
     pg_intw live = ~done, step;
     /* A re-seed replaces the history: later passes refine the new model alone. */
     base = pg_pmm_state_select_w(base, pg_pmm_initial_state_w(),

@@ -207,12 +207,30 @@ PG_FN pg_pmm_batch pg_pmm_batch_empty(void) {
   return b;
 }
 
+/* What the E-step needs of a model, computed once per pass instead of once per sample: the
+ * Cholesky factor's reciprocals and the Gaussian's normalisation over solid angle, so that a
+ * sample's responsibility takes one division (g / D) where it took four, in a chain that bounds
+ * the train kernel's time (docs/guiding.md, "One division per E-step sample"). */
+typedef struct {
+  float inv_l11, inv_l22; /* 1 / l11, 1 / l22 */
+  float norm;             /* pi / (2 pi l11 l22) / (2 pi): G(u) = norm exp(-q / 2) */
+} pg_pmm_e_terms;
+
+PG_FN pg_pmm_e_terms pg_pmm_e_terms_of(pg_pmm_model m) {
+  pg_pmm_e_terms t;
+  t.inv_l11 = 1.0f / m.l11;
+  t.inv_l22 = 1.0f / m.l22;
+  t.norm = m.pi / (PG_TWO_PI * m.l11 * m.l22) * PG_INV_TWO_PI;
+  return t;
+}
+
 /* E-step for one sample: weight a (>= 0), square point u, direction wi, BSDF density of wi,
  * and the density the sample was drawn with (0 if unknown: it then adds nothing to v1, v2).
  * A model that does not exist yet takes every sample at the initial weight (so its first
- * M-step gives the weighted moments and pi = pi_init). */
-PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_settings p, float a,
-                                    float2 u, float bsdf_pdf, float density, float history_weight) {
+ * M-step gives the weighted moments and pi = pi_init). terms = pg_pmm_e_terms_of(m). */
+PG_FN pg_pmm_batch pg_pmm_batch_add_terms(pg_pmm_batch b, pg_pmm_model m, pg_pmm_e_terms terms,
+                                          pg_kernel_settings p, float a, float2 u, float bsdf_pdf,
+                                          float density, float history_weight) {
   if (!(a >= 0.0f) || !(a <= p.max_weight)) return b; /* NaN, negative or absurd: dropped */
   /* VPL radiance is a one-path estimate with a heavy tail: a single firefly would drag the
    * lobe to a random direction. Training (not rendering) clamps weights to a multiple of the
@@ -224,8 +242,10 @@ PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_se
   }
   float gamma = p.pi_init;
   if (m.valid) {
-    float q = pg_pmm_mahalanobis2(m, u);
-    float g = m.pi * exp(-0.5f * q) / (PG_TWO_PI * m.l11 * m.l22) * PG_INV_TWO_PI;
+    float z1 = (u.x - m.mx) * terms.inv_l11;
+    float z2 = (u.y - m.my - m.l21 * z1) * terms.inv_l22;
+    float q = z1 * z1 + z2 * z2;
+    float g = terms.norm * exp(-0.5f * q);
     float d = g + (1.0f - m.pi) * bsdf_pdf;
     gamma = d > 0.0f ? g / d : 0.0f;
     if (!isfinite(gamma)) return b;
@@ -259,6 +279,13 @@ PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_se
   b.agxy += ag * u.x * u.y;
   b.count += 1.0f;
   return b;
+}
+
+/* pg_pmm_batch_add_terms with the model's E-step terms computed for this one sample. */
+PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_settings p, float a,
+                                    float2 u, float bsdf_pdf, float density, float history_weight) {
+  return pg_pmm_batch_add_terms(b, m, pg_pmm_e_terms_of(m), p, a, u, bsdf_pdf, density,
+                                history_weight);
 }
 
 /* Number of neighbour VPLs a pixel trains on at epoch k (paper 4.2). */
@@ -332,9 +359,11 @@ PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples
   if (s.s1.w >= 0.25f * p.k_max) passes = 1;
   for (int pass = 0; pass < passes; ++pass) {
     pg_pmm_batch b = pg_pmm_batch_empty();
+    pg_pmm_e_terms terms = pg_pmm_e_terms_of(m);
     for (int j = 0; j < n; ++j)
-      b = pg_pmm_batch_add(b, m, p, samples[j].x, pg_make_float2(samples[j].y, samples[j].z),
-                           samples[j].w, densities[j], s.s0.x);
+      b = pg_pmm_batch_add_terms(b, m, terms, p, samples[j].x,
+                                 pg_make_float2(samples[j].y, samples[j].z), samples[j].w,
+                                 densities[j], s.s0.x);
     /* A re-seed replaces the history: later passes refine the new model alone. */
     if (pg_pmm_batch_reseeds(b, p)) base = pg_pmm_initial_state();
     out = pg_pmm_update(base, b, p, target_count, updated);

@@ -101,10 +101,23 @@ static inline pg_pmm_batch_w pg_pmm_batch_empty_w(void) {
   return b;
 }
 
-/* pg_pmm_batch_add for the lanes whose sample is kept. */
+/* pg_pmm_e_terms per lane. */
+typedef struct {
+  pg_floatw inv_l11, inv_l22, norm;
+} pg_pmm_e_terms_w;
+
+static inline pg_pmm_e_terms_w pg_pmm_e_terms_of_w(pg_pmm_model_w m) {
+  pg_pmm_e_terms_w t;
+  t.inv_l11 = 1.0f / m.l11;
+  t.inv_l22 = 1.0f / m.l22;
+  t.norm = m.pi / (PG_TWO_PI * m.l11 * m.l22) * PG_INV_TWO_PI;
+  return t;
+}
+
+/* pg_pmm_batch_add_terms for the lanes whose sample is kept; terms = pg_pmm_e_terms_of_w(m). */
 static inline pg_pmm_batch_w pg_pmm_batch_add_w(pg_pmm_batch_w b, pg_pmm_model_w m,
-                                                pg_kernel_settings p, pg_train_samples_w s,
-                                                pg_floatw history_weight) {
+                                                pg_pmm_e_terms_w terms, pg_kernel_settings p,
+                                                pg_train_samples_w s, pg_floatw history_weight) {
   pg_floatw a = s.a;
   pg_intw ok = s.kept & (a >= 0.0f) & (a <= p.max_weight);
   if (p.weight_clamp > 0.0f) a = select(a, fmin(a, p.weight_clamp * history_weight), m.valid);
@@ -113,10 +126,10 @@ static inline pg_pmm_batch_w pg_pmm_batch_add_w(pg_pmm_batch_w b, pg_pmm_model_w
     b.count = select(b.count, b.count + 1.0f, ok);
     return b;
   }
-  pg_floatw z1 = (s.ux - m.mx) / m.l11;
-  pg_floatw z2 = (s.uy - m.my - m.l21 * z1) / m.l22;
+  pg_floatw z1 = (s.ux - m.mx) * terms.inv_l11;
+  pg_floatw z2 = (s.uy - m.my - m.l21 * z1) * terms.inv_l22;
   pg_floatw q = z1 * z1 + z2 * z2;
-  pg_floatw g = m.pi * exp(-0.5f * q) / (PG_TWO_PI * m.l11 * m.l22) * PG_INV_TWO_PI;
+  pg_floatw g = terms.norm * exp(-0.5f * q);
   pg_floatw d = g + (1.0f - m.pi) * s.bsdf_pdf;
   pg_floatw gamma_model = select((pg_floatw)(0.0f), g / d, d > 0.0f);
   pg_floatw gamma = select((pg_floatw)(p.pi_init), gamma_model, m.valid);
