@@ -39,6 +39,11 @@ bool is_finite(const glm::vec3& c) {
   return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
 }
 
+// Whether a VPL's density of its own strategy (position.w) can weight a training sample.
+bool usable_vpl_density(float pdf) {
+  return pdf > 0.0f && std::isfinite(pdf);
+}
+
 // Density of a borrowed guide's mixture at world direction w (bsdf_pdf: the vertex's own BSDF
 // density there): the Gaussian of the lending pixel in that pixel's frame, mixed with the
 // vertex's BSDF.
@@ -182,10 +187,9 @@ void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSamp
             if (vpls) {
               // The VPL keeps the density of the strategy that made it (BSDF samples are
               // distributed by the BSDF alone: paper 3.2) and the whole sampler's density D
-              // (include/rtpg/guiding_layout.h). Area measure comes later.
-              const float bsdf_pdf = shared::pg_bsdf_pdf(lobes, wo, wi);
-              vpls->position[i].w = fs.strategy == kStrategyBsdf ? bsdf_pdf : fs.pdf;
-              vpls->normal[i].w = fs.pdf;
+              // (include/rtpg/guiding_layout.h), p.prev_pdf below. Area measure comes at y.
+              vpls->strategy_pdf[i] =
+                  fs.strategy == kStrategyBsdf ? shared::pg_bsdf_pdf(lobes, wo, wi) : fs.pdf;
               vpls->info[i] = fs.strategy << PG_VPL_STRATEGY_SHIFT;
             }
             if (!is_black(p.throughput) && is_finite(p.throughput)) {
@@ -234,8 +238,10 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
           // with the MIS weight this sample got (direct_light_in_vpls).
           if (!nee || settings_.direct_light_in_vpls) p.vpl_radiance += le * w;
           if (vpls) {
-            vpls->position[i] = glm::vec4(dir, vpls->position[i].w);
-            vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
+            const float strategy_pdf = vpls->strategy_pdf[i];
+            vpls->position[i] = glm::vec4(dir, strategy_pdf);
+            vpls->normal[i] = glm::vec4(0.0f, 0.0f, 0.0f, p.prev_pdf);
+            if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
           }
         } else {
           p.vpl_radiance += p.vpl_throughput * le * w;
@@ -261,9 +267,10 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         const glm::vec3 to = sp.position - p.prev_position;
         const float d2 = glm::dot(to, to);
         const float cos_y = std::fabs(glm::dot(sp.geometric_normal, dir));
-        vpls->position[i] = glm::vec4(sp.position, vpls->position[i].w * cos_y / d2);
-        vpls->normal[i] = glm::vec4(sp.geometric_normal, vpls->normal[i].w * cos_y / d2);
-        vpls->info[i] |= PG_VPL_VALID;
+        const float strategy_pdf = vpls->strategy_pdf[i] * cos_y / d2;
+        vpls->position[i] = glm::vec4(sp.position, strategy_pdf);
+        vpls->normal[i] = glm::vec4(sp.geometric_normal, p.prev_pdf * cos_y / d2);
+        if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID;
       }
       if (depth == settings_.max_bounces) continue;
 
@@ -477,9 +484,7 @@ void PathTracer::gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls,
           }
           if (vpls) {
             const glm::vec3 vpl_l = p.vpl_radiance;
-            if (!is_finite(vpl_l) || !(vpls->position[i].w > 0.0f) ||
-                !std::isfinite(vpls->position[i].w))
-              vpls->info[i] &= ~PG_VPL_VALID;
+            if (!is_finite(vpl_l)) vpls->info[i] &= ~PG_VPL_VALID;
             // The kernels read the info bits from radiance_info.w (exact: small integers).
             vpls->radiance_info[i] = glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f),
                                                static_cast<float>(vpls->info[i]));

@@ -7,6 +7,7 @@ void VplBuffer::resize(std::size_t n) {
     position.assign(n, glm::vec4(0.0f));
     normal.assign(n, glm::vec4(0.0f));
     radiance_info.assign(n, glm::vec4(0.0f));
+    strategy_pdf.assign(n, 0.0f);
   }
   info.assign(n, 0u);
 }
