@@ -8,27 +8,36 @@
 
 namespace rtpg {
 
+FirstBounceSample bsdf_first_bounce_sample(const shared::pg_frame& frame, const glm::vec3& wo,
+                                           const shared::pg_lobes& lobes,
+                                           const SampleCoordinates& at, std::size_t i) {
+  shared::pg_rng rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
+                                           at.sample, PG_RNG_STREAM_FIRST_BOUNCE);
+  const float u_lobe = shared::pg_rng_next(&rng);
+  const float u1 = shared::pg_rng_next(&rng);
+  const float u2 = shared::pg_rng_next(&rng);
+  const shared::pg_bsdf_sample_t bs = shared::pg_bsdf_sample(lobes, wo, u_lobe, u1, u2);
+  FirstBounceSample s;
+  if (bs.pdf <= 0.0f) return s;
+  s.direction = shared::pg_to_world(frame, bs.wi);
+  s.pdf = bs.pdf;
+  s.strategy = kStrategyBsdf;
+  return s;
+}
+
 void BsdfFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
                              std::vector<FirstBounceSample>& out) {
   out.resize(g.pixel_count());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, g.pixel_count(), 4096), [&](const auto& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      FirstBounceSample& s = out[i];
-      s = FirstBounceSample{};
-      if (!g.has_surface(i)) continue;
-      shared::pg_rng rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
-                                               at.sample, PG_RNG_STREAM_FIRST_BOUNCE);
+      if (!g.has_surface(i)) {
+        out[i] = FirstBounceSample{};
+        continue;
+      }
       const shared::pg_frame frame = gbuffer_frame(g, i);
       const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
       const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
-      const float u_lobe = shared::pg_rng_next(&rng);
-      const float u1 = shared::pg_rng_next(&rng);
-      const float u2 = shared::pg_rng_next(&rng);
-      const shared::pg_bsdf_sample_t bs = shared::pg_bsdf_sample(lobes, wo, u_lobe, u1, u2);
-      if (bs.pdf <= 0.0f) continue;
-      s.direction = shared::pg_to_world(frame, bs.wi);
-      s.pdf = bs.pdf;
-      s.strategy = kStrategyBsdf;
+      out[i] = bsdf_first_bounce_sample(frame, wo, lobes, at, i);
     }
   });
 }

@@ -62,6 +62,12 @@ class FirstBounceSampler {
   // One direction for every surface pixel of the G-buffer (others get pdf 0).
   virtual void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
                       std::vector<FirstBounceSample>& out) = 0;
+  // True when sample() draws bsdf_first_bounce_sample() for every pixel (BsdfFirstBounce):
+  // the renderer then leaves sample() out and the path tracer draws the same directions at
+  // the primary hit, in the pass that already has each pixel's frame and lobes, instead of a
+  // pass of its own over every pixel (docs/host-path-tracer.md, "The BSDF's first bounce at
+  // the primary hit").
+  virtual bool samples_the_bsdf() const { return false; }
   // The density sample() uses at pixel i for direction wi: next-event estimation at the
   // primary hit needs it for its MIS weight. The caller passes what it already has of the
   // pixel: its lobes, and wo and wi in its shading frame (gbuffer_frame).
@@ -74,9 +80,16 @@ class FirstBounceSampler {
   }
 };
 
+// BSDF importance sampling of pixel i's first bounce (frame, wo and lobes of the pixel, as
+// gbuffer_frame and gbuffer_material give them): its own random stream, so any pass may draw it.
+FirstBounceSample bsdf_first_bounce_sample(const shared::pg_frame& frame, const glm::vec3& wo,
+                                           const shared::pg_lobes& lobes,
+                                           const SampleCoordinates& at, std::size_t i);
+
 // BSDF importance sampling, on the host.
 class BsdfFirstBounce final : public FirstBounceSampler {
  public:
+  bool samples_the_bsdf() const override { return true; }
   void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
               std::vector<FirstBounceSample>& out) override;
   float pdf(const GBuffer& gbuffer, std::size_t i, const shared::pg_lobes& lobes,

@@ -176,12 +176,15 @@ FrameStats Renderer::render_frame(int index) {
   for (int s = 0; s < settings_.spp; ++s) {
     SampleCoordinates at{settings_.seed, static_cast<std::uint32_t>(index),
                          static_cast<std::uint32_t>(s)};
-    t = Clock::now();
-    sampler_->sample(gbuffer, at, first_);
-    stats.time_ms["first_bounce"] += ms_since(t);
+    const bool inline_bsdf = sampler_->samples_the_bsdf();
+    if (!inline_bsdf) {
+      t = Clock::now();
+      sampler_->sample(gbuffer, at, first_);
+      stats.time_ms["first_bounce"] += ms_since(t);
+    }
     const bool keep_vpls = s == 0 && sampler_->wants_vpls();
-    path_tracer_->trace(gbuffer, first_, *sampler_, at, pass_, keep_vpls ? &vpls_ : nullptr,
-                        stats.nonfinite_samples, rays, times);
+    path_tracer_->trace(gbuffer, inline_bsdf ? nullptr : &first_, *sampler_, at, pass_,
+                        keep_vpls ? &vpls_ : nullptr, stats.nonfinite_samples, rays, times);
     t = Clock::now();
     const float weight = 1.0f / static_cast<float>(settings_.spp);
     // The first sample starts the sum from zero here, in parallel, instead of a serial fill of

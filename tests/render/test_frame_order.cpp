@@ -1,7 +1,8 @@
 // The order in which the renderer drives a first-bounce sampler within a frame. Training
 // changes the model, so it must come after the frame's last sample: samples drawn after it
 // would use a model other than the one next-event MIS at the primary hit evaluates (a bias at
-// more than one sample per pixel, invisible at one).
+// more than one sample per pixel, invisible at one). And the path tracer's own draw of BSDF
+// sampling at the primary hit equals the sampler's separate pass.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -59,6 +60,51 @@ TEST(FrameOrder, TrainingFollowsTheFramesLastSample) {
       "begin 0", "sample 0.0", "sample 0.1", "sample 0.2", "end 0 with vpls",
       "begin 1", "sample 1.0", "sample 1.1", "sample 1.2", "end 1 with vpls"};
   EXPECT_EQ(log, expected);
+}
+
+// BSDF sampling in a pass of its own: BsdfFirstBounce::sample(), which the renderer leaves out
+// for BsdfFirstBounce itself (samples_the_bsdf()).
+class SeparatePassBsdf final : public FirstBounceSampler {
+ public:
+  void sample(const GBuffer& g, const SampleCoordinates& at,
+              std::vector<FirstBounceSample>& out) override {
+    bsdf_.sample(g, at, out);
+  }
+  float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
+            const glm::vec3& wi) const override {
+    return bsdf_.pdf(g, i, lobes, wo, wi);
+  }
+
+ private:
+  BsdfFirstBounce bsdf_;
+};
+
+// Two samples a pixel, a moving camera, an odd size: every frame's image is the same to the bit
+// whether the first bounce comes from the sampler's pass or from the path tracer's.
+TEST(FrameOrder, BsdfAtThePrimaryHitEqualsItsOwnPass) {
+  const Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
+  RenderSettings settings;
+  settings.width = 23;
+  settings.height = 17;
+  settings.spp = 2;
+  settings.camera_path = "pan";
+  Renderer in_place(scene, settings), separate(scene, settings);
+  ASSERT_TRUE(BsdfFirstBounce().samples_the_bsdf());
+  separate.set_first_bounce_sampler(std::make_unique<SeparatePassBsdf>());
+  for (int frame = 0; frame < 3; ++frame) {
+    in_place.render_frame(frame);
+    separate.render_frame(frame);
+    const std::vector<glm::vec3>& a = in_place.image();
+    const std::vector<glm::vec3>& b = separate.image();
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t differ = 0, lit = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      differ += a[i] != b[i];
+      lit += a[i] != glm::vec3(0.0f);
+    }
+    EXPECT_EQ(differ, 0u) << "frame " << frame;
+    EXPECT_GT(lit, a.size() / 2) << "frame " << frame;
+  }
 }
 
 }  // namespace
