@@ -8,6 +8,8 @@
 // Counters (means over the iterations of a repetition; the aggregates give their medians):
 //   frame_ms              FrameStats "total" (also the manual time of the iteration)
 //   primary_ms, gbuffer_ms, first_bounce_ms, trace_ms, shade_ms, compact_ms   stages of the frame
+//                         (guiding off: first_bounce_ms 0, the BSDF's first bounce is drawn in
+//                         shade)
 //   guiding_ms            pmm: begin_frame (upload, reproject, state readback) + sample +
 //                         end_frame (VPL upload, train); reproject/sample/train_kernel_ms are
 //                         their kernels' profiling-event times
