@@ -25,21 +25,23 @@ FirstBounceSample bsdf_first_bounce_sample(const shared::pg_frame& frame, const 
   return s;
 }
 
-void BsdfFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
-                             std::vector<FirstBounceSample>& out) {
-  out.resize(g.pixel_count());
+FirstBounceSamples BsdfFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at) {
+  direction_pdf_.resize(g.pixel_count());
+  strategy_.resize(g.pixel_count());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, g.pixel_count(), 4096), [&](const auto& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      if (!g.has_surface(i)) {
-        out[i] = FirstBounceSample{};
-        continue;
+      FirstBounceSample s;
+      if (g.has_surface(i)) {
+        const shared::pg_frame frame = gbuffer_frame(g, i);
+        const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
+        const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
+        s = bsdf_first_bounce_sample(frame, wo, lobes, at, i);
       }
-      const shared::pg_frame frame = gbuffer_frame(g, i);
-      const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
-      const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
-      out[i] = bsdf_first_bounce_sample(frame, wo, lobes, at, i);
+      direction_pdf_[i] = glm::vec4(s.direction, s.pdf);
+      strategy_[i] = s.strategy;
     }
   });
+  return FirstBounceSamples{direction_pdf_.data(), strategy_.data()};
 }
 
 float BsdfFirstBounce::pdf(const GBuffer&, std::size_t, const shared::pg_lobes& lobes,

@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "render/gbuffer.h"
+#include "rtpg/guiding_layout.h"
 #include "shared/pmm.h"
 
 namespace rtpg {
@@ -21,11 +22,24 @@ enum FirstBounceStrategy : std::uint32_t {
   kStrategyBsdf = 1,
   kStrategyGuide = 2
 };
+static_assert(kStrategyNone == PG_STRATEGY_NONE && kStrategyBsdf == PG_STRATEGY_BSDF &&
+                  kStrategyGuide == PG_STRATEGY_GUIDE,
+              "the sample kernel's strategies are read in place as FirstBounceStrategy");
 
 struct FirstBounceSample {
   glm::vec3 direction{0.0f};  // world space, unit
   float pdf = 0.0f;           // solid-angle density of the whole sampler; 0 = no sample
   std::uint32_t strategy = kStrategyNone;
+};
+
+// One pass's first-bounce samples, in the sampler's own memory (valid until its next sample()
+// or end_frame()): pixel i's direction (world space, unit) and the whole sampler's solid-angle
+// density in direction_pdf[i] (a density not above 0, or not finite: no sample), and its
+// FirstBounceStrategy in strategy[i]. The guided sampler hands out the sample kernel's output
+// as it lies (include/rtpg/guiding_layout.h: PG_STRATEGY_* equal FirstBounceStrategy).
+struct FirstBounceSamples {
+  const glm::vec4* direction_pdf = nullptr;
+  const std::uint32_t* strategy = nullptr;
 };
 
 struct SampleCoordinates {
@@ -59,9 +73,8 @@ class FirstBounceSampler {
   // Figures of the last frame: times (ms) by kernel name, and other figures by name.
   virtual void report(std::map<std::string, double>& time_ms,
                       std::map<std::string, double>& extra) {}
-  // One direction for every surface pixel of the G-buffer (others get pdf 0).
-  virtual void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
-                      std::vector<FirstBounceSample>& out) = 0;
+  // One direction for every surface pixel of the G-buffer (others get density 0).
+  virtual FirstBounceSamples sample(const GBuffer& gbuffer, const SampleCoordinates& at) = 0;
   // True when sample() draws bsdf_first_bounce_sample() for every pixel (BsdfFirstBounce):
   // the renderer then leaves sample() out and the path tracer draws the same directions at
   // the primary hit, in the pass that already has each pixel's frame and lobes, instead of a
@@ -90,9 +103,12 @@ FirstBounceSample bsdf_first_bounce_sample(const shared::pg_frame& frame, const 
 class BsdfFirstBounce final : public FirstBounceSampler {
  public:
   bool samples_the_bsdf() const override { return true; }
-  void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
-              std::vector<FirstBounceSample>& out) override;
+  FirstBounceSamples sample(const GBuffer& gbuffer, const SampleCoordinates& at) override;
   float pdf(const GBuffer& gbuffer, std::size_t i, const shared::pg_lobes& lobes,
             const glm::vec3& wo, const glm::vec3& wi) const override;
+
+ private:
+  std::vector<glm::vec4> direction_pdf_;
+  std::vector<std::uint32_t> strategy_;
 };
 }  // namespace rtpg

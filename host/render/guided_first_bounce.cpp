@@ -114,8 +114,7 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   trained_fraction_ = 0.0;
 }
 
-void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
-                               std::vector<FirstBounceSample>& out) {
+FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at) {
   unmap_samples();  // the kernel overwrites them
   guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_);
   sample_ms_ += guider_->last_times().sample_ms;
@@ -144,24 +143,23 @@ void GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at,
     view_.mixture_b = staged_.mixture_b.data();
   }
   readback_ms_ += ms_since(t);
-  out.resize(n);
-  // The directions for the path tracer and, as a by-product, the share of surface pixels
-  // that sample a trained Gaussian and their mean pi (statistics only).
+  // The path tracer reads the directions as the kernel wrote them (no copy); the statistics
+  // of this frame's models wait for end_frame (count_models).
+  return FirstBounceSamples{view_.direction_pdf, view_.strategy};
+}
+
+void GuidedFirstBounce::count_models(const GBuffer& g) {
+  // The share of surface pixels that sampled a trained Gaussian and their mean pi, from the
+  // mixtures of the frame's last sample() (statistics only).
+  if (view_.mixture_a == nullptr) return;
   struct Counts {
     std::size_t surfaces = 0, guided = 0;
     double pi_sum = 0.0;
   };
   const Counts counts = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, n, 8192), Counts{},
+      tbb::blocked_range<std::size_t>(0, std::min(g.pixel_count(), pixels_), 8192), Counts{},
       [&](const tbb::blocked_range<std::size_t>& r, Counts c) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const glm::vec4 d = view_.direction_pdf[i];
-          out[i].direction = glm::vec3(d);
-          out[i].pdf = d.w > 0.0f && std::isfinite(d.w) ? d.w : 0.0f;
-          const std::uint32_t s = view_.strategy[i];
-          out[i].strategy = s == PG_STRATEGY_GUIDE  ? kStrategyGuide
-                            : s == PG_STRATEGY_BSDF ? kStrategyBsdf
-                                                    : kStrategyNone;
           if (!g.has_surface(i)) continue;
           ++c.surfaces;
           const glm::vec4 mixture = view_.mixture_a[i];
@@ -209,6 +207,7 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   // Last frame's G-buffer is done with (reproject read it): in place, the host writes that
   // memory next frame, so its buffers are released first.
   previous_gbuffer_ = GuiderGBuffer{};
+  count_models(g);
   if (!training_) return;
   const auto t = Clock::now();
   GuiderVpls device_vpls = owned_vpls_;

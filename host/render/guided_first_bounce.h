@@ -26,8 +26,7 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   ~GuidedFirstBounce() override;
 
   void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) override;
-  void sample(const GBuffer& gbuffer, const SampleCoordinates& at,
-              std::vector<FirstBounceSample>& out) override;
+  FirstBounceSamples sample(const GBuffer& gbuffer, const SampleCoordinates& at) override;
   float pdf(const GBuffer& gbuffer, std::size_t i, const shared::pg_lobes& lobes,
             const glm::vec3& wo, const glm::vec3& wi) const override;
   bool pixel_guide(const GBuffer& gbuffer, std::size_t i, PixelGuide& out) const override;
@@ -45,6 +44,8 @@ class GuidedFirstBounce final : public FirstBounceSampler {
  private:
   // The model pixel i sampled this frame (from the mixture the sample kernel wrote).
   shared::pg_pmm_model model_at(std::size_t i) const;
+  // surfaces_, guided_fraction_ and mean_pi_ from the mixtures of the last sample().
+  void count_models(const GBuffer& g);
 
   ClRuntime& runtime_;
   std::unique_ptr<Guider> guider_;

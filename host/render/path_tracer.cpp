@@ -71,7 +71,7 @@ PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer, const Ligh
                        PathTracerSettings settings)
     : scene_(scene), tracer_(tracer), lights_(lights), settings_(settings) {}
 
-void PathTracer::trace(const GBuffer& g, const std::vector<FirstBounceSample>* first,
+void PathTracer::trace(const GBuffer& g, const FirstBounceSamples* first,
                        const FirstBounceSampler& sampler, const SampleCoordinates& at,
                        std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite,
                        RayCounts& rays, PassTimes& times) {
@@ -138,7 +138,7 @@ bool PathTracer::next_event(const glm::vec3& position, const glm::vec3& ng,
   return true;
 }
 
-void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSample>* first,
+void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                              const FirstBounceSampler& sampler, const SampleCoordinates& at,
                              VplBuffer* vpls) {
   tbb::parallel_for(
@@ -179,8 +179,15 @@ void PathTracer::start_paths(const GBuffer& g, const std::vector<FirstBounceSamp
             has_shadow_[i] = 1;
           }
 
-          const FirstBounceSample fs =
-              first ? (*first)[i] : bsdf_first_bounce_sample(frame, wo, lobes, at, i);
+          FirstBounceSample fs;
+          if (first) {
+            const glm::vec4 d = first->direction_pdf[i];
+            fs.direction = glm::vec3(d);
+            fs.pdf = std::isfinite(d.w) ? d.w : 0.0f;
+            fs.strategy = first->strategy[i];
+          } else {
+            fs = bsdf_first_bounce_sample(frame, wo, lobes, at, i);
+          }
           if (fs.pdf > 0.0f && glm::dot(fs.direction, ng) > 0.0f) {
             const glm::vec3 wi = shared::pg_to_local(frame, fs.direction);
             const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);

@@ -67,7 +67,7 @@ class PathTracer {
   // that samples_the_bsdf()).
   // radiance[i] receives the estimate of pixel i (primary emission included); a non-finite
   // estimate is replaced by zero and counted. vpls (optional) receives the first-bounce hits.
-  void trace(const GBuffer& gbuffer, const std::vector<FirstBounceSample>* first,
+  void trace(const GBuffer& gbuffer, const FirstBounceSamples* first,
              const FirstBounceSampler& sampler, const SampleCoordinates& at,
              std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite,
              RayCounts& rays, PassTimes& times);
@@ -92,7 +92,7 @@ class PathTracer {
   // The steps of trace(), in order.
   void prepare(std::size_t n, VplBuffer* vpls);
   // At the primary hit x0 of every pixel: emission, next-event estimation, the first bounce.
-  void start_paths(const GBuffer& g, const std::vector<FirstBounceSample>* first,
+  void start_paths(const GBuffer& g, const FirstBounceSamples* first,
                    const FirstBounceSampler& sampler, const SampleCoordinates& at, VplBuffer* vpls);
   // The hits of the m live paths at path vertex `depth`: emission found by the bounce (MIS),
   // the VPL at depth 1, next-event estimation, BSDF sampling and Russian roulette.

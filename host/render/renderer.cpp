@@ -177,13 +177,14 @@ FrameStats Renderer::render_frame(int index) {
     SampleCoordinates at{settings_.seed, static_cast<std::uint32_t>(index),
                          static_cast<std::uint32_t>(s)};
     const bool inline_bsdf = sampler_->samples_the_bsdf();
+    FirstBounceSamples first;
     if (!inline_bsdf) {
       t = Clock::now();
-      sampler_->sample(gbuffer, at, first_);
+      first = sampler_->sample(gbuffer, at);
       stats.time_ms["first_bounce"] += ms_since(t);
     }
     const bool keep_vpls = s == 0 && sampler_->wants_vpls();
-    path_tracer_->trace(gbuffer, inline_bsdf ? nullptr : &first_, *sampler_, at, pass_,
+    path_tracer_->trace(gbuffer, inline_bsdf ? nullptr : &first, *sampler_, at, pass_,
                         keep_vpls ? &vpls_ : nullptr, stats.nonfinite_samples, rays, times);
     t = Clock::now();
     const float weight = 1.0f / static_cast<float>(settings_.spp);

@@ -95,7 +95,6 @@ class Renderer {
   std::vector<glm::vec3> image_, pass_;
   std::vector<Ray> camera_rays_;
   std::vector<Hit> camera_hits_;
-  std::vector<FirstBounceSample> first_;
 };
 
 // Largest image the renderer accepts (pixels); beyond it buffers would not fit in memory.

@@ -30,10 +30,9 @@ class RecordingSampler final : public FirstBounceSampler {
     log_.push_back("end " + std::to_string(at.frame) + (valid > 0 ? " with vpls" : " no vpls"));
   }
   bool wants_vpls() const override { return true; }
-  void sample(const GBuffer& g, const SampleCoordinates& at,
-              std::vector<FirstBounceSample>& out) override {
+  FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
     log_.push_back("sample " + std::to_string(at.frame) + "." + std::to_string(at.sample));
-    bsdf_.sample(g, at, out);
+    return bsdf_.sample(g, at);
   }
   float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
             const glm::vec3& wi) const override {
@@ -66,9 +65,8 @@ TEST(FrameOrder, TrainingFollowsTheFramesLastSample) {
 // for BsdfFirstBounce itself (samples_the_bsdf()).
 class SeparatePassBsdf final : public FirstBounceSampler {
  public:
-  void sample(const GBuffer& g, const SampleCoordinates& at,
-              std::vector<FirstBounceSample>& out) override {
-    bsdf_.sample(g, at, out);
+  FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
+    return bsdf_.sample(g, at);
   }
   float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
             const glm::vec3& wi) const override {

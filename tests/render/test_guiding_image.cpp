@@ -53,10 +53,11 @@ class PdfTooHigh final : public FirstBounceSampler {
   }
   bool wants_vpls() const override { return inner_->wants_vpls(); }
   bool reads_gbuffers_in_place() const override { return inner_->reads_gbuffers_in_place(); }
-  void sample(const GBuffer& g, const SampleCoordinates& at,
-              std::vector<FirstBounceSample>& out) override {
-    inner_->sample(g, at, out);
-    for (FirstBounceSample& s : out) s.pdf *= 1.05f;
+  FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
+    const FirstBounceSamples inner = inner_->sample(g, at);
+    direction_pdf_.assign(inner.direction_pdf, inner.direction_pdf + g.pixel_count());
+    for (glm::vec4& d : direction_pdf_) d.w *= 1.05f;
+    return FirstBounceSamples{direction_pdf_.data(), inner.strategy};
   }
   float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
             const glm::vec3& wi) const override {
@@ -65,6 +66,7 @@ class PdfTooHigh final : public FirstBounceSampler {
 
  private:
   std::unique_ptr<FirstBounceSampler> inner_;
+  std::vector<glm::vec4> direction_pdf_;
 };
 
 enum class Method { PathTracing, Guided, GuidedWithBias };
