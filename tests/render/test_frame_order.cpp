@@ -5,6 +5,7 @@
 // sampling at the primary hit equals the sampler's separate pass.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -61,24 +62,10 @@ TEST(FrameOrder, TrainingFollowsTheFramesLastSample) {
   EXPECT_EQ(log, expected);
 }
 
-// BSDF sampling in a pass of its own: BsdfFirstBounce::sample(), which the renderer leaves out
-// for BsdfFirstBounce itself (samples_the_bsdf()).
-class SeparatePassBsdf final : public FirstBounceSampler {
- public:
-  FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
-    return bsdf_.sample(g, at);
-  }
-  float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
-            const glm::vec3& wi) const override {
-    return bsdf_.pdf(g, i, lobes, wo, wi);
-  }
-
- private:
-  BsdfFirstBounce bsdf_;
-};
-
 // Two samples a pixel, a moving camera, an odd size: every frame's image is the same to the bit
-// whether the first bounce comes from the sampler's pass or from the path tracer's.
+// whether the first bounce comes from BsdfFirstBounce's own pass (RecordingSampler runs it; the
+// renderer leaves it out for BsdfFirstBounce itself, samples_the_bsdf()) or from the path
+// tracer's.
 TEST(FrameOrder, BsdfAtThePrimaryHitEqualsItsOwnPass) {
   const Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
   RenderSettings settings;
@@ -88,7 +75,8 @@ TEST(FrameOrder, BsdfAtThePrimaryHitEqualsItsOwnPass) {
   settings.camera_path = "pan";
   Renderer in_place(scene, settings), separate(scene, settings);
   ASSERT_TRUE(BsdfFirstBounce().samples_the_bsdf());
-  separate.set_first_bounce_sampler(std::make_unique<SeparatePassBsdf>());
+  std::vector<std::string> log;
+  separate.set_first_bounce_sampler(std::make_unique<RecordingSampler>(log));
   for (int frame = 0; frame < 3; ++frame) {
     in_place.render_frame(frame);
     separate.render_frame(frame);
@@ -103,6 +91,7 @@ TEST(FrameOrder, BsdfAtThePrimaryHitEqualsItsOwnPass) {
     EXPECT_EQ(differ, 0u) << "frame " << frame;
     EXPECT_GT(lit, a.size() / 2) << "frame " << frame;
   }
+  EXPECT_EQ(std::count(log.begin(), log.end(), "sample 2.1"), 1);  // the pass ran
 }
 
 }  // namespace
