@@ -110,9 +110,14 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSamples* first,
 
 void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
   paths_.resize(n);
-  if (vpls) vpls->resize(n);
+  keep_vpls_ = vpls != nullptr;
+  if (vpls) {
+    vpls->resize(n);
+    vpl_paths_.resize(n);
+    shadow_vpl_contribution_.resize(n);
+  }
   shadow_rays_.resize(n);
-  shadow_work_.resize(n);
+  shadow_contribution_.resize(n);
   has_shadow_.resize(n);
   rays_.resize(n);
   hits_.resize(n);
@@ -146,9 +151,8 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           PathState& p = paths_[i];
           p.radiance = glm::vec3(g.emission[i]);
-          p.vpl_radiance = glm::vec3(0.0f);
           p.throughput = glm::vec3(0.0f);
-          p.vpl_throughput = glm::vec3(1.0f);
+          if (vpls) vpl_paths_[i] = VplPath{glm::vec3(1.0f), glm::vec3(0.0f)};
           shadow_rays_[i] = inactive_ray();
           has_shadow_[i] = 0;
           rays_[i] = inactive_ray();
@@ -173,8 +177,8 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
           Ray shadow;
           if (next_event_on_ && next_event(x0, ng, frame, wo, lobes, origin, u_sel, u1, u2,
                                            first_bounce_pdf, c, shadow)) {
-            shadow_work_[i].contribution = c;
-            shadow_work_[i].vpl_contribution = glm::vec3(0.0f);
+            shadow_contribution_[i] = c;
+            if (vpls) shadow_vpl_contribution_[i] = glm::vec3(0.0f);
             shadow_rays_[i] = shadow;
             has_shadow_[i] = 1;
           }
@@ -244,15 +248,15 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
           // With next-event estimation at x0 the light's own direction is NEE's job: the
           // guide learns only what arrives indirectly (emission at y stays out), or the light
           // with the MIS weight this sample got (direct_light_in_vpls).
-          if (!nee || settings_.direct_light_in_vpls) p.vpl_radiance += le * w;
           if (vpls) {
+            if (!nee || settings_.direct_light_in_vpls) vpl_paths_[i].radiance += le * w;
             const float strategy_pdf = vpls->strategy_pdf[i];
             vpls->position[i] = glm::vec4(dir, strategy_pdf);
             vpls->normal[i] = glm::vec4(0.0f, 0.0f, 0.0f, p.prev_pdf);
             if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
           }
-        } else {
-          p.vpl_radiance += p.vpl_throughput * le * w;
+        } else if (vpls) {
+          vpl_paths_[i].radiance += vpl_paths_[i].throughput * le * w;
         }
         continue;
       }
@@ -264,10 +268,10 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
                                                        sp.position, sp.geometric_normal))
                 : 1.0f;
         p.radiance += p.throughput * sp.emission * w;
-        if (depth > 1) {
-          p.vpl_radiance += p.vpl_throughput * sp.emission * w;
-        } else if (!nee || settings_.direct_light_in_vpls) {
-          p.vpl_radiance += sp.emission * w;  // see the escaped case above
+        if (vpls && depth > 1) {
+          vpl_paths_[i].radiance += vpl_paths_[i].throughput * sp.emission * w;
+        } else if (vpls && (!nee || settings_.direct_light_in_vpls)) {
+          vpl_paths_[i].radiance += sp.emission * w;  // see the escaped case above
         }
       }
       if (depth == 1 && vpls) {
@@ -289,7 +293,8 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       const shared::pg_lobes lobes = shared::pg_make_lobes(sp.material, wo);
       const glm::vec3 origin =
           offset_ray_origin(sp.position, sp.geometric_normal, sp.offset_distance);
-      const glm::vec3 vpl_throughput = depth == 1 ? glm::vec3(1.0f) : p.vpl_throughput;
+      const glm::vec3 vpl_throughput =
+          depth == 1 || !vpls ? glm::vec3(1.0f) : vpl_paths_[i].throughput;
 
       const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
                   u2 = shared::pg_rng_next(&rng);
@@ -310,8 +315,8 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       Ray shadow;
       if (nee && next_event(sp.position, sp.geometric_normal, frame, wo, lobes, origin, u_sel, u1,
                             u2, vertex_pdf, c, shadow)) {
-        shadow_work_[j].contribution = p.throughput * c;
-        shadow_work_[j].vpl_contribution = vpl_throughput * c;
+        shadow_contribution_[j] = p.throughput * c;
+        if (vpls) shadow_vpl_contribution_[j] = vpl_throughput * c;
         shadow_rays_[j] = shadow;
         has_shadow_[j] = 1;
       }
@@ -349,14 +354,15 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       if (glm::dot(wi_world, sp.geometric_normal) <= 0.0f) continue;
       const glm::vec3 weight = shared::pg_bsdf_eval(lobes, wo, bs.wi) * (bs.wi.z / bs.pdf);
       p.throughput *= weight;
-      p.vpl_throughput = vpl_throughput * weight;
+      glm::vec3 next_vpl_throughput = vpl_throughput * weight;
       if (depth >= settings_.roulette_start) {
         const float q =
             std::min(0.95f, std::max(p.throughput.x, std::max(p.throughput.y, p.throughput.z)));
         if (!(u_rr < q)) continue;
         p.throughput /= q;
-        p.vpl_throughput /= q;
+        next_vpl_throughput /= q;
       }
+      if (vpls) vpl_paths_[i].throughput = next_vpl_throughput;
       if (is_black(p.throughput) || !is_finite(p.throughput)) continue;
       p.prev_pdf = bs.pdf;
       p.prev_position = sp.position;
@@ -461,9 +467,8 @@ void PathTracer::apply_shadow_rays_and_compact(std::size_t count,
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
       const std::uint32_t owner = owners ? (*owners)[j] : static_cast<std::uint32_t>(j);
       if (has_shadow_[j] && !occluded_[j]) {
-        PathState& p = paths_[owner];
-        p.radiance += shadow_work_[j].contribution;
-        p.vpl_radiance += shadow_work_[j].vpl_contribution;
+        paths_[owner].radiance += shadow_contribution_[j];
+        if (keep_vpls_) vpl_paths_[owner].radiance += shadow_vpl_contribution_[j];
       }
       if (alive_[j]) {
         next_rays_[slot_[j]] = rays_[j];
@@ -491,7 +496,7 @@ void PathTracer::gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls,
             ++bad;
           }
           if (vpls) {
-            const glm::vec3 vpl_l = p.vpl_radiance;
+            const glm::vec3 vpl_l = vpl_paths_[i].radiance;
             if (!is_finite(vpl_l)) vpls->info[i] &= ~PG_VPL_VALID;
             // The kernels read the info bits from radiance_info.w (exact: small integers).
             vpls->radiance_info[i] = glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f),

@@ -75,18 +75,20 @@ class PathTracer {
   const PathTracerSettings& settings() const { return settings_; }
 
  private:
+  // What every path carries from vertex to vertex (44 bytes: a path touches one cache line).
   struct PathState {
-    glm::vec3 throughput;      // from the camera
-    glm::vec3 vpl_throughput;  // from the first-bounce hit y (for the VPL's radiance)
-    glm::vec3 radiance;        // accumulated pixel estimate
-    glm::vec3 vpl_radiance;    // accumulated radiance leaving y towards x0
-    float prev_pdf;            // density of the direction that led here (for MIS)
-    glm::vec3 prev_position;   // origin of the current ray
-    std::uint32_t rng;         // pg_rng state
+    glm::vec3 throughput;     // from the camera
+    glm::vec3 radiance;       // accumulated pixel estimate
+    float prev_pdf;           // density of the direction that led here (for MIS)
+    glm::vec3 prev_position;  // origin of the current ray
+    std::uint32_t rng;        // pg_rng state
   };
-  struct ShadowWork {
-    glm::vec3 contribution;      // to the pixel, if unoccluded
-    glm::vec3 vpl_contribution;  // to the VPL radiance, if unoccluded
+  // What a path carries only where its VPL is kept (trace() with vpls): apart, so that the
+  // passes that keep none do not move it (docs/host-path-tracer.md, "The VPL's radiance
+  // apart").
+  struct VplPath {
+    glm::vec3 throughput;  // from the first-bounce hit y
+    glm::vec3 radiance;    // accumulated radiance leaving y towards x0
   };
 
   // The steps of trace(), in order.
@@ -147,7 +149,9 @@ class PathTracer {
 
   // Scratch, reused across frames.
   std::vector<PathState> paths_;
-  bool next_event_on_ = true;  // next-event estimation this frame (settings and lights)
+  std::vector<VplPath> vpl_paths_;  // per pixel, where keep_vpls_
+  bool keep_vpls_ = false;          // this pass writes VPLs (trace()'s vpls)
+  bool next_event_on_ = true;       // next-event estimation this frame (settings and lights)
   std::vector<std::uint32_t> active_, next_active_;
   std::vector<std::uint32_t> slot_;  // apply_shadow_rays_and_compact(): each survivor's new slot
   std::vector<Ray> next_rays_;       // the same: the survivors' rays, then swapped in
@@ -156,7 +160,9 @@ class PathTracer {
   std::vector<Hit> hits_;
   std::vector<std::uint8_t> occluded_;
   std::vector<std::uint8_t> has_shadow_;  // per slot: 1 where shadow_rays_ holds a segment
-  std::vector<ShadowWork> shadow_work_;
+  // Per slot with a shadow segment: what it adds to its path, and to the path's VPL radiance
+  // (keep_vpls_), if unoccluded.
+  std::vector<glm::vec3> shadow_contribution_, shadow_vpl_contribution_;
   std::vector<BorrowablePixel> borrowable_;  // per pixel, with guide_secondary
 };
 
