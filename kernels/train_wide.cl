@@ -70,7 +70,8 @@ __kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uch
   pg_intw n = pg_convert_intw(t * (settings.n_max - settings.n_min) + settings.n_min + 0.5f);
   pg_intw counts =
       select((pg_intw)(0), min(n, (pg_intw)(min(side * side, PG_MAX_TRAIN_SAMPLES))), active);
-  pg_intw lane_passes = select((pg_intw)(settings.em_passes), (pg_intw)(1), mature);
+  /* pg_pmm_train's passes: one for a mature pixel and for a new model (k = 0). */
+  pg_intw lane_passes = select((pg_intw)(settings.em_passes), (pg_intw)(1), mature | (k <= 0.0f));
   int most_samples = pg_max_lane(counts);
   pg_intw done = ~active, updated = (pg_intw)(0);
   pg_pmm_state_w result = original;
@@ -150,11 +151,13 @@ __kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uch
    * an invalid model, its last pass) is done and keeps its result. */
   pg_pmm_state_w base = original;
   pg_floatw target = pg_convert_floatw(counts);
+  /* pg_pmm_train's history weight: W of the state each lane's model comes from. */
+  pg_floatw history_weight = original.w;
   for (int pass = 0; !all(done); ++pass) {
     pg_pmm_batch_w b = pg_pmm_batch_empty_w();
     pg_pmm_e_terms_w terms = pg_pmm_e_terms_of_w(m);
     for (int s = 0; s < most_samples; ++s)
-      b = pg_pmm_batch_add_w(b, m, terms, settings, samples[s], original.w);
+      b = pg_pmm_batch_add_w(b, m, terms, settings, samples[s], history_weight);
     pg_intw live = ~done, step;
     /* A re-seed replaces the history: later passes refine the new model alone. */
     base = pg_pmm_state_select_w(base, pg_pmm_initial_state_w(),
@@ -166,6 +169,7 @@ __kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uch
     if (all(~live | last)) break; /* no lane needs the next pass's model */
     pg_pmm_model_w next_model = pg_pmm_model_from_state_w(next, settings);
     m = pg_pmm_model_select_w(m, next_model, live & step);
+    history_weight = select(history_weight, next.w, live & step);
     done |= live & (~step | ~next_model.valid | last);
   }
 

@@ -352,23 +352,33 @@ PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples
                                 float target_count, int passes, PG_PRIVATE int* updated) {
   pg_pmm_model m = pg_pmm_model_from_state(s, p);
   pg_pmm_state base = s, out = s;
+  /* The running mean weight W of the state that m comes from: the weight clamp and the
+   * re-seed test compare a sample with it. A later pass's model is the previous pass's
+   * M-step, so its W is that state's, not the frame's first: a new model's W is 0 until its
+   * first M-step (docs/guiding.md, "The history weight of later E-step passes"). */
+  float history_weight = s.s0.x;
   *updated = 0;
   /* Extra passes move a young lobe onto its target; once k is a quarter of the way to k_max the
    * lobe sits there and one pass does (measured: relMSE ratio on cornell-indirect 0.42 -> 0.44,
    * cornell-box unchanged; the train kernel 33% faster at 720p). */
   if (s.s1.w >= 0.25f * p.k_max) passes = 1;
+  /* A new model (k = 0) is the batch's plain weighted moments (pg_pmm_update), which the
+   * responsibilities of later passes do not change: one pass (docs/guiding.md, "The history
+   * weight of later E-step passes"). */
+  if (s.s1.w <= 0.0f) passes = 1;
   for (int pass = 0; pass < passes; ++pass) {
     pg_pmm_batch b = pg_pmm_batch_empty();
     pg_pmm_e_terms terms = pg_pmm_e_terms_of(m);
     for (int j = 0; j < n; ++j)
       b = pg_pmm_batch_add_terms(b, m, terms, p, samples[j].x,
                                  pg_make_float2(samples[j].y, samples[j].z), samples[j].w,
-                                 densities[j], s.s0.x);
+                                 densities[j], history_weight);
     /* A re-seed replaces the history: later passes refine the new model alone. */
     if (pg_pmm_batch_reseeds(b, p)) base = pg_pmm_initial_state();
     out = pg_pmm_update(base, b, p, target_count, updated);
     if (!*updated) return s;
     m = pg_pmm_model_from_state(out, p);
+    history_weight = out.s0.x;
     if (!m.valid) return out;
   }
   return out;

@@ -815,13 +815,14 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
     settings.local_y = kc.local_y;
     settings.apron = kc.apron;
     // The training options vary with the case (every case has its own apron): every VPL at
-    // its mixture density with apron 2, amortised training of mature pixels and re-seeds that
-    // take two samples of a batch with apron 1, the variance-aware mixing weight with aprons 1
-    // and 3 (EM's with apron 2).
+    // its mixture density and the weight clamp with apron 2, amortised training of mature pixels
+    // and re-seeds that take two samples of a batch with apron 1, the variance-aware mixing weight
+    // with aprons 1 and 3 (EM's with apron 2).
     settings.train_all_samples = kc.apron == 2 ? 1 : 0;
     settings.pi_learning = kc.apron != 2 ? 1 : 0;
     settings.train_interval = kc.apron == 1 ? 3 : 1;
     settings.reseed_samples = kc.apron == 1 ? 2 : 1;
+    settings.weight_clamp = kc.apron == 2 ? 5.0f : 0.0f;
     const pg_kernel_settings p = to_kernel_settings(settings);
     std::vector<float> state = random_states(r, g.n(), p.k_max, false);
     std::vector<float> per_variant[2];

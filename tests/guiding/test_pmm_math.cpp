@@ -621,6 +621,56 @@ TEST(PmmEm, ReseedsOnlyWhenEnoughSamplesOfOneBatchCallForIt) {
   EXPECT_EQ(k_after(1, {near_lobe, float4(15.0f, 0.8f, 0.8f, 0.3f)}), 11.0f);
 }
 
+// The weight clamp (weight_clamp, pmm.h) against the running mean weight W of the state each
+// E-step pass takes its model from. A new model (k = 0) trains in one pass, unclamped: its
+// later passes were once clamped against its W of 0, which zeroed every weight and threw the
+// frame's training away, so that no pixel ever trained with the clamp on. A young model (k = 1)
+// trains in three passes, each clamping against the W the previous pass's M-step gave, which
+// this test follows by hand: all samples sit in the lobe (no re-seed), so each pass's M-step
+// is W0 + (mean of the clamped weights - W0) / 2 from the frame's first state.
+TEST(PmmEm, WeightClampFollowsEachPassesHistory) {
+  rtpg::GuidingSettings settings;
+  settings.weight_clamp = 5.0f;
+  const pg_kernel_settings p = rtpg::to_kernel_settings(settings);
+  std::vector<float4> batch;
+  std::vector<float> weights;
+  for (int i = 0; i < 9; ++i) {
+    const float a = 10.0f + static_cast<float>(i);
+    batch.push_back(float4(a, 0.3f + 0.01f * static_cast<float>(i % 3),
+                           0.3f + 0.01f * static_cast<float>(i / 3), 0.3f));
+    weights.push_back(a);
+  }
+  batch.push_back(float4(100.0f, 0.31f, 0.31f, 0.3f));
+  weights.push_back(100.0f);
+  const std::vector<float> densities(batch.size(), 1.0f);
+  const int n = static_cast<int>(batch.size());
+
+  int updated = 0;
+  const pg_pmm_state fresh = pg_pmm_train(pg_pmm_initial_state(), batch.data(), densities.data(), n,
+                                          p, static_cast<float>(n), 3, &updated);
+  EXPECT_EQ(updated, 1);
+  EXPECT_TRUE(pg_pmm_model_from_state(fresh, p).valid);
+  double mean = 0.0;
+  for (float a : weights) mean += a;
+  EXPECT_NEAR(fresh.s0.x, mean / n, 1e-4 * mean / n) << "a new model's weights are not clamped";
+
+  const pg_pmm_state young = make_state(0.31f, 0.31f, 0.01f, 0.01f, 0.0f, 0.5f, 1.0f, 0.5f);
+  ASSERT_NEAR(young.s0.x, 1.0f, 1e-6f);  // W0 = 1
+  updated = 0;
+  const pg_pmm_state out =
+      pg_pmm_train(young, batch.data(), densities.data(), n, p, static_cast<float>(n), 3, &updated);
+  EXPECT_EQ(updated, 1);
+  double history = young.s0.x, w = 0.0;
+  for (int pass = 0; pass < 3; ++pass) {
+    double clamped = 0.0;
+    for (float a : weights) clamped += std::min(double(a), double(p.weight_clamp) * history);
+    w = young.s0.x + (clamped / n - young.s0.x) * 0.5;  // eta = 1/(k+1) at k = 1
+    history = w;
+  }
+  EXPECT_NEAR(out.s0.x, w, 1e-4 * w);
+  EXPECT_EQ(out.s1.w, 2.0f);
+}
+
 // One sample repeated (and the square's corners and edge midpoints, where the map M has its
 // kinks and the mean sits on the clamp): the empirical covariance is exactly zero, yet the
 // model keeps a positive definite Sigma and its mean at the sample.
