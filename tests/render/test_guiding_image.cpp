@@ -11,6 +11,7 @@
 
 #include "rtpg/cl_runtime.h"
 #include "rtpg/guiding_settings.h"
+#include "forwarding_sampler.h"
 #include "render/guided_first_bounce.h"
 #include "render/image_io.h"
 #include "render/renderer.h"
@@ -44,30 +45,17 @@ struct RunShape {
 
 // A guided sampler whose first-bounce samples claim a density 5% too high: every path that
 // leaves the primary hit is weighted 5% too low, a bias the unbiasedness checks must reject.
-class PdfTooHigh final : public FirstBounceSampler {
+class PdfTooHigh final : public ForwardingSampler {
  public:
-  explicit PdfTooHigh(std::unique_ptr<FirstBounceSampler> inner) : inner_(std::move(inner)) {}
-  void begin_frame(const GBuffer& g, const SampleCoordinates& at) override {
-    inner_->begin_frame(g, at);
-  }
-  void end_frame(const GBuffer& g, const VplBuffer& v, const SampleCoordinates& at) override {
-    inner_->end_frame(g, v, at);
-  }
-  bool wants_vpls() const override { return inner_->wants_vpls(); }
-  bool reads_gbuffers_in_place() const override { return inner_->reads_gbuffers_in_place(); }
+  using ForwardingSampler::ForwardingSampler;
   FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
-    const FirstBounceSamples inner = inner_->sample(g, at);
+    const FirstBounceSamples inner = ForwardingSampler::sample(g, at);
     direction_pdf_.assign(inner.direction_pdf, inner.direction_pdf + g.pixel_count());
     for (glm::vec4& d : direction_pdf_) d.w *= 1.05f;
     return FirstBounceSamples{direction_pdf_.data(), inner.strategy};
   }
-  float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
-            const glm::vec3& wi) const override {
-    return inner_->pdf(g, i, lobes, wo, wi);
-  }
 
  private:
-  std::unique_ptr<FirstBounceSampler> inner_;
   std::vector<glm::vec4> direction_pdf_;
 };
 

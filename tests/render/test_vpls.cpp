@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "forwarding_sampler.h"
 #include "render/first_bounce.h"
 #include "render/guided_first_bounce.h"
 #include "render/renderer.h"
@@ -22,40 +23,21 @@
 namespace rtpg {
 namespace {
 
-// Forwards to the guided sampler and keeps a copy of each frame's first samples.
-class KeepsFirstSamples final : public FirstBounceSampler {
+// Keeps a copy of each frame's first samples.
+class KeepsFirstSamples final : public ForwardingSampler {
  public:
-  explicit KeepsFirstSamples(std::unique_ptr<FirstBounceSampler> inner)
-      : inner_(std::move(inner)) {}
-  void begin_frame(const GBuffer& g, const SampleCoordinates& at) override {
-    inner_->begin_frame(g, at);
-  }
-  void end_frame(const GBuffer& g, const VplBuffer& v, const SampleCoordinates& at) override {
-    inner_->end_frame(g, v, at);
-  }
-  bool wants_vpls() const override { return inner_->wants_vpls(); }
-  bool reads_gbuffers_in_place() const override { return inner_->reads_gbuffers_in_place(); }
+  using ForwardingSampler::ForwardingSampler;
   FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
-    const FirstBounceSamples s = inner_->sample(g, at);
+    const FirstBounceSamples s = ForwardingSampler::sample(g, at);
     if (at.sample == 0) {
       direction_pdf.assign(s.direction_pdf, s.direction_pdf + g.pixel_count());
       strategy.assign(s.strategy, s.strategy + g.pixel_count());
     }
     return s;
   }
-  float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
-            const glm::vec3& wi) const override {
-    return inner_->pdf(g, i, lobes, wo, wi);
-  }
-  bool pixel_guide(const GBuffer& g, std::size_t i, PixelGuide& out) const override {
-    return inner_->pixel_guide(g, i, out);
-  }
 
   std::vector<glm::vec4> direction_pdf;
   std::vector<std::uint32_t> strategy;
-
- private:
-  std::unique_ptr<FirstBounceSampler> inner_;
 };
 
 struct VplCounts {
