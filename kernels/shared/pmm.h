@@ -281,13 +281,6 @@ PG_FN pg_pmm_batch pg_pmm_batch_add_terms(pg_pmm_batch b, pg_pmm_model m, pg_pmm
   return b;
 }
 
-/* pg_pmm_batch_add_terms with the model's E-step terms computed for this one sample. */
-PG_FN pg_pmm_batch pg_pmm_batch_add(pg_pmm_batch b, pg_pmm_model m, pg_kernel_settings p, float a,
-                                    float2 u, float bsdf_pdf, float density, float history_weight) {
-  return pg_pmm_batch_add_terms(b, m, pg_pmm_e_terms_of(m), p, a, u, bsdf_pdf, density,
-                                history_weight);
-}
-
 /* Number of neighbour VPLs a pixel trains on at epoch k (paper 4.2). */
 PG_FN int pg_pmm_neighbour_count(float k, pg_kernel_settings p) {
   float t = clamp(1.0f - k / p.k_max, 0.0f, 1.0f);

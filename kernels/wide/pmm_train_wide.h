@@ -122,7 +122,7 @@ static inline pg_pmm_batch_w pg_pmm_batch_add_w(pg_pmm_batch_w b, pg_pmm_model_w
   pg_intw ok = s.kept & (a >= 0.0f) & (a <= p.max_weight);
   if (p.weight_clamp > 0.0f) a = select(a, fmin(a, p.weight_clamp * history_weight), m.valid);
   pg_intw zero = a == 0.0f;
-  if (!any(ok & ~zero)) { /* no lane adds more than its count (pg_pmm_batch_add's a = 0) */
+  if (!any(ok & ~zero)) { /* no lane adds more than its count (pg_pmm_batch_add_terms's a = 0) */
     b.count = select(b.count, b.count + 1.0f, ok);
     return b;
   }

@@ -486,9 +486,9 @@ pg_pmm_state update_with(const pg_pmm_state& s, const pg_kernel_settings& p,
   const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
   pg_pmm_batch b = pg_pmm_batch_empty();
   for (const auto& [a, u] : samples)
-    b = pg_pmm_batch_add(b, m, p, a, u,
-                         pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(u)), 0.0f,
-                         s.s0.x);
+    b = pg_pmm_batch_add_terms(b, m, pg_pmm_e_terms_of(m), p, a, u,
+                               pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(u)),
+                               0.0f, s.s0.x);
   return pg_pmm_update(s, b, p, static_cast<float>(samples.size()), updated);
 }
 
@@ -522,7 +522,7 @@ TEST(PmmEm, UnusableWeightsLeaveTheStateUnchanged) {
   }
 }
 
-// pg_pmm_batch_add documents that NaN, negative and absurd weights are dropped: mixed into a
+// pg_pmm_batch_add_terms documents that NaN, negative and absurd weights are dropped: mixed into a
 // good batch they change nothing (compared to the good batch alone, up to float rounding).
 TEST(PmmEm, UnusableWeightsMixedIntoAGoodBatchAreDropped) {
   const pg_kernel_settings p = default_params();
@@ -545,13 +545,13 @@ TEST(PmmEm, UnusableWeightsMixedIntoAGoodBatchAreDropped) {
     const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
     pg_pmm_batch bg = pg_pmm_batch_empty(), bm = pg_pmm_batch_empty();
     for (const auto& [a, v] : good)
-      bg = pg_pmm_batch_add(bg, m, p, a, v,
-                            pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), 0.0f,
-                            s0.s0.x);
+      bg = pg_pmm_batch_add_terms(bg, m, pg_pmm_e_terms_of(m), p, a, v,
+                                  pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)),
+                                  0.0f, s0.s0.x);
     for (const auto& [a, v] : mixed)
-      bm = pg_pmm_batch_add(bm, m, p, a, v,
-                            pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), 0.0f,
-                            s0.s0.x);
+      bm = pg_pmm_batch_add_terms(bm, m, pg_pmm_e_terms_of(m), p, a, v,
+                                  pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)),
+                                  0.0f, s0.s0.x);
     const pg_pmm_state sg = pg_pmm_update(s0, bg, p, 12.0f, &ug);
     const pg_pmm_state sm = pg_pmm_update(s0, bm, p, 12.0f, &um);
     EXPECT_EQ(ug, 1);
@@ -574,9 +574,9 @@ TEST(PmmEm, AStarvedBatchTakesAProportionallySmallerStep) {
   const pg_lobes lobes = pg_make_lobes({float3(0.8f), 1.0f, 0.0f, 0.0f}, float3(0, 0, 1));
   pg_pmm_batch b = pg_pmm_batch_empty();
   for (const float2 v : {float2(0.55f, 0.45f), float2(0.6f, 0.5f), float2(0.52f, 0.58f)})
-    b = pg_pmm_batch_add(b, m, p, 1.0f, v,
-                         pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)), 0.0f,
-                         s0.s0.x);
+    b = pg_pmm_batch_add_terms(b, m, pg_pmm_e_terms_of(m), p, 1.0f, v,
+                               pg_bsdf_pdf(lobes, float3(0, 0, 1), pg_square_to_hemisphere(v)),
+                               0.0f, s0.s0.x);
   int full_updated = 0, starved_updated = 0;
   const pg_pmm_state full = pg_pmm_update(s0, b, p, 3.0f, &full_updated);
   const pg_pmm_state starved = pg_pmm_update(s0, b, p, 12.0f, &starved_updated);
@@ -594,7 +594,7 @@ TEST(PmmEm, AStarvedBatchTakesAProportionallySmallerStep) {
   EXPECT_GT(std::fabs(double(full.s0.z) - s0.s0.z), 1e-3) << "the batch must move the mean";
 }
 
-// Re-seeding (pmm.h, pg_pmm_batch_add): a narrow lobe whose batch has samples far outside it
+// Re-seeding (pmm.h, pg_pmm_batch_add_terms): a narrow lobe whose batch has samples far outside it
 // (beyond 5 standard deviations) and brighter than reseed_ratio times its history restarts
 // (k back to 1) once reseed_samples of them are in one batch, and otherwise trains on (k + 1).
 TEST(PmmEm, ReseedsOnlyWhenEnoughSamplesOfOneBatchCallForIt) {
@@ -768,8 +768,8 @@ TEST(PmmEm, SurvivesAHundredThousandJunkUpdates) {
       pg_pmm_batch b = pg_pmm_batch_empty();
       for (int j = 0; j < count; ++j) {
         const float4& x = samples[static_cast<std::size_t>(j)];
-        b = pg_pmm_batch_add(b, m, p, x.x, float2(x.y, x.z), x.w,
-                             densities[static_cast<std::size_t>(j)], s.s0.x);
+        b = pg_pmm_batch_add_terms(b, m, pg_pmm_e_terms_of(m), p, x.x, float2(x.y, x.z), x.w,
+                                   densities[static_cast<std::size_t>(j)], s.s0.x);
       }
       s = pg_pmm_update(s, b, p, target, &updated);
     } else {
