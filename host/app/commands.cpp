@@ -213,7 +213,8 @@ int run_render(const RenderCommand& command) {
   Renderer renderer = with_flag_names([&] { return Renderer(scene, settings); });
   if (command.guiding == "pmm")
     renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(
-        cl, command.settings.width, command.settings.height, command.guiding_settings));
+        cl, command.settings.width, command.settings.height, command.guiding_settings,
+        parse_host_transfer(command.host_transfer)));
   std::unique_ptr<SvgfDenoiser> denoiser;
   if (command.denoise == "svgf")
     denoiser =

@@ -35,7 +35,8 @@ struct RenderCommand {
                                            // borrow the mixture of the pixel showing them)
   GuidingSettings guiding_settings;
   std::string train_memory = "auto";
-  std::string denoise = "off";  // "off" or "svgf" (docs/denoising.md)
+  std::string host_transfer = "auto";  // parse_host_transfer (host/render/guided_first_bounce.h)
+  std::string denoise = "off";         // "off" or "svgf" (docs/denoising.md)
   SvgfSettings svgf_settings;
   std::string noisy_output;  // with --denoise: the unfiltered last frame; "" = none
 };

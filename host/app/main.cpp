@@ -63,6 +63,12 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
                   "VPL reads of the train kernel: auto, local or global")
       ->check(CLI::IsMember({"auto", "local", "global"}))
       ->capture_default_str();
+  grp->add_option("--host-transfer", r.host_transfer,
+                  "How the G-buffer and VPLs reach the device and the samples come back: auto "
+                  "(in-place where the device shares host memory, else pinned), in-place, pinned "
+                  "(through mapped staging) or pageable")
+      ->check(CLI::IsMember({"auto", "in-place", "pinned", "pageable"}))
+      ->capture_default_str();
 }
 
 // "--svgf-" and the setting's name with '-' for '_', one flag per row of the denoiser's table

@@ -25,17 +25,18 @@ std::size_t pixels(int width, int height) {
 
 #define RTPG_ALLOCATE(name, type, bytes) b.name = cl::Buffer(context, flags, n * (bytes));
 
-GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height) {
+GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height,
+                                  cl_mem_flags host_flags) {
   const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags = CL_MEM_READ_ONLY;
+  const cl_mem_flags flags = CL_MEM_READ_ONLY | host_flags;
   GuiderGBuffer b;
   translate_cl_errors([&] { PG_GBUFFER_CHANNELS(RTPG_ALLOCATE) });
   return b;
 }
 
-GuiderVpls make_guider_vpls(cl::Context& context, int width, int height) {
+GuiderVpls make_guider_vpls(cl::Context& context, int width, int height, cl_mem_flags host_flags) {
   const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags = CL_MEM_READ_ONLY;
+  const cl_mem_flags flags = CL_MEM_READ_ONLY | host_flags;
   GuiderVpls b;
   translate_cl_errors([&] { PG_VPL_CHANNELS(RTPG_ALLOCATE) });
   return b;

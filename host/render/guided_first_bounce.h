@@ -15,14 +15,30 @@ namespace rtpg {
 
 class ClRuntime;
 
+// How the G-buffer and VPLs reach the device and the samples come back (docs/guiding.md, "On a
+// GPU"; measured on a discrete GPU in "The renderer on a GPU").
+enum class HostTransfer {
+  automatic,  // in_place where the device shares host memory (DeviceInfo::host_unified_memory),
+              // else pinned
+  in_place,   // the device reads the host's G-buffer and VPLs where they are
+              // (CL_MEM_USE_HOST_PTR) and the host maps the samples: no copies where memory is
+              // shared; elsewhere the OpenCL implementation copies when the kernels need them
+  pinned,     // the host copies the G-buffer and VPLs into mapped CL_MEM_ALLOC_HOST_PTR staging
+              // (pinned memory on a discrete GPU), which the device copies from; the samples
+              // come back into such staging
+  pageable,   // the device copies straight from the host's own (pageable) vectors; the samples
+              // come back into pinned staging
+};
+// "auto", "in-place", "pinned", "pageable" (the CLI's --host-transfer); throws GuiderError else.
+HostTransfer parse_host_transfer(const std::string& name);
+const char* host_transfer_name(HostTransfer transfer);
+
 class GuidedFirstBounce final : public FirstBounceSampler {
  public:
-  // zero_copy: where the device shares host memory (DeviceInfo::host_unified_memory), the
-  // device reads the host's G-buffer and VPLs in place and the host reads the samples in
-  // place; the renderer must then alternate two G-buffers (reads_gbuffers_in_place()).
-  // false copies them as for any other device.
+  // With HostTransfer::in_place (automatic on a device that shares host memory) the renderer
+  // must alternate two G-buffers (reads_gbuffers_in_place()).
   GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingSettings& settings,
-                    bool zero_copy = true);
+                    HostTransfer transfer = HostTransfer::automatic);
   ~GuidedFirstBounce() override;
 
   void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) override;
@@ -34,6 +50,7 @@ class GuidedFirstBounce final : public FirstBounceSampler {
                  const SampleCoordinates& at) override;
   bool wants_vpls() const override { return true; }
   bool reads_gbuffers_in_place() const override { return zero_copy_; }
+  HostTransfer host_transfer() const { return transfer_; }  // automatic resolved
   void report(std::map<std::string, double>& time_ms,
               std::map<std::string, double>& extra) override;
 
@@ -65,8 +82,21 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   // mapped: a discrete GPU's driver copies into such (pinned) memory about 5x faster than into
   // pageable memory (docs/guiding.md, "On a GPU"). Its mapped pointers are staged_.
   void unmap_samples();
+  HostTransfer transfer_ = HostTransfer::automatic;
   bool zero_copy_ = false, mapped_ = false;
   GuiderSamples staging_;
+  // HostTransfer::pinned: the upload staging of the G-buffer and the VPLs, mapped for the
+  // host's copies (upload_gbuffer_ and upload_vpls_ point into them).
+  GuiderGBuffer gbuffer_staging_;
+  GuiderVpls vpl_staging_;
+#define RTPG_HOST_VIEW(name, type, bytes) HostChannelView<shared::type> name;
+  struct {
+    PG_GBUFFER_CHANNELS(RTPG_HOST_VIEW)
+  } upload_gbuffer_;
+  struct {
+    PG_VPL_CHANNELS(RTPG_HOST_VIEW)
+  } upload_vpls_;
+#undef RTPG_HOST_VIEW
   struct HostSamples {  // PG_SAMPLE_CHANNELS in staging_
     HostChannelView<glm::vec4> direction_pdf;
     HostChannelView<std::uint32_t> strategy;

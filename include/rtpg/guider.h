@@ -48,11 +48,14 @@ struct GuiderSamples {  // what sample() writes (PG_SAMPLE_CHANNELS)
 #undef RTPG_DEVICE_CHANNEL
 
 // Buffers for width x height pixels (inputs read-only, samples write-only for the kernels).
-// host_flags are added to the samples' flags: with CL_MEM_ALLOC_HOST_PTR, on a device that
-// shares host memory (DeviceInfo::host_unified_memory), the host can map the samples and read
-// them in place instead of copying them (host/render/guided_first_bounce.cpp does).
-GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height);
-GuiderVpls make_guider_vpls(cl::Context& context, int width, int height);
+// host_flags are added to the flags: with CL_MEM_ALLOC_HOST_PTR, on a device that shares host
+// memory (DeviceInfo::host_unified_memory), the host can map the samples and read them in place
+// instead of copying them; elsewhere such buffers, mapped, are pinned staging that a discrete
+// GPU copies from and into several times faster (host/render/guided_first_bounce.cpp does both).
+GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height,
+                                  cl_mem_flags host_flags = 0);
+GuiderVpls make_guider_vpls(cl::Context& context, int width, int height,
+                            cl_mem_flags host_flags = 0);
 GuiderSamples make_guider_samples(cl::Context& context, int width, int height,
                                   cl_mem_flags host_flags = 0);
 

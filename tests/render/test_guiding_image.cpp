@@ -260,7 +260,7 @@ TEST(GuidingImage, RejectsAFivePercentPdfError) {
 // reads the samples in place; elsewhere all three are copied. Both give the same image to the
 // bit, at 2 spp (the samples' mapping is released and renewed between samples) along a moving
 // camera, at an odd size, over enough frames for each G-buffer to be reused.
-TEST(GuidingImage, ReadInPlaceOrCopiedGiveTheSameImage) {
+TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
   ClRuntime cl;
   const Scene scene = load_scene(scene_file("cornell-box.json"));
   RenderSettings settings;
@@ -268,26 +268,40 @@ TEST(GuidingImage, ReadInPlaceOrCopiedGiveTheSameImage) {
   settings.height = 23;
   settings.spp = 2;
   settings.camera_path = scene.camera.paths.begin()->first;
-  std::vector<glm::vec3> images[2];
-  for (int in_place = 0; in_place < 2; ++in_place) {
+  const HostTransfer transfers[] = {HostTransfer::in_place, HostTransfer::pinned,
+                                    HostTransfer::pageable, HostTransfer::automatic};
+  std::vector<glm::vec3> images[4];
+  for (int t = 0; t < 4; ++t) {
+    SCOPED_TRACE(host_transfer_name(transfers[t]));
     Renderer renderer(scene, settings);
-    renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(
-        cl, settings.width, settings.height, GuidingSettings{}, in_place == 1));
+    auto guided = std::make_unique<GuidedFirstBounce>(cl, settings.width, settings.height,
+                                                      GuidingSettings{}, transfers[t]);
+    const HostTransfer used = guided->host_transfer();
+    renderer.set_first_bounce_sampler(std::move(guided));
     for (int f = 0; f < 5; ++f) {
       const FrameStats stats = renderer.render_frame(f);
-      const bool zero_copy = in_place == 1 && cl.info().host_unified_memory;
-      EXPECT_EQ(stats.extra.at("zero_copy"), zero_copy ? 1.0 : 0.0);
-      // Only the trained flags (a byte per pixel) are copied in place.
-      if (zero_copy) {
-        EXPECT_EQ(stats.extra.at("host_device_bytes_per_pixel"), 1.0);
-      }
+      const bool in_place = used == HostTransfer::in_place;
+      EXPECT_EQ(stats.extra.at("zero_copy"), in_place ? 1.0 : 0.0);
+      EXPECT_EQ(stats.extra.at("host_transfer"), static_cast<double>(used));
+      // In place only the trained flags (a byte per pixel) are copied; otherwise the G-buffer
+      // (96 bytes a pixel) and VPLs (48) go up and each sample's 44 bytes come down
+      // (include/rtpg/guiding_layout.h).
+      EXPECT_EQ(stats.extra.at("host_device_bytes_per_pixel"),
+                in_place ? 1.0 : 96.0 + 44.0 * settings.spp + 48.0 + 1.0);
     }
-    images[in_place] = renderer.image();
+    if (transfers[t] == HostTransfer::automatic) {
+      EXPECT_EQ(used,
+                cl.info().host_unified_memory ? HostTransfer::in_place : HostTransfer::pinned);
+    }
+    images[t] = renderer.image();
   }
-  ASSERT_EQ(images[0].size(), images[1].size());
-  std::size_t differ = 0;
-  for (std::size_t i = 0; i < images[0].size(); ++i) differ += images[0][i] != images[1][i];
-  EXPECT_EQ(differ, 0u) << "of " << images[0].size() << " pixels";
+  for (int t = 1; t < 4; ++t) {
+    ASSERT_EQ(images[0].size(), images[t].size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < images[0].size(); ++i) differ += images[0][i] != images[t][i];
+    EXPECT_EQ(differ, 0u) << host_transfer_name(transfers[t]) << ": of " << images[0].size()
+                          << " pixels";
+  }
 }
 
 // Every guiding setting at a value away from its default still trains and guides: the Cornell
