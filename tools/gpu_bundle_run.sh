@@ -8,8 +8,9 @@
 # RENDER=1 the tests run JOBS at a time (default 6; the test binaries find the repository's
 # scenes at the path they were built in, linked to SOURCE, default the working directory), then
 # rtpg renders FRAMES frames (default 24) of SCENES at RESOLUTIONS path-traced and guided with each
-# host transfer, and with SVGF, into OUT/frames/*.json (--stats-json), and bench_svgf and
-# bench_frame run on the Cornell box.
+# host transfer, and with SVGF, into OUT/frames/*.json (--stats-json; RUNS names them: off,
+# off-svgf, and each --host-transfer alone or with -svgf), and bench_svgf and bench_frame run on
+# the Cornell box (not with NO_BENCH).
 # Exit status: the number of test binaries that failed, 0 if none.
 set -uo pipefail
 dir=$(cd "$(dirname "$0")" && pwd)
@@ -35,6 +36,8 @@ if [ -n "${RENDER:-}" ]; then
   # The test binaries read scenes at the path they were built in (RTPG_SOURCE_DIR).
   built_in=$(cat "$dir/source_dir")
   [ -e "$built_in" ] || { mkdir -p "$(dirname "$built_in")" && ln -s "${SOURCE:-$PWD}" "$built_in"; }
+  # The CLI tests run the build's rtpg.
+  [ -e "$built_in/build/rtpg" ] || { mkdir -p "$built_in/build" && ln -s "$dir/bin/rtpg" "$built_in/build/rtpg"; }
   mkdir -p "$out/tests"
   ls "$dir/bin" | grep '^test_' | xargs -P "${JOBS:-6}" -I{} sh -c \
     'start=$(date +%s); timeout "${TEST_TIMEOUT:-300}" "$0/bin/{}" --gtest_color=no > "$1/tests/{}.log" 2>&1;
@@ -63,18 +66,21 @@ if [ -n "${RENDER:-}" ]; then
   mkdir -p "$out/frames"
   for scene in ${SCENES:-cornell-box cornell-indirect veach-ajar sunlit-room}; do
     for res in ${RESOLUTIONS:-960x540 1920x1080}; do
-      for run in "off --guiding off" "pinned --host-transfer pinned" \
-                 "pageable --host-transfer pageable" "in-place --host-transfer in-place" \
-                 "off-svgf --guiding off --denoise svgf" "pinned-svgf --denoise svgf"; do
-        set -- $run
-        name=$1
-        shift
+      for name in ${RUNS:-off pinned pageable in-place off-svgf pinned-svgf}; do
+        case $name in
+          off) set -- --guiding off ;;
+          off-svgf) set -- --guiding off --denoise svgf ;;
+          *-svgf) set -- --host-transfer "${name%-svgf}" --denoise svgf ;;
+          *) set -- --host-transfer "$name" ;;
+        esac
         "$dir/bin/rtpg" render "scenes/$scene.json" --res "$res" --frames "${FRAMES:-24}" "$@" \
           --stats-json "$out/frames/$scene-$res-$name.json" > "$out/frames/$scene-$res-$name.log" 2>&1
         echo "== $scene $res $name: exit $?, $(grep 'time per frame' "$out/frames/$scene-$res-$name.log")"
       done
     done
   done
+fi
+if [ -n "${RENDER:-}" ] && [ -z "${NO_BENCH:-}" ]; then
   "$dir/bin/bench_svgf" --benchmark_repetitions=1 \
     --benchmark_filter="${SVGF_FILTER:-^cornell/(960x540|1920x1080)/lanes:auto/history:(full|none)}" \
     --benchmark_out="$out/bench_svgf.json" --benchmark_out_format=json > "$out/bench_svgf.log" 2>&1

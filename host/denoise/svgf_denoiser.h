@@ -7,6 +7,7 @@
 
 #include <array>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,15 +21,19 @@
 
 namespace rtpg {
 
+class PinnedStaging;
+
 class SvgfDenoiser {
  public:
   // Throws InputError for settings out of range, a size below 1x1 or a work-group size the
   // device refuses. zero_copy: where the device shares host memory
   // (DeviceInfo::host_unified_memory), denoise() reads the noisy colour and the G-buffer in
   // place (CL_MEM_USE_HOST_PTR) instead of copying them, and keeps the channels the next frame's
-  // history test needs by a copy on the device.
+  // history test needs by a copy on the device. Elsewhere they are copied through pinned
+  // staging (host/render/pinned_staging.h).
   SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings = {},
                bool zero_copy = true);
+  ~SvgfDenoiser();
   SvgfDenoiser(const SvgfDenoiser&) = delete;
   SvgfDenoiser& operator=(const SvgfDenoiser&) = delete;
 
@@ -78,6 +83,7 @@ class SvgfDenoiser {
   int lanes_ = 1;
   WorkGroupShape pixel_groups_, filter_groups_;
   bool zero_copy_ = false;
+  std::unique_ptr<PinnedStaging> staging_;  // the uploads' way where !zero_copy_
   shared::pg_svgf_settings kernel_settings_;
   cl::Kernel temporal_, variance_, atrous_, remodulate_;
   std::array<Surfaces, 2> surfaces_;

@@ -69,7 +69,9 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
       local_tile_ = false;
       break;
     case GuidingSettings::TrainMemory::Auto:
-      local_tile_ = !cpu;
+      // The VPL tile on GPUs, unless the settings ask for several pixels per work-item, which
+      // read VPLs from global memory (train_wide.cl).
+      local_tile_ = !cpu && settings.train_lanes <= 1;
       break;
   }
   // A GPU keeps the VPL tile and a pixel per work-item (DeviceInfo::simd_lanes).

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "render/pinned_staging.h"
 #include "rtpg/cl_runtime.h"
 
 namespace rtpg {
@@ -24,27 +25,6 @@ constexpr std::size_t kGBufferBytes = 0 PG_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kVplBytes = 0 PG_VPL_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kSampleBytes = 0 PG_SAMPLE_CHANNELS(RTPG_ADD_BYTES);
 #undef RTPG_ADD_BYTES
-
-// Copies a host channel into mapped staging, in parallel: one core's memcpy reaches a fraction
-// of the memory bandwidth, and the G-buffer is 96 bytes a pixel (199 MB a 1080p frame).
-template <class Source, class Target>
-void copy_channel(const Source& from, const Target& to, const char* name) {
-  const std::size_t count = from.size();
-  if (count > to.size())
-    throw GuiderError(std::string("upload of ") + name + ": " + std::to_string(count) +
-                      " elements do not fit in its staging");
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1 << 14),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      std::copy(from.data() + r.begin(), from.data() + r.end(),
-                                to.data() + r.begin());
-                    });
-}
-
-template <class T>
-HostChannelView<T> map_for_writing(cl::CommandQueue& q, const cl::Buffer& b, std::size_t count) {
-  return HostChannelView<T>{
-      static_cast<T*>(q.enqueueMapBuffer(b, CL_TRUE, CL_MAP_WRITE, 0, count * sizeof(T))), count};
-}
 
 }  // namespace
 
@@ -79,21 +59,10 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
   if (transfer_ == HostTransfer::automatic)
     transfer_ = runtime.info().host_unified_memory ? HostTransfer::in_place : HostTransfer::pinned;
   zero_copy_ = transfer_ == HostTransfer::in_place;
-  if (transfer_ == HostTransfer::pinned) {
-    gbuffer_staging_ = make_guider_gbuffer(runtime.context(), width, height, CL_MEM_ALLOC_HOST_PTR);
-    vpl_staging_ = make_guider_vpls(runtime.context(), width, height, CL_MEM_ALLOC_HOST_PTR);
-    translate_cl_errors([&] {
-      cl::CommandQueue& q = runtime_.queue();
-#define RTPG_MAP_UPLOAD(name, type, bytes) \
-  upload_gbuffer_.name = map_for_writing<shared::type>(q, gbuffer_staging_.name, pixels_);
-      PG_GBUFFER_CHANNELS(RTPG_MAP_UPLOAD)
-#undef RTPG_MAP_UPLOAD
-#define RTPG_MAP_UPLOAD(name, type, bytes) \
-  upload_vpls_.name = map_for_writing<shared::type>(q, vpl_staging_.name, pixels_);
-      PG_VPL_CHANNELS(RTPG_MAP_UPLOAD)
-#undef RTPG_MAP_UPLOAD
-    });
-  }
+  if (transfer_ == HostTransfer::pinned)
+    upload_staging_ =
+        std::make_unique<PinnedStaging>(runtime.context(), runtime.queue(),
+                                        (std::max(kGBufferBytes, kVplBytes) + 64 * 8) * pixels_);
   if (!zero_copy_) {
     for (GuiderGBuffer& g : owned_gbuffers_)
       g = make_guider_gbuffer(runtime.context(), width, height);
@@ -124,17 +93,6 @@ GuidedFirstBounce::~GuidedFirstBounce() {
   q.enqueueUnmapMemObject(staging_.name, staged_.name.pointer);
       PG_SAMPLE_CHANNELS(RTPG_UNMAP_STAGING)
 #undef RTPG_UNMAP_STAGING
-    }
-    if (transfer_ == HostTransfer::pinned) {
-      cl::CommandQueue& q = runtime_.queue();
-#define RTPG_UNMAP_UPLOAD(name, type, bytes) \
-  q.enqueueUnmapMemObject(gbuffer_staging_.name, upload_gbuffer_.name.pointer);
-      PG_GBUFFER_CHANNELS(RTPG_UNMAP_UPLOAD)
-#undef RTPG_UNMAP_UPLOAD
-#define RTPG_UNMAP_UPLOAD(name, type, bytes) \
-  q.enqueueUnmapMemObject(vpl_staging_.name, upload_vpls_.name.pointer);
-      PG_VPL_CHANNELS(RTPG_UNMAP_UPLOAD)
-#undef RTPG_UNMAP_UPLOAD
     }
     runtime_.queue().finish();
   } catch (...) {  // a failing queue at teardown has nothing left to corrupt
@@ -171,16 +129,10 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
     owned_current_ = 1 - owned_current_;
     current_gbuffer_ = owned_gbuffers_[owned_current_];
     if (transfer_ == HostTransfer::pinned) {
-#define RTPG_STAGE(name, type, bytes) copy_channel(g.name, upload_gbuffer_.name, #name);
+      upload_staging_->begin();
+#define RTPG_STAGE(name, type, bytes) upload_staging_->stage(g.name, current_gbuffer_.name, #name);
       PG_GBUFFER_CHANNELS(RTPG_STAGE)
 #undef RTPG_STAGE
-      // The staging is the upload's source while it runs: finished below, before the next
-      // frame's copies into it.
-      auto staged = upload_gbuffer_;
-#define RTPG_SIZE(name, type, bytes) staged.name.count = g.name.size();
-      PG_GBUFFER_CHANNELS(RTPG_SIZE)
-#undef RTPG_SIZE
-      enqueue_upload(runtime_.queue(), staged, current_gbuffer_);
     } else {
       enqueue_upload(runtime_.queue(), g, current_gbuffer_);
     }
@@ -298,19 +250,15 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   GuiderVpls device_vpls = owned_vpls_;
   if (zero_copy_) {
     device_vpls = wrap_host_vpls(runtime_.context(), vpls);  // released when train is done
-  } else if (transfer_ == HostTransfer::pinned) {
-#define RTPG_STAGE(name, type, bytes) copy_channel(vpls.name, upload_vpls_.name, #name);
-    PG_VPL_CHANNELS(RTPG_STAGE)
-#undef RTPG_STAGE
-    auto staged = upload_vpls_;
-#define RTPG_SIZE(name, type, bytes) staged.name.count = vpls.name.size();
-    PG_VPL_CHANNELS(RTPG_SIZE)
-#undef RTPG_SIZE
-    enqueue_upload(runtime_.queue(), staged, device_vpls);
-    translate_cl_errors([&] { runtime_.queue().finish(); });
-    bytes_ += kVplBytes * g.pixel_count();
   } else {
-    enqueue_upload(runtime_.queue(), vpls, device_vpls);
+    if (transfer_ == HostTransfer::pinned) {
+      upload_staging_->begin();
+#define RTPG_STAGE(name, type, bytes) upload_staging_->stage(vpls.name, device_vpls.name, #name);
+      PG_VPL_CHANNELS(RTPG_STAGE)
+#undef RTPG_STAGE
+    } else {
+      enqueue_upload(runtime_.queue(), vpls, device_vpls);
+    }
     translate_cl_errors([&] { runtime_.queue().finish(); });
     bytes_ += kVplBytes * g.pixel_count();
   }

@@ -14,6 +14,7 @@
 namespace rtpg {
 
 class ClRuntime;
+class PinnedStaging;
 
 // How the G-buffer and VPLs reach the device and the samples come back (docs/guiding.md, "On a
 // GPU"; measured on a discrete GPU in "The renderer on a GPU").
@@ -85,18 +86,8 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   HostTransfer transfer_ = HostTransfer::automatic;
   bool zero_copy_ = false, mapped_ = false;
   GuiderSamples staging_;
-  // HostTransfer::pinned: the upload staging of the G-buffer and the VPLs, mapped for the
-  // host's copies (upload_gbuffer_ and upload_vpls_ point into them).
-  GuiderGBuffer gbuffer_staging_;
-  GuiderVpls vpl_staging_;
-#define RTPG_HOST_VIEW(name, type, bytes) HostChannelView<shared::type> name;
-  struct {
-    PG_GBUFFER_CHANNELS(RTPG_HOST_VIEW)
-  } upload_gbuffer_;
-  struct {
-    PG_VPL_CHANNELS(RTPG_HOST_VIEW)
-  } upload_vpls_;
-#undef RTPG_HOST_VIEW
+  // HostTransfer::pinned: where the G-buffer and then the VPLs are copied on their way up.
+  std::unique_ptr<PinnedStaging> upload_staging_;
   struct HostSamples {  // PG_SAMPLE_CHANNELS in staging_
     HostChannelView<glm::vec4> direction_pdf;
     HostChannelView<std::uint32_t> strategy;

@@ -62,7 +62,8 @@ struct GuidingSettings {
                          // (sample_wide.cl); 0 = auto as for train_lanes
   enum class TrainMemory { Auto, Local, Global };
   // Local: VPL tile in local memory (GPUs); Global: direct reads (faster on PoCL). Auto
-  // picks Global on CPU devices and Local elsewhere.
+  // picks Global on CPU devices and where train_lanes asks for more than one pixel per
+  // work-item (train_wide.cl reads global memory), Local elsewhere.
   TrainMemory train_memory = TrainMemory::Auto;
 };
 

@@ -52,8 +52,9 @@ VplCounts check_vpls(const std::string& scene_file, int frames) {
   settings.width = 37;
   settings.height = 21;
   settings.spp = 2;
-  Renderer renderer(scene, settings);
+  // The runtime outlives the renderer, whose guided sampler uses its queue until destroyed.
   ClRuntime cl;
+  Renderer renderer(scene, settings);
   auto keeper = std::make_unique<KeepsFirstSamples>(
       std::make_unique<GuidedFirstBounce>(cl, settings.width, settings.height, GuidingSettings{}));
   const KeepsFirstSamples& kept = *keeper;
