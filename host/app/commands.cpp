@@ -211,10 +211,14 @@ int run_render(const RenderCommand& command) {
   settings.path_tracer.guide_position = command.guiding_settings.reproject_position;
   settings.path_tracer.guide_normal = command.guiding_settings.reproject_normal;
   Renderer renderer = with_flag_names([&] { return Renderer(scene, settings); });
-  if (command.guiding == "pmm")
-    renderer.set_first_bounce_sampler(std::make_unique<GuidedFirstBounce>(
+  const GuidedFirstBounce* guided = nullptr;  // owned by the renderer
+  if (command.guiding == "pmm") {
+    auto sampler = std::make_unique<GuidedFirstBounce>(
         cl, command.settings.width, command.settings.height, command.guiding_settings,
-        parse_host_transfer(command.host_transfer)));
+        parse_host_transfer(command.host_transfer));
+    guided = sampler.get();
+    renderer.set_first_bounce_sampler(std::move(sampler));
+  }
   std::unique_ptr<SvgfDenoiser> denoiser;
   if (command.denoise == "svgf")
     denoiser =
@@ -271,7 +275,11 @@ int run_render(const RenderCommand& command) {
     if (denoiser) {
       frame_rgba.resize(image.size());
       for (std::size_t i = 0; i < image.size(); ++i) frame_rgba[i] = glm::vec4(image[i], 1.0f);
-      const std::vector<glm::vec4>& denoised = denoiser->denoise(frame_rgba, renderer.gbuffer());
+      // Where the guided sampler copied this frame's G-buffer to the device, the denoiser reads
+      // it there (docs/denoising.md, "On a GPU").
+      const std::vector<glm::vec4>& denoised =
+          denoiser->denoise(frame_rgba, renderer.gbuffer(),
+                            guided ? guided->device_gbuffer_of(renderer.gbuffer()) : nullptr);
       for (std::size_t i = 0; i < image.size(); ++i) shown[i] = glm::vec3(denoised[i]);
       for (const auto& [name, ms] : denoiser->times_ms()) stats.time_ms[name] = ms;
       stats.time_ms["total"] += denoiser->times_ms().at("svgf_total");

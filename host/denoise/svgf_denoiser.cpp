@@ -16,8 +16,10 @@ static_assert(sizeof(shared::pg_svgf_settings) == 11 * 4, "pg_svgf_settings: 4-b
 static_assert(sizeof(glm::vec4) == sizeof(cl_float4), "glm::vec4 must match cl_float4");
 
 // Bytes per pixel the upload of one frame copies: colour, emission, position_depth,
-// shading_normal, base_color_roughness (16 each), flags, material (4 each), motion (8).
+// shading_normal, base_color_roughness (16 each), flags, material (4 each), motion (8); only the
+// first two where the G-buffer is on the device already.
 constexpr double kUploadBytesPerPixel = 5 * 16 + 4 + 4 + 8;
+constexpr double kColourUploadBytesPerPixel = 2 * 16;
 constexpr double kDownloadBytesPerPixel = 16;
 
 using BufferList = std::initializer_list<const cl::Buffer*>;
@@ -30,7 +32,8 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
       width_(width),
       height_(height),
       settings_(settings),
-      zero_copy_(zero_copy && runtime.info().host_unified_memory) {
+      zero_copy_(zero_copy && runtime.info().host_unified_memory),
+      upload_bytes_per_pixel_(zero_copy_ ? 0.0 : kUploadBytesPerPixel) {
   validate(settings);
   if (width <= 0 || height <= 0)
     throw InputError("svgf", "image size must be positive, got " + std::to_string(width) + "x" +
@@ -116,7 +119,8 @@ double SvgfDenoiser::run(cl::Kernel& kernel, int lanes, const WorkGroupShape& sh
 SvgfDenoiser::~SvgfDenoiser() = default;
 
 const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>& colour,
-                                                    const GBuffer& g) {
+                                                    const GBuffer& g,
+                                                    const GuiderGBuffer* on_device) {
   check_svgf_input(width_, height_, colour, g);
   using Clock = std::chrono::steady_clock;
   const auto ms_since = [](Clock::time_point t) {
@@ -147,7 +151,31 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
       keep(g.position_depth, cur.position_depth);
       keep(g.shading_normal, cur.shading_normal);
       keep(g.material, cur.material);
+    } else if (on_device != nullptr) {
+      const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+      const auto check = [&](const cl::Buffer& b, std::size_t bytes, const char* name) {
+        if (b.getInfo<CL_MEM_SIZE>() < n * bytes)
+          throw InputError("svgf", std::string("the device G-buffer's ") + name + " holds " +
+                                       std::to_string(b.getInfo<CL_MEM_SIZE>()) +
+                                       " bytes, fewer than " + std::to_string(n * bytes));
+        return b;
+      };
+      staging_->begin();
+      staging_->stage(colour, colour_, "svgf colour");
+      staging_->stage(g.emission, emission_, "svgf emission");
+      base_color_roughness_in = check(on_device->base_color_roughness, 16, "base_color_roughness");
+      flags_in = check(on_device->flags, 4, "flags");
+      motion_in = check(on_device->motion, 8, "motion");
+      // Next frame's history test compares with these, after the guider has moved on.
+      runtime_.queue().enqueueCopyBuffer(check(on_device->position_depth, 16, "position_depth"),
+                                         cur.position_depth, 0, 0, n * 16);
+      runtime_.queue().enqueueCopyBuffer(check(on_device->shading_normal, 16, "shading_normal"),
+                                         cur.shading_normal, 0, 0, n * 16);
+      runtime_.queue().enqueueCopyBuffer(check(on_device->material, 4, "material"), cur.material, 0,
+                                         0, n * 4);
+      upload_bytes_per_pixel_ = kColourUploadBytesPerPixel;
     } else {
+      upload_bytes_per_pixel_ = kUploadBytesPerPixel;
       // Through pinned staging: a discrete GPU copies from it several times faster than from
       // the host's vectors (host/render/pinned_staging.h).
       staging_->begin();
@@ -229,7 +257,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
 }
 
 double SvgfDenoiser::host_device_bytes_per_pixel() const {
-  return (zero_copy_ ? 0.0 : kUploadBytesPerPixel) + kDownloadBytesPerPixel;
+  return upload_bytes_per_pixel_ + kDownloadBytesPerPixel;
 }
 
 std::vector<glm::vec4> SvgfDenoiser::read(SvgfStage stage) {

@@ -18,6 +18,7 @@
 #include "denoise/svgf_stage.h"
 #include "render/gbuffer.h"
 #include "rtpg/cl_runtime.h"
+#include "rtpg/guider.h"
 
 namespace rtpg {
 
@@ -39,15 +40,20 @@ class SvgfDenoiser {
 
   // Filters one frame of noisy colour (rgb; w ignored) seen through the G-buffer g, blocking;
   // returns the denoised colour (w = 1 on surfaces; pixels without a surface keep their input).
-  // Throws InputError when the sizes do not match.
-  const std::vector<glm::vec4>& denoise(const std::vector<glm::vec4>& colour, const GBuffer& g);
+  // on_device: g's channels already on the device (the guided sampler's copy of this frame's
+  // G-buffer, GuidedFirstBounce::device_gbuffer_of): where denoise() would copy its inputs, it
+  // reads the G-buffer's there and uploads only the colour and the emission (32 bytes a pixel
+  // instead of 96). Throws InputError when the sizes do not match.
+  const std::vector<glm::vec4>& denoise(const std::vector<glm::vec4>& colour, const GBuffer& g,
+                                        const GuiderGBuffer* on_device = nullptr);
   // Forgets the history: the next frame starts anew (a camera cut).
   void reset() { has_history_ = false; }
 
   // Milliseconds of the last denoise() from profiling events: "svgf_upload", "svgf_temporal",
   // "svgf_variance", "svgf_atrous" (all iterations), "svgf_remodulate", "svgf_download".
   const std::map<std::string, double>& times_ms() const { return times_; }
-  // Bytes copied between host and device per pixel by denoise().
+  // Bytes copied between host and device per pixel by the last denoise() (before the first, by
+  // one without on_device).
   double host_device_bytes_per_pixel() const;
   // Whether denoise() reads its inputs in place (the constructor's zero_copy on a device that
   // shares host memory).
@@ -83,6 +89,7 @@ class SvgfDenoiser {
   int lanes_ = 1;
   WorkGroupShape pixel_groups_, filter_groups_;
   bool zero_copy_ = false;
+  double upload_bytes_per_pixel_ = 0.0;     // the last denoise()'s
   std::unique_ptr<PinnedStaging> staging_;  // the uploads' way where !zero_copy_
   shared::pg_svgf_settings kernel_settings_;
   cl::Kernel temporal_, variance_, atrous_, remodulate_;

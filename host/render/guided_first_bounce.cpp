@@ -138,6 +138,7 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
     }
     translate_cl_errors([&] { runtime_.queue().finish(); });
     bytes_ += kGBufferBytes * g.pixel_count();
+    copied_from_ = &g;
   }
   upload_ms_ = ms_since(t);
   if (have_previous_) {

@@ -52,6 +52,12 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   bool wants_vpls() const override { return true; }
   bool reads_gbuffers_in_place() const override { return zero_copy_; }
   HostTransfer host_transfer() const { return transfer_; }  // automatic resolved
+  // This frame's G-buffer on the device where begin_frame copied g there (not in place): the
+  // denoiser reads it instead of copying it again (SvgfDenoiser::denoise). Valid until the next
+  // begin_frame; nullptr for any other G-buffer.
+  const GuiderGBuffer* device_gbuffer_of(const GBuffer& g) const {
+    return !zero_copy_ && copied_from_ == &g ? &current_gbuffer_ : nullptr;
+  }
   void report(std::map<std::string, double>& time_ms,
               std::map<std::string, double>& extra) override;
 
@@ -71,6 +77,7 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   // (wrap_host_gbuffer; current_host_ is that memory), else copies in owned_gbuffers_.
   GuiderGBuffer current_gbuffer_, previous_gbuffer_;
   const void* current_host_ = nullptr;
+  const GBuffer* copied_from_ = nullptr;  // the G-buffer current_gbuffer_ is a copy of
   GuiderGBuffer owned_gbuffers_[2];
   int owned_current_ = 0;
   bool have_previous_ = false;

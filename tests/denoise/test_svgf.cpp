@@ -294,6 +294,36 @@ TEST(SvgfKernels, TemporalAccumulationConvergesToTheMean) {
   }
 }
 
+// A G-buffer the guider already copied to the device (GuidedFirstBounce::device_gbuffer_of) is
+// read there: the same frames bit for bit as uploading it again, with 32 bytes a pixel going up
+// instead of 96, and last frame's surfaces kept although the device G-buffer is rewritten.
+TEST(SvgfKernels, GBufferOnTheDeviceEqualsUploadingIt) {
+  ClRuntime rt;
+  const int w = simulated(rt) ? 19 : 61, h = simulated(rt) ? 11 : 29;
+  SvgfDenoiser uploading(rt, w, h, SvgfSettings{}, false);
+  SvgfDenoiser sharing(rt, w, h, SvgfSettings{}, false);
+  const GuiderGBuffer on_device = make_guider_gbuffer(rt.context(), w, h);
+  std::mt19937 rng(13);
+  for (int f = 0; f < 6; ++f) {
+    const GBuffer g = scene_gbuffer(w, h, 2.3f * static_cast<float>(f), rng);
+    const std::vector<glm::vec4> colour = noisy_colour(g, rng);
+    enqueue_upload(rt.queue(), g, on_device);
+    rt.queue().finish();
+    const std::vector<glm::vec4> a = uploading.denoise(colour, g);
+    const std::vector<glm::vec4> b = sharing.denoise(colour, g, &on_device);
+    EXPECT_EQ(uploading.host_device_bytes_per_pixel(), 112.0);
+    EXPECT_EQ(sharing.host_device_bytes_per_pixel(), 48.0);
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
+    EXPECT_EQ(differ, 0u) << "frame " << f;
+  }
+  const GuiderGBuffer small = make_guider_gbuffer(rt.context(), w, h - 1);
+  std::mt19937 rng2(1);
+  const GBuffer g = scene_gbuffer(w, h, 0.0f, rng2);
+  EXPECT_THROW(sharing.denoise(noisy_colour(g, rng2), g, &small), InputError);
+}
+
 // Reading the inputs in place (zero copy, where the device shares host memory) gives the same
 // frames bit for bit as copying them, with the host rewriting one G-buffer and one colour buffer
 // every frame as the renderer does: last frame's surfaces must have been kept on the device.
