@@ -26,7 +26,32 @@ constexpr std::size_t kVplBytes = 0 PG_VPL_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kSampleBytes = 0 PG_SAMPLE_CHANNELS(RTPG_ADD_BYTES);
 #undef RTPG_ADD_BYTES
 
+// Each channel of a host G-buffer or VPL buffer through the staging into the device buffer of
+// the same name (include/rtpg/guiding_layout.h).
+void stage_channels(PinnedStaging& staging, const GBuffer& host, const GuiderGBuffer& device) {
+#define RTPG_STAGE(name, type, bytes) staging.stage(host.name, device.name, #name);
+  PG_GBUFFER_CHANNELS(RTPG_STAGE)
+#undef RTPG_STAGE
+}
+void stage_channels(PinnedStaging& staging, const VplBuffer& host, const GuiderVpls& device) {
+#define RTPG_STAGE(name, type, bytes) staging.stage(host.name, device.name, #name);
+  PG_VPL_CHANNELS(RTPG_STAGE)
+#undef RTPG_STAGE
+}
+
 }  // namespace
+
+template <class Host, class Device>
+void GuidedFirstBounce::copy_to_device(const Host& host, const Device& device, std::size_t bytes) {
+  if (transfer_ == HostTransfer::pinned) {
+    upload_staging_->begin();
+    stage_channels(*upload_staging_, host, device);
+  } else {
+    enqueue_upload(runtime_.queue(), host, device);
+  }
+  translate_cl_errors([&] { runtime_.queue().finish(); });
+  bytes_ += bytes;
+}
 
 HostTransfer parse_host_transfer(const std::string& name) {
   if (name == "auto") return HostTransfer::automatic;
@@ -128,16 +153,7 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   } else {
     owned_current_ = 1 - owned_current_;
     current_gbuffer_ = owned_gbuffers_[owned_current_];
-    if (transfer_ == HostTransfer::pinned) {
-      upload_staging_->begin();
-#define RTPG_STAGE(name, type, bytes) upload_staging_->stage(g.name, current_gbuffer_.name, #name);
-      PG_GBUFFER_CHANNELS(RTPG_STAGE)
-#undef RTPG_STAGE
-    } else {
-      enqueue_upload(runtime_.queue(), g, current_gbuffer_);
-    }
-    translate_cl_errors([&] { runtime_.queue().finish(); });
-    bytes_ += kGBufferBytes * g.pixel_count();
+    copy_to_device(g, current_gbuffer_, kGBufferBytes * g.pixel_count());
     copied_from_ = &g;
   }
   upload_ms_ = ms_since(t);
@@ -252,16 +268,7 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   if (zero_copy_) {
     device_vpls = wrap_host_vpls(runtime_.context(), vpls);  // released when train is done
   } else {
-    if (transfer_ == HostTransfer::pinned) {
-      upload_staging_->begin();
-#define RTPG_STAGE(name, type, bytes) upload_staging_->stage(vpls.name, device_vpls.name, #name);
-      PG_VPL_CHANNELS(RTPG_STAGE)
-#undef RTPG_STAGE
-    } else {
-      enqueue_upload(runtime_.queue(), vpls, device_vpls);
-    }
-    translate_cl_errors([&] { runtime_.queue().finish(); });
-    bytes_ += kVplBytes * g.pixel_count();
+    copy_to_device(vpls, device_vpls, kVplBytes * g.pixel_count());
   }
   upload_ms_ += ms_since(t);
   guider_->train(current_gbuffer_, device_vpls, at.seed, at.frame);

@@ -70,6 +70,10 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   shared::pg_pmm_model model_at(std::size_t i) const;
   // surfaces_, guided_fraction_ and mean_pi_ from the mixtures of the last sample().
   void count_models(const GBuffer& g);
+  // Copies a host G-buffer or VPL buffer into its device buffers (pinned or pageable), waits,
+  // and counts the bytes.
+  template <class Host, class Device>
+  void copy_to_device(const Host& host, const Device& device, std::size_t bytes);
 
   ClRuntime& runtime_;
   std::unique_ptr<Guider> guider_;
