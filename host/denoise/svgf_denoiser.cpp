@@ -4,6 +4,7 @@
 #include <cstring>
 #include <initializer_list>
 
+#include "render/host_transfer.h"
 #include "render/pinned_staging.h"
 #include "denoise/svgf_reference.h"
 #include "rtpg/cl_error.h"
@@ -32,7 +33,9 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
       width_(width),
       height_(height),
       settings_(settings),
-      zero_copy_(zero_copy && runtime.info().host_unified_memory),
+      zero_copy_(zero_copy && resolve_host_transfer(HostTransfer::automatic,
+                                                    runtime.info().host_unified_memory) ==
+                                  HostTransfer::in_place),
       upload_bytes_per_pixel_(zero_copy_ ? 0.0 : kUploadBytesPerPixel) {
   validate(settings);
   if (width <= 0 || height <= 0)

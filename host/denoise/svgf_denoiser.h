@@ -28,10 +28,11 @@ class SvgfDenoiser {
  public:
   // Throws InputError for settings out of range, a size below 1x1 or a work-group size the
   // device refuses. zero_copy: where the device shares host memory
-  // (DeviceInfo::host_unified_memory), denoise() reads the noisy colour and the G-buffer in
-  // place (CL_MEM_USE_HOST_PTR) instead of copying them, and keeps the channels the next frame's
-  // history test needs by a copy on the device. Elsewhere they are copied through pinned
-  // staging (host/render/pinned_staging.h).
+  // (DeviceInfo::host_unified_memory) and RTPG_HOST_TRANSFER does not ask for copies
+  // (resolve_host_transfer, host/render/host_transfer.h), denoise() reads the noisy colour and the
+  // G-buffer in place (CL_MEM_USE_HOST_PTR) instead of copying them, and keeps the channels the
+  // next frame's history test needs by a copy on the device. Elsewhere they are copied through
+  // pinned staging (host/render/pinned_staging.h).
   SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings = {},
                bool zero_copy = true);
   ~SvgfDenoiser();

@@ -53,36 +53,12 @@ void GuidedFirstBounce::copy_to_device(const Host& host, const Device& device, s
   bytes_ += bytes;
 }
 
-HostTransfer parse_host_transfer(const std::string& name) {
-  if (name == "auto") return HostTransfer::automatic;
-  if (name == "in-place") return HostTransfer::in_place;
-  if (name == "pinned") return HostTransfer::pinned;
-  if (name == "pageable") return HostTransfer::pageable;
-  throw GuiderError("host transfer '" + name + "' is none of auto, in-place, pinned, pageable");
-}
-
-const char* host_transfer_name(HostTransfer transfer) {
-  switch (transfer) {
-    case HostTransfer::automatic:
-      return "auto";
-    case HostTransfer::in_place:
-      return "in-place";
-    case HostTransfer::pinned:
-      return "pinned";
-    case HostTransfer::pageable:
-      return "pageable";
-  }
-  return "?";
-}
-
 GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
                                      const GuidingSettings& settings, HostTransfer transfer)
     : runtime_(runtime),
       guider_(std::make_unique<Guider>(runtime, width, height, settings)),
       pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
-  transfer_ = transfer;
-  if (transfer_ == HostTransfer::automatic)
-    transfer_ = runtime.info().host_unified_memory ? HostTransfer::in_place : HostTransfer::pinned;
+  transfer_ = resolve_host_transfer(transfer, runtime.info().host_unified_memory);
   zero_copy_ = transfer_ == HostTransfer::in_place;
   if (transfer_ == HostTransfer::pinned)
     upload_staging_ =

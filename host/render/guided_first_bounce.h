@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "render/first_bounce.h"
+#include "render/host_transfer.h"
 #include "render/vpl_buffer.h"
 #include "rtpg/guider.h"
 
@@ -16,28 +17,11 @@ namespace rtpg {
 class ClRuntime;
 class PinnedStaging;
 
-// How the G-buffer and VPLs reach the device and the samples come back (docs/guiding.md, "On a
-// GPU"; measured on a discrete GPU in "The renderer on a GPU").
-enum class HostTransfer {
-  automatic,  // in_place where the device shares host memory (DeviceInfo::host_unified_memory),
-              // else pinned
-  in_place,   // the device reads the host's G-buffer and VPLs where they are
-              // (CL_MEM_USE_HOST_PTR) and the host maps the samples: no copies where memory is
-              // shared; elsewhere the OpenCL implementation copies when the kernels need them
-  pinned,     // the host copies the G-buffer and VPLs into mapped CL_MEM_ALLOC_HOST_PTR staging
-              // (pinned memory on a discrete GPU), which the device copies from; the samples
-              // come back into such staging
-  pageable,   // the device copies straight from the host's own (pageable) vectors; the samples
-              // come back into pinned staging
-};
-// "auto", "in-place", "pinned", "pageable" (the CLI's --host-transfer); throws GuiderError else.
-HostTransfer parse_host_transfer(const std::string& name);
-const char* host_transfer_name(HostTransfer transfer);
-
 class GuidedFirstBounce final : public FirstBounceSampler {
  public:
   // With HostTransfer::in_place (automatic on a device that shares host memory) the renderer
-  // must alternate two G-buffers (reads_gbuffers_in_place()).
+  // must alternate two G-buffers (reads_gbuffers_in_place()). automatic is resolved by
+  // resolve_host_transfer (host/render/host_transfer.h).
   GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingSettings& settings,
                     HostTransfer transfer = HostTransfer::automatic);
   ~GuidedFirstBounce() override;
