@@ -19,10 +19,12 @@ DENOISER_ONLY = ("host/denoise/", "kernels/svgf_", "kernels/wide/svgf_wide.h", "
 # kernels/shared/ stays in the hash: the host path tracer compiles those headers.
 DEVICE_ONLY = ("host/cl/", "host/guiding/", "kernels/wide/")
 # Host sources of the guided render alone: `rtpg reference` samples the first bounce with BsdfFirstBounce,
-# never the guided one and its device buffers (host/render/guided_first_bounce.*, include/rtpg/guider.h),
-# and reports no flicker (host/render/temporal_flicker.*). On 2026-11-26 two changes to these re-rendered
-# every reference of the suite.
-GUIDED_RENDER_ONLY = ("host/render/guided_first_bounce.", "host/render/temporal_flicker.", "include/rtpg/guider.h")
+# never the guided one and its device buffers (host/render/guided_first_bounce.*, include/rtpg/guider.h,
+# and the host-device copies of host/render/host_transfer.* and host/render/pinned_staging.*), and reports
+# no flicker (host/render/temporal_flicker.*). On 2026-11-26 two changes to these re-rendered every
+# reference of the suite.
+GUIDED_RENDER_ONLY = ("host/render/guided_first_bounce.", "host/render/temporal_flicker.", "include/rtpg/guider.h",
+                      "host/render/host_transfer.", "host/render/pinned_staging.")
 
 
 def reference_independent(rel):

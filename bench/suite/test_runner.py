@@ -20,7 +20,8 @@ class ReferenceSourceTests(unittest.TestCase):
         for rel in ("kernels/train_wide.cl", "kernels/sample.cl", "kernels/wide/lanes.h", "host/guiding/guider.cpp",
                     "host/cl/device.cpp", "host/denoise/svgf_denoiser.cpp", "kernels/svgf_atrous.cl",
                     "kernels/shared/svgf.h", "host/render/guided_first_bounce.cpp",
-                    "host/render/guided_first_bounce.h", "host/render/temporal_flicker.cpp", "include/rtpg/guider.h"):
+                    "host/render/guided_first_bounce.h", "host/render/temporal_flicker.cpp", "include/rtpg/guider.h",
+                    "host/render/host_transfer.cpp", "host/render/pinned_staging.h"):
             self.assertTrue(runner.reference_independent(rel), rel)
 
     def test_hash_moves_with_a_path_tracer_source_only(self):
