@@ -9,8 +9,9 @@
 # scenes at the path they were built in, linked to SOURCE, default the working directory), then
 # rtpg renders FRAMES frames (default 24) of SCENES at RESOLUTIONS path-traced and guided with each
 # host transfer, and with SVGF, into OUT/frames/*.json (--stats-json; RUNS names them: off,
-# off-svgf, and each --host-transfer alone or with -svgf), and bench_svgf and bench_frame run on
-# the Cornell box (not with NO_BENCH).
+# off-svgf, and each --host-transfer alone or with -svgf) with their table in OUT/frames.md
+# (gpu_frames_summary.py), and bench_svgf and bench_frame run on the Cornell box (not with
+# NO_BENCH). TESTS narrows the tests there too.
 # Exit status: the number of test binaries that failed, 0 if none.
 set -uo pipefail
 dir=$(cd "$(dirname "$0")" && pwd)
@@ -39,7 +40,7 @@ if [ -n "${RENDER:-}" ]; then
   # The CLI tests run the build's rtpg.
   [ -e "$built_in/build/rtpg" ] || { mkdir -p "$built_in/build" && ln -s "$dir/bin/rtpg" "$built_in/build/rtpg"; }
   mkdir -p "$out/tests"
-  ls "$dir/bin" | grep '^test_' | xargs -P "${JOBS:-6}" -I{} sh -c \
+  for t in ${TESTS:-$(ls "$dir/bin" | grep '^test_')}; do echo "$t"; done | xargs -P "${JOBS:-6}" -I{} sh -c \
     'start=$(date +%s); timeout "${TEST_TIMEOUT:-300}" "$0/bin/{}" --gtest_color=no > "$1/tests/{}.log" 2>&1;
      echo "== {}: exit $?, $(( $(date +%s) - start )) s"' "$dir" "$out" | tee -a "$out/tests.log"
   failed=$(grep -c -v ': exit 0,' "$out/tests.log")
@@ -79,6 +80,7 @@ if [ -n "${RENDER:-}" ]; then
       done
     done
   done
+  python3 "$dir/gpu_frames_summary.py" "$out/frames" | tee "$out/frames.md"
 fi
 if [ -n "${RENDER:-}" ] && [ -z "${NO_BENCH:-}" ]; then
   "$dir/bin/bench_svgf" --benchmark_repetitions=1 \
