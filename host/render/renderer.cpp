@@ -85,77 +85,84 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
   camera_hits_.resize(n);
 
   auto start = Clock::now();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
-      float jx = 0.5f, jy = 0.5f;
-      if (settings_.jitter) {
-        shared::pg_rng rng =
-            shared::pg_rng_make(settings_.seed, static_cast<shared::uint>(i),
-                                static_cast<shared::uint>(frame), 0u, PG_RNG_STREAM_CAMERA);
-        jx = shared::pg_rng_next(&rng);
-        jy = shared::pg_rng_next(&rng);
+  // By rows: a pixel's coordinates without a division per pixel (docs/host-path-tracer.md,
+  // "Camera rays by rows").
+  const int rows_per_task = std::max(1, 4096 / std::max(w, 1));
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, rows_per_task), [&](const auto& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i =
+            static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+        float jx = 0.5f, jy = 0.5f;
+        if (settings_.jitter) {
+          shared::pg_rng rng =
+              shared::pg_rng_make(settings_.seed, static_cast<shared::uint>(i),
+                                  static_cast<shared::uint>(frame), 0u, PG_RNG_STREAM_CAMERA);
+          jx = shared::pg_rng_next(&rng);
+          jy = shared::pg_rng_next(&rng);
+        }
+        Ray ray;
+        ray.origin = camera.position;
+        ray.direction = camera.ray_direction((static_cast<float>(x) + jx) / static_cast<float>(w),
+                                             (static_cast<float>(y) + jy) / static_cast<float>(h));
+        camera_rays_[i] = ray;
       }
-      Ray ray;
-      ray.origin = camera.position;
-      ray.direction = camera.ray_direction((static_cast<float>(x) + jx) / static_cast<float>(w),
-                                           (static_cast<float>(y) + jy) / static_cast<float>(h));
-      camera_rays_[i] = ray;
-    }
   });
   tracer_->intersect(camera_rays_.data(), camera_hits_.data(), n, kCameraRayMode);
   stats.time_ms["primary"] += ms_since(start);
   stats.primary_rays += n;
 
   start = Clock::now();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const Ray& ray = camera_rays_[i];
-      const Hit& hit = camera_hits_[i];
-      const glm::vec3 dir = glm::normalize(ray.direction);
-      g.motion[i] = glm::vec2(0.0f);
-      if (!hit.valid()) {
-        // Every channel written, as GBuffer::resize leaves a sky pixel: nothing of an older
-        // frame stays behind (the frames may alternate between two G-buffers).
-        g.flags[i] = PG_GBUF_SKY;
-        g.position_depth[i] = glm::vec4(0.0f);
-        g.shading_normal[i] = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
-        g.geometric_normal[i] = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
-        g.base_color_roughness[i] = glm::vec4(0.0f);
-        g.metallic_specular[i] = glm::vec4(0.0f);
-        g.material[i] = 0;
-        g.emission[i] = glm::vec4(lights_->escaped_radiance(dir), 0.0f);
+  // A static camera (no path, or a path held at one frame) has exactly zero motion, whatever the
+  // jitter.
+  const bool static_camera =
+      frame == 0 || settings_.camera_path.empty() || settings_.camera_frame >= 0;
+  tbb::parallel_for(tbb::blocked_range<int>(0, h, rows_per_task), [&](const auto& rows) {
+    for (int y = rows.begin(); y != rows.end(); ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i =
+            static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+        const Ray& ray = camera_rays_[i];
+        const Hit& hit = camera_hits_[i];
+        const glm::vec3 dir = glm::normalize(ray.direction);
+        g.motion[i] = glm::vec2(0.0f);
+        if (!hit.valid()) {
+          // Every channel written, as GBuffer::resize leaves a sky pixel: nothing of an older
+          // frame stays behind (the frames may alternate between two G-buffers).
+          g.flags[i] = PG_GBUF_SKY;
+          g.position_depth[i] = glm::vec4(0.0f);
+          g.shading_normal[i] = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
+          g.geometric_normal[i] = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
+          g.base_color_roughness[i] = glm::vec4(0.0f);
+          g.metallic_specular[i] = glm::vec4(0.0f);
+          g.material[i] = 0;
+          g.emission[i] = glm::vec4(lights_->escaped_radiance(dir), 0.0f);
+          g.view_dir[i] = glm::vec4(-dir, 0.0f);
+          continue;
+        }
+        const SurfacePoint sp = make_surface_point(scene_, ray, hit);
+        const float depth = glm::dot(sp.position - camera.position, camera.forward);
+        g.position_depth[i] = glm::vec4(sp.position, depth);
+        g.shading_normal[i] = glm::vec4(sp.shading_normal, 0.0f);
+        g.geometric_normal[i] = glm::vec4(sp.geometric_normal, sp.offset_distance);
         g.view_dir[i] = glm::vec4(-dir, 0.0f);
-        continue;
+        g.base_color_roughness[i] = glm::vec4(sp.material.base_color.x, sp.material.base_color.y,
+                                              sp.material.base_color.z, sp.material.roughness);
+        g.metallic_specular[i] = glm::vec4(sp.material.metallic, sp.material.specular, 0.0f, 0.0f);
+        g.emission[i] = glm::vec4(sp.emission, 0.0f);
+        g.material[i] = sp.material_id;
+        std::uint32_t flags = 0;
+        if (sp.emission.x > 0.0f || sp.emission.y > 0.0f || sp.emission.z > 0.0f)
+          flags |= PG_GBUF_EMITTER;
+        if (sp.material.roughness <= PG_MIN_ROUGHNESS) flags |= PG_GBUF_DELTA;
+        if (sp.transmissive) flags |= PG_GBUF_TRANSMISSIVE;
+        g.flags[i] = flags;
+        float px = 0.0f, py = 0.0f;
+        if (!static_camera && previous.project(sp.position, px, py))
+          g.motion[i] =
+              glm::vec2(px * static_cast<float>(g.width) - (static_cast<float>(x) + 0.5f),
+                        py * static_cast<float>(g.height) - (static_cast<float>(y) + 0.5f));
       }
-      const SurfacePoint sp = make_surface_point(scene_, ray, hit);
-      const float depth = glm::dot(sp.position - camera.position, camera.forward);
-      g.position_depth[i] = glm::vec4(sp.position, depth);
-      g.shading_normal[i] = glm::vec4(sp.shading_normal, 0.0f);
-      g.geometric_normal[i] = glm::vec4(sp.geometric_normal, sp.offset_distance);
-      g.view_dir[i] = glm::vec4(-dir, 0.0f);
-      g.base_color_roughness[i] = glm::vec4(sp.material.base_color.x, sp.material.base_color.y,
-                                            sp.material.base_color.z, sp.material.roughness);
-      g.metallic_specular[i] = glm::vec4(sp.material.metallic, sp.material.specular, 0.0f, 0.0f);
-      g.emission[i] = glm::vec4(sp.emission, 0.0f);
-      g.material[i] = sp.material_id;
-      std::uint32_t flags = 0;
-      if (sp.emission.x > 0.0f || sp.emission.y > 0.0f || sp.emission.z > 0.0f)
-        flags |= PG_GBUF_EMITTER;
-      if (sp.material.roughness <= PG_MIN_ROUGHNESS) flags |= PG_GBUF_DELTA;
-      if (sp.transmissive) flags |= PG_GBUF_TRANSMISSIVE;
-      g.flags[i] = flags;
-      float px = 0.0f, py = 0.0f;
-      if (previous.project(sp.position, px, py)) {
-        const int x = static_cast<int>(i % g.width), y = static_cast<int>(i / g.width);
-        g.motion[i] = glm::vec2(px * static_cast<float>(g.width) - (static_cast<float>(x) + 0.5f),
-                                py * static_cast<float>(g.height) - (static_cast<float>(y) + 0.5f));
-        // A static camera (no path, or a path held at one frame) has exactly zero motion,
-        // whatever the jitter.
-        if (frame == 0 || settings_.camera_path.empty() || settings_.camera_frame >= 0)
-          g.motion[i] = glm::vec2(0.0f);
-      }
-    }
   });
   stats.time_ms["gbuffer"] += ms_since(start);
 }
