@@ -21,6 +21,7 @@ static_assert(sizeof(glm::vec4) == sizeof(cl_float4), "glm::vec4 must match cl_f
 // first two where the G-buffer is on the device already.
 constexpr double kUploadBytesPerPixel = 5 * 16 + 4 + 4 + 8;
 constexpr double kColourUploadBytesPerPixel = 2 * 16;
+constexpr std::size_t kUploadChannels = 8;
 constexpr double kDownloadBytesPerPixel = 16;
 
 using BufferList = std::initializer_list<const cl::Buffer*>;
@@ -107,7 +108,7 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
   if (!zero_copy_)
     staging_ = std::make_unique<PinnedStaging>(
         runtime.context(), runtime.queue(),
-        static_cast<std::size_t>(kUploadBytesPerPixel + 0.5) * n + 64 * 8);
+        static_cast<std::size_t>(kUploadBytesPerPixel + 0.5) * n, kUploadChannels);
 }
 
 double SvgfDenoiser::run(cl::Kernel& kernel, int lanes, const WorkGroupShape& shape) {

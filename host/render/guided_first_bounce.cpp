@@ -25,6 +25,10 @@ constexpr std::size_t kGBufferBytes = 0 PG_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kVplBytes = 0 PG_VPL_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kSampleBytes = 0 PG_SAMPLE_CHANNELS(RTPG_ADD_BYTES);
 #undef RTPG_ADD_BYTES
+#define RTPG_COUNT(name, type, bytes) +1
+constexpr std::size_t kGBufferChannels = 0 PG_GBUFFER_CHANNELS(RTPG_COUNT);
+constexpr std::size_t kVplChannels = 0 PG_VPL_CHANNELS(RTPG_COUNT);
+#undef RTPG_COUNT
 
 // Each channel of a host G-buffer or VPL buffer through the staging into the device buffer of
 // the same name (include/rtpg/guiding_layout.h).
@@ -61,9 +65,9 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
   transfer_ = resolve_host_transfer(transfer, runtime.info().host_unified_memory);
   zero_copy_ = transfer_ == HostTransfer::in_place;
   if (transfer_ == HostTransfer::pinned)
-    upload_staging_ =
-        std::make_unique<PinnedStaging>(runtime.context(), runtime.queue(),
-                                        (std::max(kGBufferBytes, kVplBytes) + 64 * 8) * pixels_);
+    upload_staging_ = std::make_unique<PinnedStaging>(runtime.context(), runtime.queue(),
+                                                      std::max(kGBufferBytes, kVplBytes) * pixels_,
+                                                      std::max(kGBufferChannels, kVplChannels));
   if (!zero_copy_) {
     for (GuiderGBuffer& g : owned_gbuffers_)
       g = make_guider_gbuffer(runtime.context(), width, height);

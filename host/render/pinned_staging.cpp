@@ -16,8 +16,8 @@ constexpr std::size_t kAlignment = 64;
 }  // namespace
 
 PinnedStaging::PinnedStaging(const cl::Context& context, const cl::CommandQueue& queue,
-                             std::size_t bytes)
-    : queue_(queue), size_(std::max<std::size_t>(bytes, 1)) {
+                             std::size_t bytes, std::size_t channels)
+    : queue_(queue), size_(std::max<std::size_t>(bytes + channels * kAlignment, 1)) {
   translate_cl_errors([&] {
     buffer_ = cl::Buffer(context, CL_MEM_ALLOC_HOST_PTR | CL_MEM_READ_ONLY, size_);
     mapped_ = static_cast<unsigned char*>(

@@ -19,8 +19,10 @@ namespace rtpg {
 
 class PinnedStaging {
  public:
-  // Maps `bytes` of staging; throws ClError when OpenCL refuses.
-  PinnedStaging(const cl::Context& context, const cl::CommandQueue& queue, std::size_t bytes);
+  // Maps staging for up to `channels` channels of `bytes` together per begin() (each channel
+  // starts on a cache line of its own); throws ClError when OpenCL refuses.
+  PinnedStaging(const cl::Context& context, const cl::CommandQueue& queue, std::size_t bytes,
+                std::size_t channels);
   ~PinnedStaging();
   PinnedStaging(const PinnedStaging&) = delete;
   PinnedStaging& operator=(const PinnedStaging&) = delete;
