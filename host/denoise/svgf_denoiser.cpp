@@ -155,42 +155,42 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
       keep(g.position_depth, cur.position_depth);
       keep(g.shading_normal, cur.shading_normal);
       keep(g.material, cur.material);
-    } else if (on_device != nullptr) {
-      const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
-      const auto check = [&](const cl::Buffer& b, std::size_t bytes, const char* name) {
-        if (b.getInfo<CL_MEM_SIZE>() < n * bytes)
-          throw InputError("svgf", std::string("the device G-buffer's ") + name + " holds " +
-                                       std::to_string(b.getInfo<CL_MEM_SIZE>()) +
-                                       " bytes, fewer than " + std::to_string(n * bytes));
-        return b;
-      };
-      staging_->begin();
-      staging_->stage(colour, colour_, "svgf colour");
-      staging_->stage(g.emission, emission_, "svgf emission");
-      base_color_roughness_in = check(on_device->base_color_roughness, 16, "base_color_roughness");
-      flags_in = check(on_device->flags, 4, "flags");
-      motion_in = check(on_device->motion, 8, "motion");
-      // Next frame's history test compares with these, after the guider has moved on.
-      runtime_.queue().enqueueCopyBuffer(check(on_device->position_depth, 16, "position_depth"),
-                                         cur.position_depth, 0, 0, n * 16);
-      runtime_.queue().enqueueCopyBuffer(check(on_device->shading_normal, 16, "shading_normal"),
-                                         cur.shading_normal, 0, 0, n * 16);
-      runtime_.queue().enqueueCopyBuffer(check(on_device->material, 4, "material"), cur.material, 0,
-                                         0, n * 4);
-      upload_bytes_per_pixel_ = kColourUploadBytesPerPixel;
     } else {
-      upload_bytes_per_pixel_ = kUploadBytesPerPixel;
       // Through pinned staging: a discrete GPU copies from it several times faster than from
       // the host's vectors (host/render/pinned_staging.h).
       staging_->begin();
       staging_->stage(colour, colour_, "svgf colour");
       staging_->stage(g.emission, emission_, "svgf emission");
-      staging_->stage(g.position_depth, cur.position_depth, "svgf position_depth");
-      staging_->stage(g.shading_normal, cur.shading_normal, "svgf shading_normal");
-      staging_->stage(g.base_color_roughness, base_color_roughness_, "svgf base_color_roughness");
-      staging_->stage(g.flags, flags_, "svgf flags");
-      staging_->stage(g.material, cur.material, "svgf material");
-      staging_->stage(g.motion, motion_, "svgf motion");
+      if (on_device != nullptr) {
+        const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+        const auto check = [&](const cl::Buffer& b, std::size_t bytes, const char* name) {
+          if (b.getInfo<CL_MEM_SIZE>() < n * bytes)
+            throw InputError("svgf", std::string("the device G-buffer's ") + name + " holds " +
+                                         std::to_string(b.getInfo<CL_MEM_SIZE>()) +
+                                         " bytes, fewer than " + std::to_string(n * bytes));
+          return b;
+        };
+        base_color_roughness_in =
+            check(on_device->base_color_roughness, 16, "base_color_roughness");
+        flags_in = check(on_device->flags, 4, "flags");
+        motion_in = check(on_device->motion, 8, "motion");
+        // Next frame's history test compares with these, after the guider has moved on.
+        runtime_.queue().enqueueCopyBuffer(check(on_device->position_depth, 16, "position_depth"),
+                                           cur.position_depth, 0, 0, n * 16);
+        runtime_.queue().enqueueCopyBuffer(check(on_device->shading_normal, 16, "shading_normal"),
+                                           cur.shading_normal, 0, 0, n * 16);
+        runtime_.queue().enqueueCopyBuffer(check(on_device->material, 4, "material"), cur.material,
+                                           0, 0, n * 4);
+        upload_bytes_per_pixel_ = kColourUploadBytesPerPixel;
+      } else {
+        staging_->stage(g.position_depth, cur.position_depth, "svgf position_depth");
+        staging_->stage(g.shading_normal, cur.shading_normal, "svgf shading_normal");
+        staging_->stage(g.base_color_roughness, base_color_roughness_, "svgf base_color_roughness");
+        staging_->stage(g.flags, flags_, "svgf flags");
+        staging_->stage(g.material, cur.material, "svgf material");
+        staging_->stage(g.motion, motion_, "svgf motion");
+        upload_bytes_per_pixel_ = kUploadBytesPerPixel;
+      }
     }
     runtime_.queue().finish();  // the host vectors may change once denoise() returns
     times_["svgf_upload"] = ms_since(start);
