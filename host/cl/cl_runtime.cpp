@@ -1,5 +1,7 @@
 #include "rtpg/cl_runtime.h"
 
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <mutex>
 #include <utility>
@@ -33,7 +35,15 @@ struct ClRuntime::Programs {
   ProgramCacheStats stats;
 };
 
-ClRuntime::~ClRuntime() = default;
+ClRuntime::~ClRuntime() {
+  if (const int users = users_.load(); users > 0) {
+    std::fprintf(stderr,
+                 "rtpg: an OpenCL runtime was destroyed while %d object(s) still use it: destroy "
+                 "the guider, renderer and denoiser first\n",
+                 users);
+    std::abort();
+  }
+}
 
 ProgramCacheStats ClRuntime::cache_stats() const {
   std::lock_guard<std::mutex> lock(programs_->mutex);

@@ -85,6 +85,7 @@ class SvgfDenoiser {
   };
 
   ClRuntime& runtime_;
+  ClRuntime::Use runtime_use_{runtime_};  // the runtime must outlive this
   int width_, height_;
   SvgfSettings settings_;
   int lanes_ = 1;

@@ -60,6 +60,7 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void copy_to_device(const Host& host, const Device& device, std::size_t bytes);
 
   ClRuntime& runtime_;
+  ClRuntime::Use runtime_use_{runtime_};  // the runtime must outlive this
   std::unique_ptr<Guider> guider_;
   // This frame's and last frame's G-buffer on the device: in place, the host's own memory
   // (wrap_host_gbuffer; current_host_ is that memory), else copies in owned_gbuffers_.

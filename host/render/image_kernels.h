@@ -54,6 +54,7 @@ class Accumulator {
 
  private:
   ClRuntime& runtime_;
+  ClRuntime::Use runtime_use_{runtime_};  // the runtime must outlive this
   int width_;
   int height_;
   std::size_t local_size_;

@@ -3,6 +3,7 @@
 // build options, caching and error reporting are decided here once.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -84,6 +85,23 @@ class ClRuntime {
   // END - START of a finished command in milliseconds, from its profiling info.
   static double event_ms(const cl::Event& event);
 
+  // Held by every object that keeps a reference to a runtime (Guider, and the renderer's guided
+  // first bounce, denoiser and image kernels). A runtime destroyed while one is alive would leave
+  // it a released queue, which some drivers survive and others do not (NVIDIA's crashed where
+  // PoCL's did not; docs/guiding.md, "The renderer on a GPU"): the runtime's destructor then
+  // stops the program with a message instead, on every device.
+  class Use {
+   public:
+    explicit Use(ClRuntime& runtime) : runtime_(runtime) { ++runtime_.users_; }
+    ~Use() { --runtime_.users_; }
+    Use(const Use&) = delete;
+    Use& operator=(const Use&) = delete;
+
+   private:
+    ClRuntime& runtime_;
+  };
+  int users() const { return users_.load(); }
+
   ProgramCacheStats cache_stats() const;
   // The rtpg cache folder this runtime uses (rtpg_cache_dir() at construction; "" = off).
   const std::string& cache_dir() const { return cache_dir_; }
@@ -101,6 +119,7 @@ class ClRuntime {
   cl::CommandQueue queue_;
   std::string cache_dir_;
   std::unique_ptr<Programs> programs_;
+  std::atomic<int> users_{0};
 };
 
 // A read-only device buffer over a host container's memory (CL_MEM_USE_HOST_PTR, any container

@@ -206,6 +206,7 @@ class Guider {
   double run(cl::Kernel& kernel, int lanes, bool pixel_kernel);
 
   ClRuntime& runtime_;
+  ClRuntime::Use runtime_use_{runtime_};  // the runtime must outlive this
   int width_, height_;
   GuidingSettings settings_;
   pg_kernel_settings kernel_settings_;

@@ -3,6 +3,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 
 #include "rtpg/cl_error.h"
 #include "rtpg/cl_runtime.h"
+#include "rtpg/guider.h"
 #include "cl/device.h"
 #include "render/image_kernels.h"
 #include "support/test_env.h"
@@ -269,6 +271,27 @@ TEST(ClRuntimeTiming, EventTimesAreNonNegative) {
   // read from the same counter) fails here.
   EXPECT_GT(ms, 0.0);
   EXPECT_LT(ms, 10000.0);
+}
+
+// A runtime destroyed before an object that keeps a reference to it stops the program with a
+// message (ClRuntime::Use). Without it a test that did so ran on silently on PoCL and crashed on
+// NVIDIA's OpenCL, whose released queue the guided sampler's destructor then used
+// (docs/guiding.md, "The renderer on a GPU").
+TEST(ClRuntimeDeathTest, DestroyedBeforeItsUsersStopsWithAMessage) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_DEATH(
+      {
+        auto runtime = std::make_unique<ClRuntime>();
+        Guider guider(*runtime, 8, 4);
+        runtime.reset();
+      },
+      "still use it");
+  auto runtime = std::make_unique<ClRuntime>();
+  {
+    Guider guider(*runtime, 8, 4);
+    EXPECT_EQ(runtime->users(), 1);
+  }
+  EXPECT_EQ(runtime->users(), 0);
 }
 
 }  // namespace
