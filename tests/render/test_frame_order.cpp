@@ -45,13 +45,21 @@ class RecordingSampler final : public FirstBounceSampler {
   BsdfFirstBounce bsdf_;
 };
 
-TEST(FrameOrder, TrainingFollowsTheFramesLastSample) {
-  const Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
+// The Cornell box at an odd size (23x17), spp samples a pixel.
+Scene cornell_box() {
+  return load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
+}
+RenderSettings odd_size(int spp) {
   RenderSettings settings;
   settings.width = 23;
   settings.height = 17;
-  settings.spp = 3;
-  Renderer renderer(scene, settings);
+  settings.spp = spp;
+  return settings;
+}
+
+TEST(FrameOrder, TrainingFollowsTheFramesLastSample) {
+  const Scene scene = cornell_box();
+  Renderer renderer(scene, odd_size(3));
   std::vector<std::string> log;
   renderer.set_first_bounce_sampler(std::make_unique<RecordingSampler>(log));
   renderer.render_frame(0);
@@ -67,11 +75,8 @@ TEST(FrameOrder, TrainingFollowsTheFramesLastSample) {
 // renderer leaves it out for BsdfFirstBounce itself, samples_the_bsdf()) or from the path
 // tracer's.
 TEST(FrameOrder, BsdfAtThePrimaryHitEqualsItsOwnPass) {
-  const Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
-  RenderSettings settings;
-  settings.width = 23;
-  settings.height = 17;
-  settings.spp = 2;
+  const Scene scene = cornell_box();
+  RenderSettings settings = odd_size(2);
   settings.camera_path = "pan";
   Renderer in_place(scene, settings), separate(scene, settings);
   ASSERT_TRUE(BsdfFirstBounce().samples_the_bsdf());
