@@ -143,12 +143,35 @@ nlohmann::json guiding_settings_json(const GuidingSettings& s) {
   return out;
 }
 
+const char* shared_randoms_name(SharedRandoms s) {
+  switch (s) {
+    case SharedRandoms::first_bounce:
+      return "first-bounce";
+    case SharedRandoms::primary_vertex:
+      return "primary-vertex";
+    case SharedRandoms::none:
+      break;
+  }
+  return "none";
+}
+
 nlohmann::json path_tracer_settings_json(const PathTracerSettings& s) {
   return {{"max_bounces", s.max_bounces},
           {"roulette_start", s.roulette_start},
           {"next_event", s.next_event},
           {"guide_secondary", s.guide_secondary},
-          {"direct_light_in_vpls", s.direct_light_in_vpls}};
+          {"direct_light_in_vpls", s.direct_light_in_vpls},
+          {"shared_randoms", shared_randoms_name(s.shared_randoms)}};
+}
+
+// The value of --share-randoms (checked by the command line's parser; a wrong name from
+// elsewhere is an input error naming the flag).
+SharedRandoms parse_shared_randoms(const std::string& name) {
+  if (name == "none") return SharedRandoms::none;
+  if (name == "first-bounce") return SharedRandoms::first_bounce;
+  if (name == "primary-vertex") return SharedRandoms::primary_vertex;
+  throw InputError("--share-randoms",
+                   "unknown value '" + name + "' (none, first-bounce or primary-vertex)");
 }
 
 // The flag wins, then the scene's integrator setting, then the renderer's default.
@@ -208,6 +231,7 @@ int run_render(const RenderCommand& command) {
   settings.path_tracer.guide_secondary =
       command.guiding == "pmm" && command.guide_vertices == "all";
   settings.path_tracer.direct_light_in_vpls = command.guide_direct_light == "mis";
+  settings.path_tracer.shared_randoms = parse_shared_randoms(command.share_randoms);
   settings.path_tracer.guide_position = command.guiding_settings.reproject_position;
   settings.path_tracer.guide_normal = command.guiding_settings.reproject_normal;
   Renderer renderer = with_flag_names([&] { return Renderer(scene, settings); });

@@ -167,8 +167,16 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
           const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
           const glm::vec3 origin = offset_ray_origin(x0, ng, g.geometric_normal[i].w);
 
-          const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
-                      u2 = shared::pg_rng_next(&rng);
+          // Next-event estimation takes the sample's first three numbers, or sample 0's where
+          // the frame's samples share the primary vertex (SharedRandoms).
+          shared::pg_rng nee_rng = rng;
+          if (settings_.shared_randoms == SharedRandoms::primary_vertex)
+            nee_rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame, 0u,
+                                          PG_RNG_STREAM_PATH);
+          shared::pg_rng* const nee_stream =
+              settings_.shared_randoms == SharedRandoms::primary_vertex ? &nee_rng : &rng;
+          const float u_sel = shared::pg_rng_next(nee_stream), u1 = shared::pg_rng_next(nee_stream),
+                      u2 = shared::pg_rng_next(nee_stream);
           // The first bounce's own sampler competes with the light here (the guided mixture).
           const auto first_bounce_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
             return sampler.pdf(g, i, lobes, wo, wi);
@@ -190,7 +198,8 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
             fs.pdf = std::isfinite(d.w) ? d.w : 0.0f;
             fs.strategy = first->strategy[i];
           } else {
-            fs = bsdf_first_bounce_sample(frame, wo, lobes, at, i);
+            fs = bsdf_first_bounce_sample(
+                frame, wo, lobes, first_bounce_coordinates(at, settings_.shared_randoms), i);
           }
           if (fs.pdf > 0.0f && glm::dot(fs.direction, ng) > 0.0f) {
             const glm::vec3 wi = shared::pg_to_local(frame, fs.direction);

@@ -20,6 +20,16 @@ namespace rtpg {
 
 struct SurfacePoint;
 
+// Which random numbers every sample of a frame takes from sample 0 instead of its own stream: a
+// diagnostic that splits a pixel's variance by where it arises (bench/variance_split.py,
+// docs/guiding.md, "Where the variance is"). Each sample stays an unbiased estimate; the frame's
+// samples are then correlated, so --spp averages only what comes after the shared part.
+enum class SharedRandoms {
+  none,            // every sample its own (the renderer)
+  first_bounce,    // the first bounce's direction (BSDF or guided) is sample 0's
+  primary_vertex,  // and so is the next-event estimate at the primary hit
+};
+
 struct PathTracerSettings {
   int max_bounces = 8;     // path vertices after the primary hit
   int roulette_start = 3;  // first bounce at which Russian roulette may end a path
@@ -36,7 +46,16 @@ struct PathTracerSettings {
   bool direct_light_in_vpls = true;
   float guide_position = 0.05f;  // relative distance to the pixel's depth
   float guide_normal = 0.9f;     // normal cosine
+  SharedRandoms shared_randoms = SharedRandoms::none;
 };
+
+// The coordinates a sample's first bounce draws with: sample 0's where the first bounce is
+// shared by the frame's samples (SharedRandoms).
+inline SampleCoordinates first_bounce_coordinates(const SampleCoordinates& at, SharedRandoms s) {
+  SampleCoordinates first = at;
+  if (s != SharedRandoms::none) first.sample = 0;
+  return first;
+}
 
 // How a frame's rays go to Embree (host/trace/ray.h): camera rays in packets of 8; bounce and
 // shadow rays in streams, 1.1-1.2x and 1.7-1.8x as fast as one by one (2026-11-26, AVX-512)

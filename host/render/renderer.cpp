@@ -187,7 +187,8 @@ FrameStats Renderer::render_frame(int index) {
     FirstBounceSamples first;
     if (!inline_bsdf) {
       t = Clock::now();
-      first = sampler_->sample(gbuffer, at);
+      first = sampler_->sample(gbuffer,
+                               first_bounce_coordinates(at, settings_.path_tracer.shared_randoms));
       stats.time_ms["first_bounce"] += ms_since(t);
     }
     const bool keep_vpls = s == 0 && sampler_->wants_vpls();

@@ -285,6 +285,11 @@ TEST_F(Cli, RejectsUnknownGuideVertices) {
                   {"out.exr"});
 }
 
+TEST_F(Cli, RejectsUnknownSharedRandoms) {
+  expect_rejected("render --res 16x16 --spp 2 --share-randoms everything -o out.exr",
+                  "--share-randoms", {"out.exr"});
+}
+
 TEST_F(Cli, RejectsUnknownDevice) {
   expect_rejected(render("--res 16x16 --device nosuch"), "nosuch");
 }
