@@ -8,22 +8,25 @@ variance is").
     python3 bench/variance_split.py --scenes cornell-box --variants '{"PG": [], "pi 0.95": ["--pg-pi-max", "0.95"]}'
 
 Per scene, seed and method (PT: --guiding off; each variant: --guiding pmm with its extra
-arguments, by default one variant, PG, with none), four renders of --frames frames
-against the cached reference (`rtpg reference`, --ref-spp, seed 777; the protocol of
-bench/variant_sweep.py), each figure the mean relMSE of the last --window frames:
+arguments, by default one variant, PG, with none), five renders of --frames frames against the
+cached reference (`rtpg reference`, --ref-spp, seed 777; the protocol of bench/variant_sweep.py),
+each figure the mean relMSE of the last --window frames:
 
-    t  1 spp                                          = P + D + N + R
-    a  M spp, every sample its own                    = P + (D + N + R) / M
-    b  M spp, the first bounce shared (--share-randoms first-bounce)   = P + D + (N + R) / M
-    c  M spp, the primary vertex shared (--share-randoms primary-vertex) = P + D + N + R / M
+    t  1 spp                                                  = P + D + N + Y + R
+    a  M spp, every sample its own                            = P + (D + N + Y + R) / M
+    b  M spp, the first bounce shared (--share-randoms first-bounce)    = P + D + (N + Y + R) / M
+    c  M spp, the primary vertex shared (primary-vertex)      = P + D + N + (Y + R) / M
+    d  M spp, the first bounce's hit y shared (second-vertex) = P + D + N + Y + R / M
 
-P is what a frame's samples share anyway (the camera ray is jittered once a frame), D the
-first-bounce direction's part (what first-bounce guiding changes), N the next-event estimate at
-the primary hit, R the rest of the path (the radiance arriving at the first bounce's vertex y,
-with everything after it). relMSE is a mean of per-pixel squared errors, so the parts add:
-D = (b - a) / (1 - 1/M), N = (c - b) / (1 - 1/M), R = (t - c) / (1 - 1/M), P = t - D - N - R.
-All four renders of a seed draw sample 0 identically, so PG's model is the same in all four
-(training reads sample 0's VPLs) and their differences carry little noise of their own.
+P is what a frame's samples share anyway (the camera ray is jittered once a frame; the
+reference's own error adds here too), D the first-bounce direction's part (what first-bounce
+guiding changes), N the next-event estimate at the primary hit, Y the light sample and bounce at
+y (the radiance estimate at the VPL's vertex, one bounce deep), R the rest of the path. relMSE is
+a mean of per-pixel squared errors, so the parts add: with k = 1 - 1/M, D = (b - a) / k,
+N = (c - b) / k, Y = (d - c) / k, R = (t - d) / k, P = t - D - N - Y - R. Sample 0 draws as the
+renderer does in every mode (tests/render/test_shared_randoms.cpp), so the five renders of a
+seed share it, PG's model is the same in all five (training reads sample 0's VPLs), and their
+differences carry little noise of their own.
 
 Prints a line per scene and method and a Markdown table of the parts as shares of PT's 1-spp
 relMSE (a row per scene and method), with the standard error over seeds; writes
@@ -45,15 +48,16 @@ RUNS = {  # name -> (spp multiplier: 1 or M, --share-randoms)
     "a": (True, "none"),
     "b": (True, "first-bounce"),
     "c": (True, "primary-vertex"),
+    "d": (True, "second-vertex"),
 }
-PARTS = ["P", "D", "N", "R"]
+PARTS = ["P", "D", "N", "Y", "R"]
 
 
-def split(t, a, b, c, m):
-    """The four parts from the four figures (module docstring)."""
+def split(f, m):
+    """The five parts from the five figures f[run] (module docstring)."""
     k = 1.0 - 1.0 / m
-    d, n, r = (b - a) / k, (c - b) / k, (t - c) / k
-    return {"P": t - d - n - r, "D": d, "N": n, "R": r}
+    d, n, y, r = (f["b"] - f["a"]) / k, (f["c"] - f["b"]) / k, (f["d"] - f["c"]) / k, (f["t"] - f["d"]) / k
+    return {"P": f["t"] - d - n - y - r, "D": d, "N": n, "Y": y, "R": r}
 
 
 def main():
@@ -110,7 +114,7 @@ def main():
         for seed in args.seeds:
             for method in methods:
                 f = {run: figure(scene, method, run, seed) for run in RUNS}
-                per_seed[method].append({"figures": f, "parts": split(f["t"], f["a"], f["b"], f["c"], args.spp)})
+                per_seed[method].append({"figures": f, "parts": split(f, args.spp)})
         # Shares of PT's 1-spp relMSE, per seed, then mean and standard error over seeds.
         shares = {}
         for method, seeds in per_seed.items():
@@ -124,7 +128,8 @@ def main():
             print(f"{scene:18s} {method:12s} (PT relMSE {pt_t:.4g}) " +
                   " ".join(f"{p} {shares[method][p][0]:.3f}" for p in PARTS + ["t"]), flush=True)
 
-    header = ["scene", "method", "P (jitter)", "D (first bounce)", "N (light at x0)", "R (rest of path)", "total"]
+    header = ["scene", "method", "P (jitter)", "D (first bounce)", "N (light at x0)", "Y (vertex y)", "R (rest)",
+              "total"]
     lines = ["| " + " | ".join(header) + " |", "|---" * len(header) + "|"]
     for scene, r in results.items():
         for method, parts in r["shares"].items():

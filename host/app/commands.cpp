@@ -149,6 +149,8 @@ const char* shared_randoms_name(SharedRandoms s) {
       return "first-bounce";
     case SharedRandoms::primary_vertex:
       return "primary-vertex";
+    case SharedRandoms::second_vertex:
+      return "second-vertex";
     case SharedRandoms::none:
       break;
   }
@@ -170,8 +172,10 @@ SharedRandoms parse_shared_randoms(const std::string& name) {
   if (name == "none") return SharedRandoms::none;
   if (name == "first-bounce") return SharedRandoms::first_bounce;
   if (name == "primary-vertex") return SharedRandoms::primary_vertex;
-  throw InputError("--share-randoms",
-                   "unknown value '" + name + "' (none, first-bounce or primary-vertex)");
+  if (name == "second-vertex") return SharedRandoms::second_vertex;
+  throw InputError(
+      "--share-randoms",
+      "unknown value '" + name + "' (none, first-bounce, primary-vertex or second-vertex)");
 }
 
 // The flag wins, then the scene's integrator setting, then the renderer's default.

@@ -137,10 +137,11 @@ int main(int argc, char** argv) {
   render_cmd
       ->add_option("--share-randoms", render.share_randoms,
                    "Diagnostic: every sample of a frame reuses sample 0's random numbers for the "
-                   "first bounce (first-bounce), or for it and the next-event estimate at the "
-                   "primary hit (primary-vertex), so --spp averages only the rest of the path "
+                   "first bounce (first-bounce), also for the next-event estimate at the primary "
+                   "hit (primary-vertex), and also for the light sample and bounce at the first "
+                   "bounce's hit (second-vertex), so --spp averages only the rest of the path "
                    "(bench/variance_split.py); none is the renderer")
-      ->check(CLI::IsMember({"none", "first-bounce", "primary-vertex"}))
+      ->check(CLI::IsMember({"none", "first-bounce", "primary-vertex", "second-vertex"}))
       ->capture_default_str();
   render_cmd->add_option("-o,--output", render.output,
                          "Last frame: .exr (linear) or .png (tonemapped)");

@@ -23,6 +23,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr std::size_t kGrain = 2048;
+// Random numbers a path vertex draws from its stream, whatever it does with them: three for
+// next-event estimation (light choice, point on the light), then four for the bounce (lobe,
+// direction, Russian roulette). SharedRandoms counts on them to find where sample 0's stream
+// stood at a vertex.
+constexpr int kNextEventDraws = 3;
+constexpr int kBounceDraws = 4;
 // How many vertices ahead the shading loop starts loading the pixel a later vertex borrows
 // from (prefetch_borrowable).
 constexpr std::size_t kPrefetchAhead = 4;
@@ -78,6 +84,7 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSamples* first,
   const std::size_t n = g.pixel_count();
   gbuffer_ = &g;
   sampler_ = &sampler;
+  at_ = at;
   prepare(n, vpls);
   auto start = Clock::now();
   if (settings_.guide_secondary) collect_borrowable(g, sampler);
@@ -143,6 +150,13 @@ bool PathTracer::next_event(const glm::vec3& position, const glm::vec3& ng,
   return true;
 }
 
+shared::pg_rng PathTracer::second_vertex_stream(std::uint32_t i, shared::pg_rng& own) const {
+  shared::pg_rng zero = shared::pg_rng_make(at_.seed, i, at_.frame, 0u, PG_RNG_STREAM_PATH);
+  for (int k = 0; k < kNextEventDraws; ++k) shared::pg_rng_next(&zero);  // x0's light sample
+  for (int k = 0; k < kNextEventDraws + kBounceDraws; ++k) shared::pg_rng_next(&own);
+  return zero;
+}
+
 void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                              const FirstBounceSampler& sampler, const SampleCoordinates& at,
                              VplBuffer* vpls) {
@@ -169,12 +183,16 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
 
           // Next-event estimation takes the sample's first three numbers, or sample 0's where
           // the frame's samples share the primary vertex (SharedRandoms).
+          // The own stream then skips them, so that sample 0 draws as the renderer does.
+          const bool shared_nee = settings_.shared_randoms == SharedRandoms::primary_vertex ||
+                                  settings_.shared_randoms == SharedRandoms::second_vertex;
           shared::pg_rng nee_rng = rng;
-          if (settings_.shared_randoms == SharedRandoms::primary_vertex)
+          if (shared_nee) {
             nee_rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame, 0u,
                                           PG_RNG_STREAM_PATH);
-          shared::pg_rng* const nee_stream =
-              settings_.shared_randoms == SharedRandoms::primary_vertex ? &nee_rng : &rng;
+            for (int k = 0; k < kNextEventDraws; ++k) shared::pg_rng_next(&rng);
+          }
+          shared::pg_rng* const nee_stream = shared_nee ? &nee_rng : &rng;
           const float u_sel = shared::pg_rng_next(nee_stream), u1 = shared::pg_rng_next(nee_stream),
                       u2 = shared::pg_rng_next(nee_stream);
           // The first bounce's own sampler competes with the light here (the guided mixture).
@@ -297,6 +315,9 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
 
       shared::pg_rng rng;
       rng.state = p.rng;
+      shared::pg_rng own = rng;
+      const bool shared_y = depth == 1 && settings_.shared_randoms == SharedRandoms::second_vertex;
+      if (shared_y) rng = second_vertex_stream(i, own);
       const shared::pg_frame frame = shared::pg_frame_from_normal(sp.shading_normal);
       const glm::vec3 wo = shared::pg_to_local(frame, -dir);
       const shared::pg_lobes lobes = shared::pg_make_lobes(sp.material, wo);
@@ -332,7 +353,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
 
       const float u_lobe = shared::pg_rng_next(&rng), v1 = shared::pg_rng_next(&rng),
                   v2 = shared::pg_rng_next(&rng), u_rr = shared::pg_rng_next(&rng);
-      p.rng = rng.state;
+      p.rng = shared_y ? own.state : rng.state;
       shared::pg_bsdf_sample_t bs;
       glm::vec3 wi_world;
       if (!guided) {

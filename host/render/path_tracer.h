@@ -14,6 +14,7 @@
 #include "render/lights.h"
 #include "render/vpl_buffer.h"
 #include "scene/scene.h"
+#include "shared/rng.h"
 #include "trace/embree_scene.h"
 
 namespace rtpg {
@@ -28,6 +29,8 @@ enum class SharedRandoms {
   none,            // every sample its own (the renderer)
   first_bounce,    // the first bounce's direction (BSDF or guided) is sample 0's
   primary_vertex,  // and so is the next-event estimate at the primary hit
+  second_vertex,   // and so are the first bounce's hit y's light sample and bounce (with its
+                   // Russian roulette draw)
 };
 
 struct PathTracerSettings {
@@ -118,6 +121,10 @@ class PathTracer {
   // The hits of the m live paths at path vertex `depth`: emission found by the bounce (MIS),
   // the VPL at depth 1, next-event estimation, BSDF sampling and Russian roulette.
   void shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays);
+  // The random numbers of path i's vertex y (the first bounce's hit) where the frame's samples
+  // share it (SharedRandoms::second_vertex): sample 0's stream there; `own` then continues
+  // past y as if it had drawn them.
+  shared::pg_rng second_vertex_stream(std::uint32_t i, shared::pg_rng& own) const;
   // Next-event estimation at a surface point, once for every vertex: samples a light and,
   // where the BSDF sees it, returns true with the contribution an unoccluded shadow ray adds
   // (BSDF x cosine x radiance x MIS weight / pdf; competing_pdf(world_dir, local_dir) is the
@@ -165,6 +172,7 @@ class PathTracer {
   // This frame's G-buffer and first-bounce sampler (set by trace()).
   const GBuffer* gbuffer_ = nullptr;
   const FirstBounceSampler* sampler_ = nullptr;
+  SampleCoordinates at_;  // this sample's (trace)
 
   // Scratch, reused across frames.
   std::vector<PathState> paths_;

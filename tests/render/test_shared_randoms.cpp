@@ -91,15 +91,59 @@ TEST(SharedRandoms, PrimaryVertexAlsoRepeatsTheLightSample) {
   }
 }
 
+// Two bounces: the second vertex's light sample and bounce are the last numbers a path draws
+// (the vertex after them only adds what its ray found), so sharing the second vertex repeats
+// sample 0 exactly, and sharing only the primary vertex does not.
+TEST(SharedRandoms, SecondVertexAlsoRepeatsTheFirstBouncesHit) {
+  const Scene scene = cornell_box();
+  Renderer one(scene, settings_for(1, 2, true, SharedRandoms::none));
+  Renderer second(scene, settings_for(2, 2, true, SharedRandoms::second_vertex));
+  Renderer primary(scene, settings_for(2, 2, true, SharedRandoms::primary_vertex));
+  for (int frame = 0; frame < 3; ++frame) {
+    const Difference d = render_and_compare(one, second, frame);
+    EXPECT_EQ(d.differ, 0u) << "frame " << frame;
+    EXPECT_GT(d.lit, one.image().size() / 3) << "frame " << frame;
+    primary.render_frame(frame);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < primary.image().size(); ++i)
+      differ += primary.image()[i] != one.image()[i];
+    EXPECT_GT(differ, one.image().size() / 4) << "frame " << frame << ": y shared";
+  }
+}
+
+// Sample 0 draws as the renderer does in every mode (the shared parts are its numbers), so one
+// sample a pixel gives the renderer's image to the bit at full depth: the four renders of
+// bench/variance_split.py share their first sample, and a guided run trains on the same VPLs.
+TEST(SharedRandoms, SampleZeroIsTheRenderersOwn) {
+  const Scene scene = cornell_box();
+  Renderer plain(scene, settings_for(1, 8, true, SharedRandoms::none));
+  Renderer first(scene, settings_for(1, 8, true, SharedRandoms::first_bounce));
+  Renderer primary(scene, settings_for(1, 8, true, SharedRandoms::primary_vertex));
+  Renderer second(scene, settings_for(1, 8, true, SharedRandoms::second_vertex));
+  for (int frame = 0; frame < 2; ++frame) {
+    plain.render_frame(frame);
+    for (Renderer* r : {&first, &primary, &second}) {
+      r->render_frame(frame);
+      EXPECT_EQ(r->image(), plain.image()) << "frame " << frame;
+    }
+  }
+}
+
 // At full depth the rest of the path stays each sample's own: the shared images differ from
 // the one-sample image, and from each other only through what follows the shared part.
 TEST(SharedRandoms, TheRestOfThePathKeepsItsOwnNumbers) {
   const Scene scene = cornell_box();
   Renderer one(scene, settings_for(1, 8, true, SharedRandoms::none));
   Renderer vertex(scene, settings_for(2, 8, true, SharedRandoms::primary_vertex));
+  Renderer second(scene, settings_for(2, 8, true, SharedRandoms::second_vertex));
   for (int frame = 0; frame < 2; ++frame) {
     const Difference d = render_and_compare(one, vertex, frame);
     EXPECT_GT(d.differ, one.image().size() / 4) << "frame " << frame;
+    second.render_frame(frame);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < second.image().size(); ++i)
+      differ += second.image()[i] != one.image()[i];
+    EXPECT_GT(differ, one.image().size() / 8) << "frame " << frame;
   }
 }
 
@@ -124,8 +168,8 @@ class CoordinateLog final : public FirstBounceSampler {
 
 TEST(SharedRandoms, ASamplerOfItsOwnDrawsWithSampleZero) {
   const Scene scene = cornell_box();
-  for (const SharedRandoms shared :
-       {SharedRandoms::none, SharedRandoms::first_bounce, SharedRandoms::primary_vertex}) {
+  for (const SharedRandoms shared : {SharedRandoms::none, SharedRandoms::first_bounce,
+                                     SharedRandoms::primary_vertex, SharedRandoms::second_vertex}) {
     Renderer renderer(scene, settings_for(3, 2, true, shared));
     std::vector<std::uint32_t> samples;
     renderer.set_first_bounce_sampler(std::make_unique<CoordinateLog>(samples));
