@@ -73,12 +73,7 @@ def main():
     parser.add_argument("--variants", default='{"PG": []}',
                         help="JSON object: guided variant name -> list of extra rtpg arguments")
     args = parser.parse_args()
-    try:
-        variants = json.loads(args.variants)
-    except json.JSONDecodeError as e:
-        parser.error(f"--variants is not JSON: {e}")
-    if not isinstance(variants, dict) or not all(isinstance(v, list) for v in variants.values()):
-        parser.error('--variants must be a JSON object of argument lists, e.g. {"PG": []}')
+    variants = runner.parse_variants(parser, args.variants, '{"PG": []}')
     # Method name -> (--guiding, extra arguments, cache tag); "PG" keeps the tag "pg".
     methods = {"PT": ("off", [], "pt")}
     for name, extra in variants.items():

@@ -64,12 +64,7 @@ def main():
                         help="with --camera-path: 0-based frames compared with their own references "
                              "(default: the last --window frames)")
     args = parser.parse_args()
-    try:
-        variants = json.loads(args.variants)
-    except json.JSONDecodeError as e:
-        parser.error(f"--variants is not JSON: {e}")
-    if not isinstance(variants, dict) or not all(isinstance(v, list) for v in variants.values()):
-        parser.error('--variants must be a JSON object of argument lists, e.g. {"default": []}')
+    variants = runner.parse_variants(parser, args.variants, '{"default": []}')
     if not 1 <= args.window <= args.frames:
         parser.error(f"--window {args.window} must be between 1 and --frames {args.frames}")
     if args.checkpoints and not args.camera_path:

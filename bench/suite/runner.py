@@ -168,3 +168,15 @@ def machine_info():
     except OSError:
         info["git_commit"] = "unknown"
     return info
+
+
+def parse_variants(parser, text, example):
+    """--variants as JSON: an object of variant name -> list of extra rtpg arguments, or a usage
+    error naming the flag."""
+    try:
+        variants = json.loads(text)
+    except json.JSONDecodeError as e:
+        parser.error(f"--variants is not JSON: {e}")
+    if not isinstance(variants, dict) or not all(isinstance(v, list) for v in variants.values()):
+        parser.error(f"--variants must be a JSON object of argument lists, e.g. {example}")
+    return variants

@@ -393,6 +393,26 @@ TEST(GuidingImage, InPlaceRefusesTheSameGBufferTwoFramesRunning) {
 // guiding is at most half that without (0.21 measured), against a 1024-spp reference rendered
 // here. At the scene's full depth (8 bounces) the equal-frame ratio is 0.97, not significant
 // (docs/results/equal-frame-2026-11-23/): that gain is not there to guard yet.
+// A path-traced reference of the scene with `settings` (size, bounces): 256 frames of
+// spp_per_frame samples from seed 1000, averaged (the camera is static).
+ImageRgb reference_image(const Scene& scene, const RenderSettings& settings, int spp_per_frame) {
+  ImageRgb reference{settings.width, settings.height,
+                     std::vector<glm::vec3>(static_cast<std::size_t>(settings.width) *
+                                                static_cast<std::size_t>(settings.height),
+                                            glm::vec3(0.0f))};
+  RenderSettings ref_settings = settings;
+  ref_settings.seed = 1000;
+  ref_settings.spp = spp_per_frame;
+  Renderer renderer(scene, ref_settings);
+  const int passes = 256;
+  for (int p = 0; p < passes; ++p) {
+    renderer.render_frame(p);
+    for (std::size_t i = 0; i < reference.pixels.size(); ++i)
+      reference.pixels[i] += renderer.image()[i] / float(passes);
+  }
+  return reference;
+}
+
 TEST(GuidingImage, HalvesErrorOnCornellIndirect) {
   const Scene scene = load_scene(scene_file("cornell-indirect.json"));
   ClRuntime cl;
@@ -401,19 +421,7 @@ TEST(GuidingImage, HalvesErrorOnCornellIndirect) {
   settings.width = settings.height = size;
   settings.path_tracer.max_bounces = 2;
 
-  ImageRgb reference{size, size, std::vector<glm::vec3>(size * size, glm::vec3(0.0f))};
-  {
-    RenderSettings ref_settings = settings;
-    ref_settings.seed = 1000;
-    ref_settings.spp = 4;
-    Renderer renderer(scene, ref_settings);
-    const int passes = 256;  // 1024 spp
-    for (int p = 0; p < passes; ++p) {
-      renderer.render_frame(p);
-      for (std::size_t i = 0; i < reference.pixels.size(); ++i)
-        reference.pixels[i] += renderer.image()[i] / float(passes);
-    }
-  }
+  const ImageRgb reference = reference_image(scene, settings, 4);  // 1024 spp
   double error[2] = {0.0, 0.0};
   for (int guided = 0; guided < 2; ++guided) {
     Renderer renderer(scene, settings);
@@ -452,19 +460,7 @@ double first_bounce_error_ratio(const char* name) {
   settings.spp = spp;
   settings.path_tracer.max_bounces = scene.max_bounces > 0 ? scene.max_bounces : 8;
 
-  ImageRgb reference{size, size, std::vector<glm::vec3>(size * size, glm::vec3(0.0f))};
-  {
-    RenderSettings ref_settings = settings;
-    ref_settings.seed = 1000;
-    ref_settings.spp = 16;
-    Renderer renderer(scene, ref_settings);
-    const int passes = 256;  // 4096 spp
-    for (int p = 0; p < passes; ++p) {
-      renderer.render_frame(p);
-      for (std::size_t i = 0; i < reference.pixels.size(); ++i)
-        reference.pixels[i] += renderer.image()[i] / float(passes);
-    }
-  }
+  const ImageRgb reference = reference_image(scene, settings, 16);  // 4096 spp
   // relMSE of the last `window` frames, guided or not, with or without the first bounce shared.
   auto error = [&](bool guided, SharedRandoms shared) {
     RenderSettings s = settings;
