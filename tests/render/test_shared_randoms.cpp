@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "forwarding_sampler.h"
 #include "render/first_bounce.h"
 #include "render/renderer.h"
 #include "scene/scene_loader.h"
@@ -148,22 +149,19 @@ TEST(SharedRandoms, TheRestOfThePathKeepsItsOwnNumbers) {
 }
 
 // A first-bounce sampler of its own (the guided one draws in the sample kernel) is handed
-// sample 0's coordinates for every sample of the frame.
-class CoordinateLog final : public FirstBounceSampler {
+// sample 0's coordinates for every sample of the frame: BSDF sampling through
+// ForwardingSampler (which makes the renderer call sample()), recording each call's sample.
+class CoordinateLog final : public ForwardingSampler {
  public:
-  explicit CoordinateLog(std::vector<std::uint32_t>& samples) : samples_(samples) {}
+  explicit CoordinateLog(std::vector<std::uint32_t>& samples)
+      : ForwardingSampler(std::make_unique<BsdfFirstBounce>()), samples_(samples) {}
   FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
     samples_.push_back(at.sample);
-    return bsdf_.sample(g, at);
-  }
-  float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
-            const glm::vec3& wi) const override {
-    return bsdf_.pdf(g, i, lobes, wo, wi);
+    return ForwardingSampler::sample(g, at);
   }
 
  private:
   std::vector<std::uint32_t>& samples_;
-  BsdfFirstBounce bsdf_;
 };
 
 TEST(SharedRandoms, ASamplerOfItsOwnDrawsWithSampleZero) {
