@@ -33,8 +33,8 @@ struct RenderCommand {
                                            // with its MIS weight (PathTracerSettings)
   std::string guide_vertices = "first";    // "first" (the paper) or "all" (secondary vertices
                                            // borrow the mixture of the pixel showing them)
-  std::string share_randoms = "none";      // "none", "first-bounce" or "primary-vertex"
-                                           // (SharedRandoms, host/render/path_tracer.h)
+  std::string share_randoms = "none";      // --share-randoms: SharedRandoms by name
+                                           // (host/render/path_tracer.h)
   GuidingSettings guiding_settings;
   std::string train_memory = "auto";
   std::string host_transfer = "auto";  // parse_host_transfer (host/render/guided_first_bounce.h)

@@ -181,20 +181,22 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
           const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
           const glm::vec3 origin = offset_ray_origin(x0, ng, g.geometric_normal[i].w);
 
-          // Next-event estimation takes the sample's first three numbers, or sample 0's where
-          // the frame's samples share the primary vertex (SharedRandoms).
-          // The own stream then skips them, so that sample 0 draws as the renderer does.
+          // Next-event estimation draws three numbers: the sample's own, or sample 0's where the
+          // frame's samples share the primary vertex (SharedRandoms); either way the sample's
+          // own stream moves past them, so that sample 0 draws as the renderer does.
           const bool shared_nee = settings_.shared_randoms == SharedRandoms::primary_vertex ||
                                   settings_.shared_randoms == SharedRandoms::second_vertex;
-          shared::pg_rng nee_rng = rng;
+          shared::pg_rng nee_rng = shared_nee
+                                       ? shared::pg_rng_make(at.seed, static_cast<shared::uint>(i),
+                                                             at.frame, 0u, PG_RNG_STREAM_PATH)
+                                       : rng;
+          const float u_sel = shared::pg_rng_next(&nee_rng), u1 = shared::pg_rng_next(&nee_rng),
+                      u2 = shared::pg_rng_next(&nee_rng);
           if (shared_nee) {
-            nee_rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame, 0u,
-                                          PG_RNG_STREAM_PATH);
             for (int k = 0; k < kNextEventDraws; ++k) shared::pg_rng_next(&rng);
+          } else {
+            rng = nee_rng;
           }
-          shared::pg_rng* const nee_stream = shared_nee ? &nee_rng : &rng;
-          const float u_sel = shared::pg_rng_next(nee_stream), u1 = shared::pg_rng_next(nee_stream),
-                      u2 = shared::pg_rng_next(nee_stream);
           // The first bounce's own sampler competes with the light here (the guided mixture).
           const auto first_bounce_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
             return sampler.pdf(g, i, lobes, wo, wi);
@@ -313,11 +315,12 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       }
       if (depth == settings_.max_bounces) continue;
 
-      shared::pg_rng rng;
-      rng.state = p.rng;
-      shared::pg_rng own = rng;
+      // The vertex's stream: the path's own, or at y sample 0's where the frame's samples share
+      // it (SharedRandoms; `own` then moves past the numbers y draws).
+      shared::pg_rng own;
+      own.state = p.rng;
       const bool shared_y = depth == 1 && settings_.shared_randoms == SharedRandoms::second_vertex;
-      if (shared_y) rng = second_vertex_stream(i, own);
+      shared::pg_rng rng = shared_y ? second_vertex_stream(i, own) : own;
       const shared::pg_frame frame = shared::pg_frame_from_normal(sp.shading_normal);
       const glm::vec3 wo = shared::pg_to_local(frame, -dir);
       const shared::pg_lobes lobes = shared::pg_make_lobes(sp.material, wo);
