@@ -115,8 +115,13 @@ def density(model, u, cos):
     return dens
 
 
-def fit(u, cos, a, k, pi_cap, rng, iterations=80):
-    """Weighted EM of K lobes beside the fixed BSDF component, from a weighted k-means++ start."""
+def fit(u, cos, a, k, pi_cap, rng, iterations=80, second_moment=False):
+    """Weighted EM of K lobes beside the fixed BSDF component, from a weighted k-means++ start.
+    With second_moment the target is F^2 / D of the current model instead of F (each iteration
+    reweights a sample of weight a = F / r by a / D): the fixed point lowers the estimator's
+    second moment, integral F^2 / D, where the plain fit maximises the likelihood of F (lever 2
+    of issue 9, "fit for variance")."""
+    base = a
     total = a.sum()
     if k == 0 or total <= 0:
         return ([], [], [])
@@ -131,6 +136,9 @@ def fit(u, cos, a, k, pi_cap, rng, iterations=80):
     for _ in range(iterations):
         model = (pis, means, covs)
         dens = density(model, u, cos)
+        if second_moment:
+            a = base * base / np.maximum(dens, 1e-12)
+            total = a.sum()
         new_pis, new_means, new_covs = [], [], []
         for j in range(k):
             resp = a * pis[j] * gauss(u, means[j], covs[j]) / (2 * math.pi) / dens
@@ -172,8 +180,11 @@ def main():
     inside = (ys >= a) & (ys < h - a) & (xs >= a) & (xs < w - a)
     ys, xs = ys[inside], xs[inside]
     pick = rng.choice(len(ys), size=min(args.pixels, len(ys)), replace=False)
-    models = {"BSDF": (0, 0.0), "1 lobe, pi <= 0.5": (1, 0.5), "1 lobe, pi <= 0.95": (1, 0.95),
-              "2 lobes, pi <= 0.95": (2, 0.95), "3 lobes, pi <= 0.95": (3, 0.95), "4 lobes, pi <= 0.95": (4, 0.95)}
+    models = {"BSDF": (0, 0.0, False), "1 lobe, pi <= 0.5": (1, 0.5, False), "1 lobe, pi <= 0.95": (1, 0.95, False),
+              "2 lobes, pi <= 0.95": (2, 0.95, False), "3 lobes, pi <= 0.95": (3, 0.95, False),
+              "4 lobes, pi <= 0.95": (4, 0.95, False), "1 lobe, pi <= 0.5, second moment": (1, 0.5, True),
+              "1 lobe, pi <= 0.95, second moment": (1, 0.95, True),
+              "2 lobes, pi <= 0.95, second moment": (2, 0.95, True)}
     rel = {name: [] for name in models}
     share = {name: [] for name in models}
     fit_frames, eval_frames = range(args.fit_frames), range(args.fit_frames, frames)
@@ -185,8 +196,8 @@ def main():
             continue
         weights = f / r
         estimate = (ef / er).mean()
-        for name, (k, cap) in models.items():
-            model = fit(u, cos, weights, k, cap, rng)
+        for name, (k, cap, second_moment) in models.items():
+            model = fit(u, cos, weights, k, cap, rng, second_moment=second_moment)
             dens = density(model, eu, ecos)
             m2 = (ef ** 2 / (dens * er)).mean()
             rel[name].append((m2 - estimate ** 2) / (estimate ** 2 + 0.01))
