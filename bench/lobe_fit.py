@@ -36,20 +36,17 @@ def load(path):
     return data.reshape(-1, h, w, 28)
 
 
-def atan_unit(z):
-    return np.arctan(z)
-
-
 def hemisphere_to_square(w):
-    """M^-1 of kernels/shared/mapping.h (the concentric map with the equal-area lift)."""
+    """M^-1 of kernels/shared/mapping.h (the concentric map with the equal-area lift; numpy's
+    arctan where the kernel has its polynomial)."""
     x, y, z = w[:, 0], w[:, 1], w[:, 2]
     r = np.sqrt(np.clip(1.0 - z, 0.0, 1.0))
     u = np.full((len(w), 2), 0.5)
     with np.errstate(divide="ignore", invalid="ignore"):
         xa = np.abs(x) >= np.abs(y)
         a = np.where(xa, np.where(x > 0, r, -r), 0.0)
-        b = np.where(xa, a * atan_unit(y / x) * 4 / math.pi, np.where(y > 0, r, -r))
-        a = np.where(xa, a, b * atan_unit(x / y) * 4 / math.pi)
+        b = np.where(xa, a * np.arctan(y / x) * 4 / math.pi, np.where(y > 0, r, -r))
+        a = np.where(xa, a, b * np.arctan(x / y) * 4 / math.pi)
     ok = (r > 0) & ~((x == 0) & (y == 0))
     u[ok, 0] = np.clip(0.5 * (a[ok] + 1), 0, 1)
     u[ok, 1] = np.clip(0.5 * (b[ok] + 1), 0, 1)

@@ -36,6 +36,13 @@ RenderSettings settings_for(int spp, int bounces, bool next_event, SharedRandoms
   return settings;
 }
 
+// Pixels whose value differs between the last frames of two renderers.
+std::size_t differing_pixels(const Renderer& a, const Renderer& b) {
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.image().size(); ++i) differ += a.image()[i] != b.image()[i];
+  return differ;
+}
+
 // Pixels whose value differs between frame `frame` of two renderers, and pixels lit in the first.
 struct Difference {
   std::size_t differ = 0, lit = 0;
@@ -44,10 +51,8 @@ Difference render_and_compare(Renderer& a, Renderer& b, int frame) {
   a.render_frame(frame);
   b.render_frame(frame);
   Difference d;
-  for (std::size_t i = 0; i < a.image().size(); ++i) {
-    d.differ += a.image()[i] != b.image()[i];
-    d.lit += a.image()[i] != glm::vec3(0.0f);
-  }
+  d.differ = differing_pixels(a, b);
+  for (const glm::vec3& c : a.image()) d.lit += c != glm::vec3(0.0f);
   return d;
 }
 
@@ -64,8 +69,7 @@ TEST(SharedRandoms, FirstBounceRepeatsSampleZero) {
     EXPECT_EQ(d.differ, 0u) << "frame " << frame;
     lit += d.lit;
     own.render_frame(frame);
-    for (std::size_t i = 0; i < own.image().size(); ++i)
-      own_differ += own.image()[i] != one.image()[i];
+    own_differ += differing_pixels(own, one);
   }
   // Lit pixels are those whose bounce found the light (besides the light's own); with samples of
   // their own, two samples find it in other pixels than one does.
@@ -85,9 +89,7 @@ TEST(SharedRandoms, PrimaryVertexAlsoRepeatsTheLightSample) {
     EXPECT_EQ(d.differ, 0u) << "frame " << frame;
     EXPECT_GT(d.lit, one.image().size() / 3) << "frame " << frame;
     bounce.render_frame(frame);
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < bounce.image().size(); ++i)
-      differ += bounce.image()[i] != one.image()[i];
+    const std::size_t differ = differing_pixels(bounce, one);
     EXPECT_GT(differ, one.image().size() / 4) << "frame " << frame << ": light samples shared";
   }
 }
@@ -105,9 +107,7 @@ TEST(SharedRandoms, SecondVertexAlsoRepeatsTheFirstBouncesHit) {
     EXPECT_EQ(d.differ, 0u) << "frame " << frame;
     EXPECT_GT(d.lit, one.image().size() / 3) << "frame " << frame;
     primary.render_frame(frame);
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < primary.image().size(); ++i)
-      differ += primary.image()[i] != one.image()[i];
+    const std::size_t differ = differing_pixels(primary, one);
     EXPECT_GT(differ, one.image().size() / 4) << "frame " << frame << ": y shared";
   }
 }
@@ -141,9 +141,7 @@ TEST(SharedRandoms, TheRestOfThePathKeepsItsOwnNumbers) {
     const Difference d = render_and_compare(one, vertex, frame);
     EXPECT_GT(d.differ, one.image().size() / 4) << "frame " << frame;
     second.render_frame(frame);
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < second.image().size(); ++i)
-      differ += second.image()[i] != one.image()[i];
+    const std::size_t differ = differing_pixels(second, one);
     EXPECT_GT(differ, one.image().size() / 8) << "frame " << frame;
   }
 }
