@@ -111,7 +111,7 @@ Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const Svgf
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       if (!g.has_surface(i)) {
-        c.temporal_bytes += 4 + 52;
+        c.temporal_bytes += 40 + 88;  // the surface kept for next frame: 36 read, 36 written
         c.variance_bytes += 16 + 16;
         c.variance_flops += 1;
         c.atrous_bytes += s.iterations * 48.0;
@@ -121,7 +121,7 @@ Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const Svgf
       }
       // temporal, static camera: one bilinear tap of weight 1 (the others have weight 0),
       // tested and accepted.
-      c.temporal_bytes += 96 + 68 + 52;
+      c.temporal_bytes += 96 + 68 + 88;
       c.temporal_flops += 41 + 4 * 8 + 19 + 15 + 30;
       const bool spatial = moments[i].z < static_cast<float>(s.min_history);
       c.variance_bytes += 16 + 16 + 16 + 16 + (spatial ? 4 : 0);

@@ -3,12 +3,15 @@
  * luminance moments through the motion vector (2x2 bilinear taps, each kept only where
  * pg_same_surface holds: the test guiding's reprojection uses; where none holds, the 3x3
  * neighbourhood's same-surface pixels, pg_svgf_history_tap), and blends them with this
- * frame's. Also writes the surface and depth slope the later passes read.
+ * frame's. Also writes the surface and depth slope the later passes read, and keeps this
+ * frame's position, normal and material for the next frame's history test (kept_*): the inputs
+ * may be the host's G-buffer read in place, which the renderer overwrites (a copy here rather
+ * than a pass of its own: the pixel's channels are in registers already).
  * Per pixel (hand count; the rules: docs/guiding.md, "The roofline"; bench/bench_svgf.cpp counts
  * with it): 41 flops without history; with it 8 per bilinear tap, 34 per tap tested for the same
  * surface and summed, 30 for the blend; where no bilinear tap holds, 4 per neighbourhood tap and
- * 34 per tap tested. Bytes: 96 read and 52 written, 68 more read where a tap of last frame is
- * tested; a pixel without a surface reads 4 and writes 52. */
+ * 34 per tap tested. Bytes: 96 read and 88 written, 68 more read where a tap of last frame is
+ * tested; a pixel without a surface reads 40 and writes 88. */
 /* Each operation rounded on its own, as in the host reference. */
 #pragma OPENCL FP_CONTRACT OFF
 
@@ -29,12 +32,20 @@ __kernel void svgf_temporal(__global const float4* colour, __global const float4
                             __global const float* prev_moments,
                             __global float* surface, __global float* depth_slope,
                             __global float* integrated, __global float* moments,
+                            __global float4* kept_position_depth,
+                            __global float4* kept_shading_normal, __global uint* kept_material,
                             uint width, uint height, uint has_history,
                             pg_svgf_settings settings) {
   /* clang-format on */
   uint x = get_global_id(0), y = get_global_id(1);
   if (x >= width || y >= height) return;
   uint i = y * width + x, n = width * height;
+  float4 pd = position_depth[i];
+  float4 normal4 = shading_normal[i];
+  uint m = material[i];
+  kept_position_depth[i] = pd;
+  kept_shading_normal[i] = normal4;
+  kept_material[i] = m;
   if (!pg_svgf_has_surface(flags[i])) {
     pg_planar_set(surface, n, i, (float4)(0.0f, 0.0f, 1.0f, 0.0f));
     depth_slope[i] = 0.0f;
@@ -42,8 +53,7 @@ __kernel void svgf_temporal(__global const float4* colour, __global const float4
     pg_planar_set(moments, n, i, (float4)(0.0f));
     return;
   }
-  float4 pd = position_depth[i];
-  float3 normal = shading_normal[i].xyz;
+  float3 normal = normal4.xyz;
   pg_planar_set(surface, n, i, (float4)(normal, pd.w));
   float z_left = x > 0u ? position_depth[i - 1u].w : 0.0f;
   float z_right = x + 1u < width ? position_depth[i + 1u].w : 0.0f;
@@ -60,7 +70,6 @@ __kernel void svgf_temporal(__global const float4* colour, __global const float4
   float sum_weight = 0.0f;
   if (has_history != 0u) {
     float2 position = (float2)((float)x, (float)y) + motion[i];
-    uint m = material[i];
     for (int pass = 0; pass < 2; ++pass) {
       if (pass == 1) {
         if (sum_weight >= PG_SVGF_MIN_TAP_WEIGHT || settings.history_fallback == 0u) break;

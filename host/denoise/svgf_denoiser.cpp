@@ -37,7 +37,8 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
       zero_copy_(zero_copy && resolve_host_transfer(HostTransfer::automatic,
                                                     runtime.info().host_unified_memory) ==
                                   HostTransfer::in_place),
-      upload_bytes_per_pixel_(zero_copy_ ? 0.0 : kUploadBytesPerPixel) {
+      upload_bytes_per_pixel_(zero_copy_ ? 0.0 : kUploadBytesPerPixel),
+      download_bytes_per_pixel_(zero_copy_ ? 0.0 : kDownloadBytesPerPixel) {
   validate(settings);
   if (width <= 0 || height <= 0)
     throw InputError("svgf", "image size must be positive, got " + std::to_string(width) + "x" +
@@ -94,17 +95,24 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
     if (!zero_copy_) {  // else denoise() reads these in place
       colour_ = buffer(16);
       emission_ = buffer(16);
+      position_depth_ = buffer(16);
+      shading_normal_ = buffer(16);
       base_color_roughness_ = buffer(16);
       flags_ = buffer(4);
+      material_ = buffer(4);
       motion_ = buffer(8);
     }
     surface_ = buffer(16);
     depth_slope_ = buffer(4);
     integrated_ = buffer(16);
     history_ = buffer(16);
-    output_ = buffer(16);
+    // Where memory is shared, remodulate writes the host's output image in place (mapped after
+    // the kernel: OpenCL 1.2 gives the mapped pointer from host_ptr); elsewhere it is read back.
+    output_host_.resize(n);
+    output_ = zero_copy_ ? cl::Buffer(c, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, n * 16,
+                                      output_host_.data())
+                         : buffer(16);
   });
-  output_host_.resize(n);
   if (!zero_copy_)
     staging_ = std::make_unique<PinnedStaging>(
         runtime.context(), runtime.queue(),
@@ -135,26 +143,22 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
   const Surfaces& cur = surfaces_[current_];
   const Surfaces& prev = surfaces_[1 - current_];
   // The inputs the kernels read: the owned buffers the host copies into, or the host's memory.
-  cl::Buffer colour_in = colour_, emission_in = emission_,
-             base_color_roughness_in = base_color_roughness_, flags_in = flags_,
-             motion_in = motion_;
+  // The temporal pass keeps position, normal and material in `cur` for next frame's history test.
+  cl::Buffer colour_in = colour_, emission_in = emission_, position_depth_in = position_depth_,
+             shading_normal_in = shading_normal_, base_color_roughness_in = base_color_roughness_,
+             flags_in = flags_, material_in = material_, motion_in = motion_;
   translate_cl_errors([&] {
     const auto start = Clock::now();
     if (zero_copy_) {
       const cl::Context& c = runtime_.context();
       colour_in = read_in_place(c, colour);
       emission_in = read_in_place(c, g.emission);
+      position_depth_in = read_in_place(c, g.position_depth);
+      shading_normal_in = read_in_place(c, g.shading_normal);
       base_color_roughness_in = read_in_place(c, g.base_color_roughness);
       flags_in = read_in_place(c, g.flags);
+      material_in = read_in_place(c, g.material);
       motion_in = read_in_place(c, g.motion);
-      // Next frame's history test compares with these, after the host has moved on.
-      const auto keep = [&](const auto& host, const cl::Buffer& own) {
-        runtime_.queue().enqueueCopyBuffer(read_in_place(c, host), own, 0, 0,
-                                           host.size() * sizeof(host[0]));
-      };
-      keep(g.position_depth, cur.position_depth);
-      keep(g.shading_normal, cur.shading_normal);
-      keep(g.material, cur.material);
     } else {
       // Through pinned staging: a discrete GPU copies from it several times faster than from
       // the host's vectors (host/render/pinned_staging.h).
@@ -170,24 +174,20 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
                                          " bytes, fewer than " + std::to_string(n * bytes));
           return b;
         };
+        position_depth_in = check(on_device->position_depth, 16, "position_depth");
+        shading_normal_in = check(on_device->shading_normal, 16, "shading_normal");
         base_color_roughness_in =
             check(on_device->base_color_roughness, 16, "base_color_roughness");
         flags_in = check(on_device->flags, 4, "flags");
+        material_in = check(on_device->material, 4, "material");
         motion_in = check(on_device->motion, 8, "motion");
-        // Next frame's history test compares with these, after the guider has moved on.
-        runtime_.queue().enqueueCopyBuffer(check(on_device->position_depth, 16, "position_depth"),
-                                           cur.position_depth, 0, 0, n * 16);
-        runtime_.queue().enqueueCopyBuffer(check(on_device->shading_normal, 16, "shading_normal"),
-                                           cur.shading_normal, 0, 0, n * 16);
-        runtime_.queue().enqueueCopyBuffer(check(on_device->material, 4, "material"), cur.material,
-                                           0, 0, n * 4);
         upload_bytes_per_pixel_ = kColourUploadBytesPerPixel;
       } else {
-        staging_->stage(g.position_depth, cur.position_depth, "svgf position_depth");
-        staging_->stage(g.shading_normal, cur.shading_normal, "svgf shading_normal");
+        staging_->stage(g.position_depth, position_depth_, "svgf position_depth");
+        staging_->stage(g.shading_normal, shading_normal_, "svgf shading_normal");
         staging_->stage(g.base_color_roughness, base_color_roughness_, "svgf base_color_roughness");
         staging_->stage(g.flags, flags_, "svgf flags");
-        staging_->stage(g.material, cur.material, "svgf material");
+        staging_->stage(g.material, material_, "svgf material");
         staging_->stage(g.motion, motion_, "svgf motion");
         upload_bytes_per_pixel_ = kUploadBytesPerPixel;
       }
@@ -196,11 +196,26 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     times_["svgf_upload"] = ms_since(start);
 
     int a = 0;
-    for (const cl::Buffer* b : BufferList{
-             &colour_in, &emission_in, &cur.position_depth, &cur.shading_normal,
-             &base_color_roughness_in, &flags_in, &cur.material, &motion_in, &prev.position_depth,
-             &prev.shading_normal, &prev.material, &history_, &moments_[1 - current_], &surface_,
-             &depth_slope_, &integrated_, &moments_[current_]})
+    for (const cl::Buffer* b : BufferList{&colour_in,
+                                          &emission_in,
+                                          &position_depth_in,
+                                          &shading_normal_in,
+                                          &base_color_roughness_in,
+                                          &flags_in,
+                                          &material_in,
+                                          &motion_in,
+                                          &prev.position_depth,
+                                          &prev.shading_normal,
+                                          &prev.material,
+                                          &history_,
+                                          &moments_[1 - current_],
+                                          &surface_,
+                                          &depth_slope_,
+                                          &integrated_,
+                                          &moments_[current_],
+                                          &cur.position_depth,
+                                          &cur.shading_normal,
+                                          &cur.material})
       temporal_.setArg(a++, *b);
     temporal_.setArg(a++, w);
     temporal_.setArg(a++, h);
@@ -248,8 +263,19 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     times_["svgf_remodulate"] = run(remodulate_, 1, pixel_groups_);
 
     const auto download = Clock::now();
-    runtime_.queue().enqueueReadBuffer(output_, CL_TRUE, 0, output_host_.size() * 16,
-                                       output_host_.data());
+    const std::size_t bytes = output_host_.size() * 16;
+    if (zero_copy_) {
+      // Nothing to copy where the mapped pointer is output_host_ (OpenCL 1.2 promises a pointer
+      // derived from host_ptr for CL_MEM_USE_HOST_PTR; the memcpy keeps a device that hands back
+      // another one correct).
+      void* mapped = runtime_.queue().enqueueMapBuffer(output_, CL_TRUE, CL_MAP_READ, 0, bytes);
+      if (mapped != static_cast<void*>(output_host_.data()))
+        std::memcpy(output_host_.data(), mapped, bytes);
+      runtime_.queue().enqueueUnmapMemObject(output_, mapped);
+      runtime_.queue().finish();
+    } else {
+      runtime_.queue().enqueueReadBuffer(output_, CL_TRUE, 0, bytes, output_host_.data());
+    }
     times_["svgf_download"] = ms_since(download);
   });
   double total = 0.0;
@@ -261,7 +287,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
 }
 
 double SvgfDenoiser::host_device_bytes_per_pixel() const {
-  return upload_bytes_per_pixel_ + kDownloadBytesPerPixel;
+  return upload_bytes_per_pixel_ + download_bytes_per_pixel_;
 }
 
 std::vector<glm::vec4> SvgfDenoiser::read(SvgfStage stage) {

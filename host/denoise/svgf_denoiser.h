@@ -30,9 +30,10 @@ class SvgfDenoiser {
   // device refuses. zero_copy: where the device shares host memory
   // (DeviceInfo::host_unified_memory) and RTPG_HOST_TRANSFER does not ask for copies
   // (resolve_host_transfer, host/render/host_transfer.h), denoise() reads the noisy colour and the
-  // G-buffer in place (CL_MEM_USE_HOST_PTR) instead of copying them, and keeps the channels the
-  // next frame's history test needs by a copy on the device. Elsewhere they are copied through
-  // pinned staging (host/render/pinned_staging.h).
+  // G-buffer in place (CL_MEM_USE_HOST_PTR) instead of copying them and writes the denoised
+  // colour into the returned vector in place; the temporal pass keeps the channels the next
+  // frame's history test needs on the device. Elsewhere they are copied through pinned staging
+  // (host/render/pinned_staging.h) and the denoised colour is read back.
   SvgfDenoiser(ClRuntime& runtime, int width, int height, const SvgfSettings& settings = {},
                bool zero_copy = true);
   ~SvgfDenoiser();
@@ -79,7 +80,8 @@ class SvgfDenoiser {
   // Runs kernel over the image in work-groups of that shape, each work-item covering `lanes`
   // pixels of a row; blocking.
   double run(cl::Kernel& kernel, int lanes, const WorkGroupShape& shape);
-  // The G-buffer channels the kernels read, this frame's and last frame's (ping-pong).
+  // The G-buffer channels the history test reads, this frame's (written by the temporal pass)
+  // and last frame's (ping-pong).
   struct Surfaces {
     cl::Buffer position_depth, shading_normal, material;
   };
@@ -91,7 +93,8 @@ class SvgfDenoiser {
   int lanes_ = 1;
   WorkGroupShape pixel_groups_, filter_groups_;
   bool zero_copy_ = false;
-  double upload_bytes_per_pixel_ = 0.0;     // the last denoise()'s
+  double upload_bytes_per_pixel_ = 0.0;  // the last denoise()'s
+  double download_bytes_per_pixel_ = 0.0;
   std::unique_ptr<PinnedStaging> staging_;  // the uploads' way where !zero_copy_
   shared::pg_svgf_settings kernel_settings_;
   cl::Kernel temporal_, variance_, atrous_, remodulate_;
@@ -99,7 +102,9 @@ class SvgfDenoiser {
   std::array<cl::Buffer, 2> moments_;  // this frame's and last frame's
   int current_ = 0;
   bool has_history_ = false;
-  cl::Buffer colour_, emission_, base_color_roughness_, flags_, motion_;
+  // The inputs' device copies where !zero_copy_.
+  cl::Buffer colour_, emission_, position_depth_, shading_normal_, base_color_roughness_, flags_,
+      material_, motion_;
   cl::Buffer surface_, depth_slope_, integrated_, history_, output_;
   // The a-trous ping-pong ([0], [1]) and the variance pass's output ([2]).
   std::array<cl::Buffer, 3> illumination_;
