@@ -8,8 +8,9 @@
 //
 //   bench_svgf                  960x540 and 1920x1080, the variance and a-trous kernels one
 //                               pixel per work-item (lanes:1) and in the device's SIMD lanes
-//                               (lanes:auto), in the device's own work-groups (rows on CPUs)
-//                               and, with the lanes, in 16x16 tiles (local:16x16)
+//                               (lanes:auto), in the device's own work-groups (rows on CPUs,
+//                               filters included) and, with the lanes, every kernel in 16x16
+//                               tiles (local:16x16)
 //   bench_svgf --benchmark_filter='cornell/960'
 //
 // Time is the sum of the kernels' OpenCL profiling-event times of one denoise() (manual time).
@@ -26,7 +27,8 @@
 //                        and multiply-add yardsticks launched in the same iterations
 //   lanes                pixels per work-item of the variance and a-trous kernels
 //   row_work_groups      1 where the temporal and remodulate kernels run in work-groups along
-//                        rows, 0 for tiles (the filters always run in tiles)
+//                        rows, 0 for tiles
+//   filter_row_work_groups  the same for the variance and a-trous filters
 #include "bench_common.h"
 #include "bench_roofline.h"
 
@@ -223,6 +225,7 @@ void BM_Svgf(benchmark::State& state, const std::string& scene_name, int w, int 
   state.counters["frame_fraction"] = sum["svgf"] / it / f.pt_frame_ms;
   state.counters["lanes"] = s->denoiser->lanes();
   state.counters["row_work_groups"] = s->denoiser->pixel_work_groups().rows ? 1.0 : 0.0;
+  state.counters["filter_row_work_groups"] = s->denoiser->filter_work_groups().rows ? 1.0 : 0.0;
   state.SetItemsProcessed(static_cast<std::int64_t>(n) * state.iterations());
 }
 

@@ -13,6 +13,7 @@ WorkGroupShape resolve_work_groups(const DeviceInfo& info, int local_x, int loca
     return shape;
   }
   if (info.type != "cpu" || reach == KernelReach::Neighbourhood) return shape;
+  // Pixel and GlobalNeighbourhood kernels on a CPU: rows.
   shape.rows = true;
   shape.x =
       static_cast<int>(std::min<std::size_t>(kRowGroupItems, std::max<std::size_t>(max_group, 1)));

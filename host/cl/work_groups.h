@@ -23,16 +23,19 @@ struct WorkGroupShape {
 };
 
 // What a kernel's work-item reads around its own pixels: its pixels alone (or one gathered
-// pixel: reproject, sample, SVGF's temporal and remodulate passes), or a neighbourhood of them
-// (train's VPL window, SVGF's variance and a-trous filters).
-enum class KernelReach { Pixel, Neighbourhood };
+// pixel: reproject, sample, SVGF's temporal and remodulate passes), a neighbourhood of them
+// through a tile in local memory (train's VPL window), or a neighbourhood straight from global
+// memory (SVGF's variance and a-trous filters).
+enum class KernelReach { Pixel, Neighbourhood, GlobalNeighbourhood };
 
 // The shape a kernel runs with. local_x and local_y are the settings' (both 0: chosen per
 // device; non-zero: a tile as given, for every kernel). Chosen per device: on CPU devices, whose
 // OpenCL runs a work-group as a loop over its work-items, pixel kernels run in rows of up to
 // kRowGroupItems (and at most max_group) work-items, so that a group streams through memory;
-// neighbourhood kernels, and every kernel elsewhere, in a 16x16 tile, whose rows share the
-// neighbourhood rows in cache (docs/guiding.md, "Work-groups along rows").
+// so do the kernels that read a neighbourhood from global memory (measured faster in rows than in
+// tiles: docs/denoising.md, "Cost"); the kernel with a local-memory tile (train), and every
+// kernel elsewhere, in a 16x16 tile, whose rows share the neighbourhood rows in cache
+// (docs/guiding.md, "Work-groups along rows").
 WorkGroupShape resolve_work_groups(const DeviceInfo& info, int local_x, int local_y,
                                    KernelReach reach, std::size_t max_group);
 

@@ -67,11 +67,11 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
     const std::size_t max_group =
         largest_row_group(runtime.device(), {&temporal_, &variance_, &atrous_, &remodulate_});
     // Temporal and remodulate read their own pixel (temporal also the bilinear taps of one
-    // back-projected position); variance and a-trous filter neighbourhoods.
+    // back-projected position); variance and a-trous filter neighbourhoods, from global memory.
     pixel_groups_ = resolve_work_groups(runtime.info(), settings.local_x, settings.local_y,
                                         KernelReach::Pixel, max_group);
     filter_groups_ = resolve_work_groups(runtime.info(), settings.local_x, settings.local_y,
-                                         KernelReach::Neighbourhood, max_group);
+                                         KernelReach::GlobalNeighbourhood, max_group);
     const std::size_t group = static_cast<std::size_t>(filter_groups_.x) * filter_groups_.y;
     for (cl::Kernel* k : {&temporal_, &variance_, &atrous_, &remodulate_}) {
       const std::size_t limit = k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device());

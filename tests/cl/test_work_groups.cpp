@@ -21,17 +21,25 @@ TEST(WorkGroups, RowsForPixelKernelsOnCpusTilesElsewhereAndAsGiven) {
   EXPECT_EQ(rows.y, 1);
   // A kernel that allows fewer work-items per group caps the rows.
   EXPECT_EQ(resolve_work_groups(cpu, 0, 0, KernelReach::Pixel, 64).x, 64);
-  // Neighbourhood kernels keep a tile on CPUs; GPUs get one for every kernel.
+  // Filters that read their neighbourhood from global memory run in rows on CPUs too.
+  const WorkGroupShape filter_rows =
+      resolve_work_groups(cpu, 0, 0, KernelReach::GlobalNeighbourhood, 4096);
+  EXPECT_TRUE(filter_rows.rows);
+  EXPECT_EQ(filter_rows.x, kRowGroupItems);
+  EXPECT_EQ(filter_rows.y, 1);
+  // The kernel with a local-memory tile keeps it on CPUs; GPUs get a tile for every kernel.
   for (const WorkGroupShape& s :
        {resolve_work_groups(cpu, 0, 0, KernelReach::Neighbourhood, 4096),
         resolve_work_groups(gpu, 0, 0, KernelReach::Pixel, 1024),
-        resolve_work_groups(gpu, 0, 0, KernelReach::Neighbourhood, 1024)}) {
+        resolve_work_groups(gpu, 0, 0, KernelReach::Neighbourhood, 1024),
+        resolve_work_groups(gpu, 0, 0, KernelReach::GlobalNeighbourhood, 1024)}) {
     EXPECT_FALSE(s.rows);
     EXPECT_EQ(s.x, 16);
     EXPECT_EQ(s.y, 16);
   }
   // A size given is a tile for every kernel.
-  for (KernelReach reach : {KernelReach::Pixel, KernelReach::Neighbourhood}) {
+  for (KernelReach reach :
+       {KernelReach::Pixel, KernelReach::Neighbourhood, KernelReach::GlobalNeighbourhood}) {
     const WorkGroupShape given = resolve_work_groups(cpu, 12, 6, reach, 4096);
     EXPECT_FALSE(given.rows);
     EXPECT_EQ(given.x, 12);
