@@ -128,7 +128,20 @@ double SvgfDenoiser::run(cl::Kernel& kernel, int lanes, const WorkGroupShape& sh
   return ClRuntime::event_ms(done);
 }
 
-SvgfDenoiser::~SvgfDenoiser() = default;
+SvgfDenoiser::~SvgfDenoiser() {
+  try {
+    unmap_output();
+    runtime_.queue().finish();
+  } catch (...) {  // a failing queue at teardown has nothing left to corrupt
+  }
+}
+
+void SvgfDenoiser::unmap_output() {
+  if (mapped_output_ == nullptr) return;
+  void* mapped = mapped_output_;
+  mapped_output_ = nullptr;
+  translate_cl_errors([&] { runtime_.queue().enqueueUnmapMemObject(output_, mapped); });
+}
 
 const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>& colour,
                                                     const GBuffer& g,
@@ -139,6 +152,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
   };
   times_.clear();
+  unmap_output();  // remodulate writes it again
   const cl_uint w = static_cast<cl_uint>(width_), h = static_cast<cl_uint>(height_);
   const Surfaces& cur = surfaces_[current_];
   const Surfaces& prev = surfaces_[1 - current_];
@@ -265,14 +279,13 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     const auto download = Clock::now();
     const std::size_t bytes = output_host_.size() * 16;
     if (zero_copy_) {
-      // Nothing to copy where the mapped pointer is output_host_ (OpenCL 1.2 promises a pointer
-      // derived from host_ptr for CL_MEM_USE_HOST_PTR; the memcpy keeps a device that hands back
-      // another one correct).
-      void* mapped = runtime_.queue().enqueueMapBuffer(output_, CL_TRUE, CL_MAP_READ, 0, bytes);
-      if (mapped != static_cast<void*>(output_host_.data()))
-        std::memcpy(output_host_.data(), mapped, bytes);
-      runtime_.queue().enqueueUnmapMemObject(output_, mapped);
-      runtime_.queue().finish();
+      // Mapped for reading until the next denoise(), so that the host reads output_host_ only
+      // between map and unmap, as OpenCL 1.2 asks of a CL_MEM_USE_HOST_PTR buffer. Nothing is
+      // copied where the mapped pointer is output_host_ (OpenCL 1.2 promises one derived from
+      // host_ptr; the memcpy keeps a device that hands back another one correct).
+      mapped_output_ = runtime_.queue().enqueueMapBuffer(output_, CL_TRUE, CL_MAP_READ, 0, bytes);
+      if (mapped_output_ != static_cast<void*>(output_host_.data()))
+        std::memcpy(output_host_.data(), mapped_output_, bytes);
     } else {
       runtime_.queue().enqueueReadBuffer(output_, CL_TRUE, 0, bytes, output_host_.data());
     }

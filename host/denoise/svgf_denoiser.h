@@ -41,7 +41,8 @@ class SvgfDenoiser {
   SvgfDenoiser& operator=(const SvgfDenoiser&) = delete;
 
   // Filters one frame of noisy colour (rgb; w ignored) seen through the G-buffer g, blocking;
-  // returns the denoised colour (w = 1 on surfaces; pixels without a surface keep their input).
+  // returns the denoised colour (w = 1 on surfaces; pixels without a surface keep their input),
+  // valid until the next denoise().
   // on_device: g's channels already on the device (the guided sampler's copy of this frame's
   // G-buffer, GuidedFirstBounce::device_gbuffer_of): where denoise() would copy its inputs, it
   // reads the G-buffer's there and uploads only the colour and the emission (32 bytes a pixel
@@ -77,6 +78,8 @@ class SvgfDenoiser {
   const WorkGroupShape& filter_work_groups() const { return filter_groups_; }
 
  private:
+  // Where the output is written in place: unmaps it before the device writes it again.
+  void unmap_output();
   // Runs kernel over the image in work-groups of that shape, each work-item covering `lanes`
   // pixels of a row; blocking.
   double run(cl::Kernel& kernel, int lanes, const WorkGroupShape& shape);
@@ -110,6 +113,7 @@ class SvgfDenoiser {
   std::array<cl::Buffer, 3> illumination_;
   const cl::Buffer* filtered_ = nullptr;  // the last iteration's output
   std::vector<glm::vec4> output_host_;
+  void* mapped_output_ = nullptr;  // output_ mapped for reading, from denoise() to the next
   std::map<std::string, double> times_;
 };
 
