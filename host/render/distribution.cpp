@@ -12,9 +12,28 @@ Distribution1D::Distribution1D(std::vector<float> weights) : weights_(std::move(
     cdf_[i + 1] = cdf_[i] + weights_[i];
   }
   total_ = static_cast<float>(cdf_.back());
+  probabilities_.resize(weights_.size());
+  std::size_t cells_with_weight = 0;
+  only_cell_ = weights_.size();
+  for (std::size_t i = 0; i < weights_.size(); ++i) {
+    probabilities_[i] = total_ > 0.0f ? weights_[i] / total_ : 0.0f;
+    if (weights_[i] > 0.0f) {
+      ++cells_with_weight;
+      only_cell_ = i;
+    }
+  }
+  if (cells_with_weight != 1) only_cell_ = weights_.size();
 }
 
 std::size_t Distribution1D::sample_discrete(float u, float* probability, float* remapped) const {
+  if (only_cell_ < weights_.size()) {
+    // What the search below gives for one cell with weight w: cdf = w exactly (a float in a
+    // double), so target = u * w is exact and (target - 0) / w = u, before the same clamp.
+    if (probability) *probability = probabilities_[only_cell_];
+    if (remapped)
+      *remapped = static_cast<float>(std::clamp(static_cast<double>(u), 0.0, 1.0 - 1e-7));
+    return only_cell_;
+  }
   const double target = static_cast<double>(u) * cdf_.back();
   auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), target);
   std::size_t i =

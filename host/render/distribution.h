@@ -18,7 +18,10 @@ class Distribution1D {
   // uniform number for the next decision.
   std::size_t sample_discrete(float u, float* probability = nullptr,
                               float* remapped = nullptr) const;
-  float probability(std::size_t i) const { return total_ > 0.0f ? weights_[i] / total_ : 0.0f; }
+  // 0 for an index outside the distribution (an empty one has no cells).
+  float probability(std::size_t i) const {
+    return i < probabilities_.size() ? probabilities_[i] : 0.0f;
+  }
   // Continuous on [0,1): returns x, writes the density over [0,1) and the cell index.
   float sample_continuous(float u, float* pdf, std::size_t* cell) const;
   float pdf_continuous(float x) const;
@@ -26,7 +29,12 @@ class Distribution1D {
  private:
   std::vector<float> weights_;
   std::vector<double> cdf_;  // size()+1 entries; double: sums over millions of texels
+  std::vector<float>
+      probabilities_;  // weight / total, once (next-event estimation asks per vertex)
   float total_ = 0.0f;
+  // The only cell with weight (a scene with one kind of light), else size(): sampling it needs
+  // no search and no division.
+  std::size_t only_cell_ = 0;
 };
 
 // Over [0,1)^2, rows along v: a marginal over v, a conditional over u per row.

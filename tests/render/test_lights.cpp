@@ -268,6 +268,29 @@ TEST(Distribution1D, PicksCellsInProportionAndNeverAnEmptyOne) {
   }
 }
 
+// One cell with weight among empty ones (a scene with one kind of light, which takes a path of
+// its own in sample_discrete): that cell with probability 1, and the remapped number is u itself
+// (below the clamp at 1 - 1e-7 that every cell's remapping has), as the cumulative search gives.
+TEST(Distribution1D, OneCellWithWeightKeepsUAsItsRemappedNumber) {
+  for (std::size_t size : {1u, 3u, 7u}) {
+    for (std::size_t cell = 0; cell < size; ++cell) {
+      std::vector<float> weights(size, 0.0f);
+      weights[cell] = 0.37f;
+      const Distribution1D dist(weights);
+      for (float u : {0.0f, 1e-30f, 0.25f, 0.3333333f, 0.5f, 0.9999f, 0.9999999f, 0.99999994f}) {
+        float probability = -1.0f, remapped = -1.0f;
+        EXPECT_EQ(dist.sample_discrete(u, &probability, &remapped), cell);
+        EXPECT_EQ(probability, 1.0f);
+        EXPECT_EQ(remapped, static_cast<float>(std::min(static_cast<double>(u), 1.0 - 1e-7)))
+            << "u " << u;
+      }
+      EXPECT_EQ(dist.probability(cell), 1.0f);
+      EXPECT_EQ(dist.probability(size), 0.0f);  // outside the distribution
+    }
+  }
+  EXPECT_EQ(Distribution1D().probability(0), 0.0f);
+}
+
 // Distribution2D: samples fall in cells in proportion to their weights, and the density it
 // reports integrates to one and equals weight / mean weight.
 TEST(Distribution2D, SamplesInProportionToTheWeights) {
