@@ -298,8 +298,10 @@ int run_render(const RenderCommand& command) {
   for (int f = 0; f < command.frames; ++f) {
     FrameStats stats = renderer.render_frame(f);
     const std::vector<glm::vec3>& image = renderer.image();
-    shown = image;
+    // The flicker metrics and their copies of last frame's images go only to the stats JSON.
+    const bool want_stats = !command.stats_json.empty();
     double svgf_bytes = 0.0;
+    if (!denoiser) shown = image;
     if (denoiser) {
       frame_rgba.resize(image.size());
       for (std::size_t i = 0; i < image.size(); ++i) frame_rgba[i] = glm::vec4(image[i], 1.0f);
@@ -308,16 +310,16 @@ int run_render(const RenderCommand& command) {
       const std::vector<glm::vec4>& denoised =
           denoiser->denoise(frame_rgba, renderer.gbuffer(),
                             guided ? guided->device_gbuffer_of(renderer.gbuffer()) : nullptr);
+      shown.resize(image.size());
       for (std::size_t i = 0; i < image.size(); ++i) shown[i] = glm::vec3(denoised[i]);
       for (const auto& [name, ms] : denoiser->times_ms()) stats.time_ms[name] = ms;
       stats.time_ms["total"] += denoiser->times_ms().at("svgf_total");
       svgf_bytes = denoiser->host_device_bytes_per_pixel();
     }
     totals.push_back(stats.time_ms["total"]);
-    const double flicker = flicker_mse(shown, previous);
-    const double flicker_noisy = denoiser ? flicker_mse(image, previous_noisy) : -1.0;
-    // Only for the stats JSON, where it goes: a tonemap and a copy of the G-buffer per frame.
-    const bool want_stats = !command.stats_json.empty();
+    const double flicker = want_stats ? flicker_mse(shown, previous) : -1.0;
+    const double flicker_noisy = want_stats && denoiser ? flicker_mse(image, previous_noisy) : -1.0;
+    // A tonemap and a copy of the G-buffer per frame.
     const ReprojectedFlicker::Frame tracked =
         want_stats ? reprojected_flicker.add(shown, renderer.gbuffer(), scene.exposure)
                    : ReprojectedFlicker::Frame{};
@@ -325,8 +327,8 @@ int run_render(const RenderCommand& command) {
         want_stats && denoiser
             ? reprojected_flicker_noisy.add(image, renderer.gbuffer(), scene.exposure)
             : ReprojectedFlicker::Frame{};
-    previous = shown;
-    if (denoiser) previous_noisy = image;
+    if (want_stats) previous = shown;
+    if (want_stats && denoiser) previous_noisy = image;
     if (accumulator) {
       frame_rgba.resize(shown.size());
       for (std::size_t i = 0; i < shown.size(); ++i) frame_rgba[i] = glm::vec4(shown[i], 1.0f);
