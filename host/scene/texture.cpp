@@ -89,6 +89,22 @@ Bilinear bilinear_at(glm::vec2 uv, int width, int height) {
 glm::vec4 Texture::sample(glm::vec2 uv) const {
   if (width <= 0 || height <= 0 || (texels.empty() && texels8.empty())) return glm::vec4(1.0f);
   const Bilinear b = bilinear_at(uv, width, height);
+  const std::size_t w = static_cast<std::size_t>(width);
+  if (texels8.size() == w * static_cast<std::size_t>(height)) {
+    // What fetch() does for the four taps, which bilinear_at has wrapped into the image: no
+    // clamps or size tests per texel, the decode tables chosen once (Sponza's textures took a
+    // fifth of a path-traced frame; docs/host-path-tracer.md).
+    const std::array<float, 256>& rgb = srgb ? srgb_decode_table() : unorm_decode_table();
+    const std::array<float, 256>& unorm = unorm_decode_table();
+    const auto texel = [&](int x, int y) {
+      const std::array<std::uint8_t, 4>& t =
+          texels8[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(x)];
+      return glm::vec4(rgb[t[0]], rgb[t[1]], rgb[t[2]], unorm[t[3]]);
+    };
+    const glm::vec4 top = glm::mix(texel(b.x0, b.y0), texel(b.x1, b.y0), b.tx);
+    const glm::vec4 bottom = glm::mix(texel(b.x0, b.y1), texel(b.x1, b.y1), b.tx);
+    return glm::mix(top, bottom, b.ty);
+  }
   const glm::vec4 top = glm::mix(fetch(b.x0, b.y0), fetch(b.x1, b.y0), b.tx);
   const glm::vec4 bottom = glm::mix(fetch(b.x0, b.y1), fetch(b.x1, b.y1), b.tx);
   return glm::mix(top, bottom, b.ty);

@@ -236,6 +236,43 @@ TEST(Texture, BumpSlopesGiveTheFiniteDifferenceGradient) {
   }
 }
 
+// An 8-bit texture samples exactly as the same texels decoded to floats (the 8-bit path reads
+// its four taps without fetch()'s per-texel checks), sRGB and linear, at random points across
+// the wrapping edges, far outside [0, 1), and on texel centres and edges.
+TEST(Texture, EightBitSamplesEqualTheirDecodedFloats) {
+  std::mt19937 gen(21);
+  std::uniform_int_distribution<int> byte(0, 255);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (bool srgb : {false, true}) {
+    Texture eight;
+    eight.width = 5;
+    eight.height = 3;
+    eight.srgb = srgb;
+    for (int i = 0; i < eight.width * eight.height; ++i)
+      eight.texels8.push_back(
+          {static_cast<std::uint8_t>(byte(gen)), static_cast<std::uint8_t>(byte(gen)),
+           static_cast<std::uint8_t>(byte(gen)), static_cast<std::uint8_t>(byte(gen))});
+    Texture decoded;
+    decoded.width = eight.width;
+    decoded.height = eight.height;
+    for (int y = 0; y < eight.height; ++y)
+      for (int x = 0; x < eight.width; ++x) decoded.texels.push_back(eight.fetch(x, y));
+    std::vector<glm::vec2> points;
+    for (int i = 0; i < 3000; ++i) points.emplace_back(8.0f * u(gen) - 4.0f, 8.0f * u(gen) - 4.0f);
+    for (int x = 0; x <= 2 * eight.width; ++x)
+      for (int y = 0; y <= 2 * eight.height; ++y)
+        points.emplace_back(0.5f * static_cast<float>(x) / static_cast<float>(eight.width),
+                            0.5f * static_cast<float>(y) / static_cast<float>(eight.height));
+    points.emplace_back(0.99999994f, 0.99999994f);
+    points.emplace_back(-1e-30f, 1e6f);
+    for (const glm::vec2& uv : points) {
+      const glm::vec4 got = eight.sample(uv), want = decoded.sample(uv);
+      for (int c = 0; c < 4; ++c)
+        ASSERT_EQ(got[c], want[c]) << "srgb " << srgb << " uv " << uv.x << ", " << uv.y;
+    }
+  }
+}
+
 TEST(ImageLoader, DecodesSrgbOnlyForColourAndExpandsGrey) {
   TempDir dir;
   write_png(dir / "grey.png", 2, 2, 1, [](int, int, int) { return 128; });
