@@ -37,8 +37,7 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
       zero_copy_(zero_copy && resolve_host_transfer(HostTransfer::automatic,
                                                     runtime.info().host_unified_memory) ==
                                   HostTransfer::in_place),
-      upload_bytes_per_pixel_(zero_copy_ ? 0.0 : kUploadBytesPerPixel),
-      download_bytes_per_pixel_(zero_copy_ ? 0.0 : kDownloadBytesPerPixel) {
+      upload_bytes_per_pixel_(zero_copy_ ? 0.0 : kUploadBytesPerPixel) {
   validate(settings);
   if (width <= 0 || height <= 0)
     throw InputError("svgf", "image size must be positive, got " + std::to_string(width) + "x" +
@@ -300,7 +299,8 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
 }
 
 double SvgfDenoiser::host_device_bytes_per_pixel() const {
-  return upload_bytes_per_pixel_ + download_bytes_per_pixel_;
+  // In place, remodulate writes the host's output: nothing comes back.
+  return upload_bytes_per_pixel_ + (zero_copy_ ? 0.0 : kDownloadBytesPerPixel);
 }
 
 std::vector<glm::vec4> SvgfDenoiser::read(SvgfStage stage) {

@@ -96,8 +96,7 @@ class SvgfDenoiser {
   int lanes_ = 1;
   WorkGroupShape pixel_groups_, filter_groups_;
   bool zero_copy_ = false;
-  double upload_bytes_per_pixel_ = 0.0;  // the last denoise()'s
-  double download_bytes_per_pixel_ = 0.0;
+  double upload_bytes_per_pixel_ = 0.0;     // the last denoise()'s
   std::unique_ptr<PinnedStaging> staging_;  // the uploads' way where !zero_copy_
   shared::pg_svgf_settings kernel_settings_;
   cl::Kernel temporal_, variance_, atrous_, remodulate_;
