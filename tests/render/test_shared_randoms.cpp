@@ -77,39 +77,38 @@ TEST(SharedRandoms, FirstBounceRepeatsSampleZero) {
   EXPECT_GT(own_differ, 30u);
 }
 
+// Two samples that share `repeating` give the one-sample image to the bit over three frames (on
+// an image a third of whose pixels are lit), and sharing only `weaker` changes a quarter or more
+// of the pixels: `repeating` covers every number of the path that `weaker` leaves its own.
+void expect_share_repeats_sample_zero(int bounces, SharedRandoms repeating, SharedRandoms weaker,
+                                      const char* left_own) {
+  const Scene scene = cornell_box();
+  Renderer one(scene, settings_for(1, bounces, true, SharedRandoms::none));
+  Renderer shared(scene, settings_for(2, bounces, true, repeating));
+  Renderer less(scene, settings_for(2, bounces, true, weaker));
+  for (int frame = 0; frame < 3; ++frame) {
+    const Difference d = render_and_compare(one, shared, frame);
+    EXPECT_EQ(d.differ, 0u) << "frame " << frame;
+    EXPECT_GT(d.lit, one.image().size() / 3) << "frame " << frame;
+    less.render_frame(frame);
+    EXPECT_GT(differing_pixels(less, one), one.image().size() / 4)
+        << "frame " << frame << ": " << left_own << " shared";
+  }
+}
+
 // With next-event estimation at the primary hit, sharing the first bounce leaves the light sample
 // each sample's own; sharing the primary vertex repeats it too.
 TEST(SharedRandoms, PrimaryVertexAlsoRepeatsTheLightSample) {
-  const Scene scene = cornell_box();
-  Renderer one(scene, settings_for(1, 1, true, SharedRandoms::none));
-  Renderer vertex(scene, settings_for(2, 1, true, SharedRandoms::primary_vertex));
-  Renderer bounce(scene, settings_for(2, 1, true, SharedRandoms::first_bounce));
-  for (int frame = 0; frame < 3; ++frame) {
-    const Difference d = render_and_compare(one, vertex, frame);
-    EXPECT_EQ(d.differ, 0u) << "frame " << frame;
-    EXPECT_GT(d.lit, one.image().size() / 3) << "frame " << frame;
-    bounce.render_frame(frame);
-    const std::size_t differ = differing_pixels(bounce, one);
-    EXPECT_GT(differ, one.image().size() / 4) << "frame " << frame << ": light samples shared";
-  }
+  expect_share_repeats_sample_zero(1, SharedRandoms::primary_vertex, SharedRandoms::first_bounce,
+                                   "light samples");
 }
 
 // Two bounces: the second vertex's light sample and bounce are the last numbers a path draws
 // (the vertex after them only adds what its ray found), so sharing the second vertex repeats
 // sample 0 exactly, and sharing only the primary vertex does not.
 TEST(SharedRandoms, SecondVertexAlsoRepeatsTheFirstBouncesHit) {
-  const Scene scene = cornell_box();
-  Renderer one(scene, settings_for(1, 2, true, SharedRandoms::none));
-  Renderer second(scene, settings_for(2, 2, true, SharedRandoms::second_vertex));
-  Renderer primary(scene, settings_for(2, 2, true, SharedRandoms::primary_vertex));
-  for (int frame = 0; frame < 3; ++frame) {
-    const Difference d = render_and_compare(one, second, frame);
-    EXPECT_EQ(d.differ, 0u) << "frame " << frame;
-    EXPECT_GT(d.lit, one.image().size() / 3) << "frame " << frame;
-    primary.render_frame(frame);
-    const std::size_t differ = differing_pixels(primary, one);
-    EXPECT_GT(differ, one.image().size() / 4) << "frame " << frame << ": y shared";
-  }
+  expect_share_repeats_sample_zero(2, SharedRandoms::second_vertex, SharedRandoms::primary_vertex,
+                                   "y");
 }
 
 // Sample 0 draws as the renderer does in every mode (the shared parts are its numbers), so one
