@@ -163,6 +163,7 @@ nlohmann::json path_tracer_settings_json(const PathTracerSettings& s) {
           {"next_event", s.next_event},
           {"guide_secondary", s.guide_secondary},
           {"direct_light_in_vpls", s.direct_light_in_vpls},
+          {"first_bounce_mis", s.first_bounce_mis == FirstBounceMis::bsdf ? "bsdf" : "mixture"},
           {"shared_randoms", shared_randoms_name(s.shared_randoms)}};
 }
 
@@ -235,6 +236,8 @@ int run_render(const RenderCommand& command) {
   settings.path_tracer.guide_secondary =
       command.guiding == "pmm" && command.guide_vertices == "all";
   settings.path_tracer.direct_light_in_vpls = command.guide_direct_light == "mis";
+  settings.path_tracer.first_bounce_mis =
+      command.first_bounce_mis == "bsdf" ? FirstBounceMis::bsdf : FirstBounceMis::mixture;
   settings.path_tracer.shared_randoms = parse_shared_randoms(command.share_randoms);
   settings.path_tracer.guide_position = command.guiding_settings.reproject_position;
   settings.path_tracer.guide_normal = command.guiding_settings.reproject_normal;

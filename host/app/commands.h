@@ -31,6 +31,8 @@ struct RenderCommand {
   std::string guiding = "pmm";   // "off" or "pmm"
   std::string guide_direct_light = "mis";  // "off" or "mis": the VPLs carry y's emission
                                            // with its MIS weight (PathTracerSettings)
+  std::string first_bounce_mis = "bsdf";   // "bsdf" or "mixture": FirstBounceMis by name
+                                           // (host/render/path_tracer.h)
   std::string guide_vertices = "first";    // "first" (the paper) or "all" (secondary vertices
                                            // borrow the mixture of the pixel showing them)
   std::string share_randoms = "none";      // --share-randoms: SharedRandoms by name

@@ -49,6 +49,13 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
                   "y emits) or mis (they carry it with its MIS weight)")
       ->check(CLI::IsMember({"off", "mis"}))
       ->capture_default_str();
+  cmd->add_option("--first-bounce-mis", r.first_bounce_mis,
+                  "With --guiding pmm and next-event estimation: the density the primary hit's "
+                  "light sample and first bounce weigh each other with: bsdf (the BSDF's; the "
+                  "mixture is not evaluated for the light sample) or mixture (the guided "
+                  "mixture's); both unbiased")
+      ->check(CLI::IsMember({"mixture", "bsdf"}))
+      ->capture_default_str();
   auto* grp = cmd->add_option_group("Guiding",
                                     "Settings of the PMM guider (include/rtpg/guiding_settings.h)");
   for (const rtpg::GuidingSettingInfo& row : rtpg::guiding_settings_table()) {

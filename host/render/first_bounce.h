@@ -82,8 +82,9 @@ class FirstBounceSampler {
   // the primary hit").
   virtual bool samples_the_bsdf() const { return false; }
   // The density sample() uses at pixel i for direction wi: next-event estimation at the
-  // primary hit needs it for its MIS weight. The caller passes what it already has of the
-  // pixel: its lobes, and wo and wi in its shading frame (gbuffer_frame).
+  // primary hit needs it for its MIS weight under FirstBounceMis::mixture (under bsdf, the
+  // default, the path tracer weighs with the BSDF's density). The caller passes what it already has
+  // of the pixel: its lobes, and wo and wi in its shading frame (gbuffer_frame).
   virtual float pdf(const GBuffer& gbuffer, std::size_t i, const shared::pg_lobes& lobes,
                     const glm::vec3& wo, const glm::vec3& wi) const = 0;
   // The mixture pixel i sampled this frame, for a secondary vertex on pixel i's surface;

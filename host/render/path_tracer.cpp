@@ -45,6 +45,15 @@ bool is_finite(const glm::vec3& c) {
   return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
 }
 
+// The density the primary hit's light sample and first bounce weigh each other with under
+// FirstBounceMis::bsdf: the BSDF's, kept above 0 so that a guided bounce into a direction the
+// BSDF never samples still counts in full where the light sample cannot reach (the power
+// heuristic gives a density of 0 no weight even against 0), and both weights of a direction
+// still sum to one.
+float bsdf_mis_density(float bsdf_pdf) {
+  return std::max(bsdf_pdf, std::numeric_limits<float>::min());
+}
+
 // Whether a VPL's density of its own strategy (position.w) can weight a training sample.
 bool usable_vpl_density(float pdf) {
   return pdf > 0.0f && std::isfinite(pdf);
@@ -160,13 +169,16 @@ shared::pg_rng PathTracer::second_vertex_stream(std::uint32_t i, shared::pg_rng&
 void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                              const FirstBounceSampler& sampler, const SampleCoordinates& at,
                              VplBuffer* vpls) {
+  // A sampler of the BSDF has the BSDF's density already (its samples' own).
+  const bool mis_with_bsdf =
+      settings_.first_bounce_mis == FirstBounceMis::bsdf && !sampler.samples_the_bsdf();
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, g.pixel_count(), kGrain), [&](const auto& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           PathState& p = paths_[i];
           p.radiance = glm::vec3(g.emission[i]);
           p.throughput = glm::vec3(0.0f);
-          if (vpls) vpl_paths_[i] = VplPath{glm::vec3(1.0f), glm::vec3(0.0f)};
+          if (vpls) vpl_paths_[i] = VplPath{glm::vec3(1.0f), glm::vec3(0.0f), 0.0f};
           shadow_rays_[i] = inactive_ray();
           has_shadow_[i] = 0;
           rays_[i] = inactive_ray();
@@ -197,9 +209,11 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
           } else {
             rng = nee_rng;
           }
-          // The first bounce's own sampler competes with the light here (the guided mixture).
+          // The first bounce's own sampler competes with the light here: the MIS weights use
+          // its density (the guided mixture), or the BSDF's where first_bounce_mis says so.
           const auto first_bounce_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
-            return sampler.pdf(g, i, lobes, wo, wi);
+            return mis_with_bsdf ? bsdf_mis_density(shared::pg_bsdf_pdf(lobes, wo, wi))
+                                 : sampler.pdf(g, i, lobes, wo, wi);
           };
           glm::vec3 c;
           Ray shadow;
@@ -225,20 +239,26 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
             const glm::vec3 wi = shared::pg_to_local(frame, fs.direction);
             const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
             p.throughput = f / fs.pdf;
+            const bool bsdf_strategy = fs.strategy == kStrategyBsdf;
+            const float bsdf_pdf = (vpls && bsdf_strategy) || mis_with_bsdf
+                                       ? shared::pg_bsdf_pdf(lobes, wo, wi)
+                                       : 0.0f;
             if (vpls) {
               // The VPL keeps the density of the strategy that made it (BSDF samples are
               // distributed by the BSDF alone: paper 3.2) and the whole sampler's density D
-              // (include/rtpg/guiding_layout.h), p.prev_pdf below. Area measure comes at y.
-              vpls->strategy_pdf[i] =
-                  fs.strategy == kStrategyBsdf ? shared::pg_bsdf_pdf(lobes, wo, wi) : fs.pdf;
+              // (include/rtpg/guiding_layout.h). Area measure comes at y.
+              vpls->strategy_pdf[i] = bsdf_strategy ? bsdf_pdf : fs.pdf;
               vpls->info[i] = fs.strategy << PG_VPL_STRATEGY_SHIFT;
+              vpl_paths_[i].sampler_pdf = fs.pdf;
             }
             if (!is_black(p.throughput) && is_finite(p.throughput)) {
               Ray r;
               r.origin = origin;
               r.direction = fs.direction;
               rays_[i] = r;
-              p.prev_pdf = fs.pdf;
+              // The density the hit's MIS weight uses: the same function of the direction
+              // as next-event estimation's above.
+              p.prev_pdf = mis_with_bsdf ? bsdf_mis_density(bsdf_pdf) : fs.pdf;
               p.prev_position = x0;
               alive_[i] = 1;
             }
@@ -281,7 +301,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
             if (!nee || settings_.direct_light_in_vpls) vpl_paths_[i].radiance += le * w;
             const float strategy_pdf = vpls->strategy_pdf[i];
             vpls->position[i] = glm::vec4(dir, strategy_pdf);
-            vpls->normal[i] = glm::vec4(0.0f, 0.0f, 0.0f, p.prev_pdf);
+            vpls->normal[i] = glm::vec4(0.0f, 0.0f, 0.0f, vpl_paths_[i].sampler_pdf);
             if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
           }
         } else if (vpls) {
@@ -310,7 +330,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         const float cos_y = std::fabs(glm::dot(sp.geometric_normal, dir));
         const float strategy_pdf = vpls->strategy_pdf[i] * cos_y / d2;
         vpls->position[i] = glm::vec4(sp.position, strategy_pdf);
-        vpls->normal[i] = glm::vec4(sp.geometric_normal, p.prev_pdf * cos_y / d2);
+        vpls->normal[i] = glm::vec4(sp.geometric_normal, vpl_paths_[i].sampler_pdf * cos_y / d2);
         if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID;
       }
       if (depth == settings_.max_bounces) continue;

@@ -33,6 +33,16 @@ enum class SharedRandoms {
                    // Russian roulette draw)
 };
 
+// The density the primary hit's two strategies for direct light weigh each other with (the light
+// sample of next-event estimation, and the first bounce's hit on an emitter). Both sides use the
+// same function of the direction, so the weights sum to one and either choice is unbiased (Veach's
+// MIS needs a partition of unity, not the sampling densities); they differ in variance and cost
+// (docs/guiding.md, "The primary hit's MIS with the BSDF's density").
+enum class FirstBounceMis {
+  mixture,  // the first-bounce sampler's own density (the guided mixture D of paper eq. 2)
+  bsdf,     // the BSDF's density (D where that is 0): no mixture evaluated for the light sample
+};
+
 struct PathTracerSettings {
   int max_bounces = 8;     // path vertices after the primary hit
   int roulette_start = 3;  // first bounce at which Russian roulette may end a path
@@ -47,6 +57,7 @@ struct PathTracerSettings {
   // received, so that directions where light sampling does worse than the mixture are learnt
   // (Sponza's sun and sky: relMSE -2% to -3% on every seed, no scene worse).
   bool direct_light_in_vpls = true;
+  FirstBounceMis first_bounce_mis = FirstBounceMis::bsdf;
   float guide_position = 0.05f;  // relative distance to the pixel's depth
   float guide_normal = 0.9f;     // normal cosine
   SharedRandoms shared_randoms = SharedRandoms::none;
@@ -111,6 +122,7 @@ class PathTracer {
   struct VplPath {
     glm::vec3 throughput;  // from the first-bounce hit y
     glm::vec3 radiance;    // accumulated radiance leaving y towards x0
+    float sampler_pdf;     // the first-bounce sampler's density D of the direction x0 -> y
   };
 
   // The steps of trace(), in order.

@@ -42,6 +42,7 @@ struct RunShape {
   std::string camera_path;
   bool guide_secondary = false;  // later vertices borrow their pixel's mixture
   bool pi_learning = false;      // the variance-aware mixing weight (GuidingSettings)
+  FirstBounceMis first_bounce_mis = FirstBounceMis::bsdf;  // PathTracerSettings
 };
 
 // A guided sampler whose first-bounce samples claim a density 5% too high: every path that
@@ -70,6 +71,7 @@ TileSeries run(const Scene& scene, Method method, int size, int frames, ClRuntim
   settings.spp = shape.spp;
   settings.camera_path = shape.camera_path;
   settings.path_tracer.guide_secondary = guided && shape.guide_secondary;
+  settings.path_tracer.first_bounce_mis = shape.first_bounce_mis;
   settings.jitter = false;  // both methods estimate the same integral per pixel
   settings.seed = guided ? 11u : 12u;
   settings.path_tracer.max_bounces = scene.max_bounces > 0 ? scene.max_bounces : 8;
@@ -138,8 +140,8 @@ struct Comparison {
   std::uint64_t guided_vertices = 0;
 };
 
-Comparison compare_means(const char* name, Method method, int frames, const RunShape& shape) {
-  const Scene scene = load_scene(scene_file(name));
+Comparison compare_means(const char* name, const Scene& scene, Method method, int frames,
+                         const RunShape& shape) {
   ClRuntime cl;
   const int size = 64;
   const TileSeries pt = run(scene, Method::PathTracing, size, frames, cl, shape);
@@ -176,6 +178,10 @@ Comparison compare_means(const char* name, Method method, int frames, const RunS
       name, 100.0 * c.whole_relative_difference, 100.0 * c.whole_relative_se,
       100.0 * c.worst_tile_relative_se, c.z, c.rejected.size());
   return c;
+}
+
+Comparison compare_means(const char* name, Method method, int frames, const RunShape& shape) {
+  return compare_means(name, load_scene(scene_file(name)), method, frames, shape);
 }
 
 // Guided and plain path tracing agree on the whole image and every tile, and the check has
@@ -242,6 +248,32 @@ TEST(GuidingImage, UnbiasedWithLearnedMixingWeightAlongCameraPathAtTwoSpp) {
   RunShape shape{2, "pan"};
   shape.pi_learning = true;
   expect_same_means("cornell-box.json", 120, 0.0015, shape);
+}
+
+// The Cornell box under a light that fills most of its ceiling (1.8 m square instead of 0.5 m,
+// its emission scaled down by the area), where the light sample's and the first bounce's
+// densities are of one size and the guide learns the light: either MIS density must leave the
+// image unbiased. Here the weights that do not sum to one (mutant first-bounce-mis-mixed) are
+// seen, where the small light's were not: its light sample's density dwarfs both others.
+TEST(GuidingImage, UnbiasedUnderALargeLightWithEitherMisDensity) {
+  Scene scene = load_scene(scene_file("cornell-box.json"));
+  for (Mesh& mesh : scene.meshes) {
+    Material& material = scene.materials[mesh.material];
+    if (!material.is_emissive()) continue;
+    glm::vec3 centre(0.0f);
+    for (const glm::vec3& v : mesh.positions) centre += v;
+    centre /= static_cast<float>(mesh.positions.size());
+    for (glm::vec3& v : mesh.positions) v = centre + (v - centre) * 3.6f;
+    material.emission /= 3.6f * 3.6f;
+  }
+  for (const FirstBounceMis mis : {FirstBounceMis::mixture, FirstBounceMis::bsdf}) {
+    RunShape shape{2, "pan"};
+    shape.first_bounce_mis = mis;
+    const Comparison c =
+        compare_means("cornell-box.json, large light", scene, Method::Guided, 120, shape);
+    for (const std::string& r : c.rejected) ADD_FAILURE() << static_cast<int>(mis) << " " << r;
+    EXPECT_LE(c.whole_relative_se, 0.0015);
+  }
 }
 
 TEST(GuidingImage, UnbiasedAlongCameraPathAtFourSpp) {
