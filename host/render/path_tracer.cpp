@@ -130,7 +130,6 @@ void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
   if (vpls) {
     vpls->resize(n);
     vpl_paths_.resize(n);
-    shadow_vpl_contribution_.resize(n);
   }
   shadow_rays_.resize(n);
   shadow_contribution_.resize(n);
@@ -176,9 +175,14 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
       tbb::blocked_range<std::size_t>(0, g.pixel_count(), kGrain), [&](const auto& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           PathState& p = paths_[i];
-          p.radiance = glm::vec3(g.emission[i]);
           p.throughput = glm::vec3(0.0f);
-          if (vpls) vpl_paths_[i] = VplPath{glm::vec3(1.0f), glm::vec3(0.0f), 0.0f};
+          if (vpls) {
+            // Measured from y (VplPath): x0's emission is the pixel's own.
+            p.radiance = glm::vec3(0.0f);
+            vpl_paths_[i] = VplPath{glm::vec3(0.0f), glm::vec3(g.emission[i]), 0.0f};
+          } else {
+            p.radiance = glm::vec3(g.emission[i]);
+          }
           shadow_rays_[i] = inactive_ray();
           has_shadow_[i] = 0;
           rays_[i] = inactive_ray();
@@ -220,7 +224,6 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
           if (next_event_on_ && next_event(x0, ng, frame, wo, lobes, origin, u_sel, u1, u2,
                                            first_bounce_pdf, c, shadow)) {
             shadow_contribution_[i] = c;
-            if (vpls) shadow_vpl_contribution_[i] = glm::vec3(0.0f);
             shadow_rays_[i] = shadow;
             has_shadow_[i] = 1;
           }
@@ -238,7 +241,7 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
           if (fs.pdf > 0.0f && glm::dot(fs.direction, ng) > 0.0f) {
             const glm::vec3 wi = shared::pg_to_local(frame, fs.direction);
             const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
-            p.throughput = f / fs.pdf;
+            const glm::vec3 throughput = f / fs.pdf;
             const bool bsdf_strategy = fs.strategy == kStrategyBsdf;
             const float bsdf_pdf = (vpls && bsdf_strategy) || mis_with_bsdf
                                        ? shared::pg_bsdf_pdf(lobes, wo, wi)
@@ -251,7 +254,13 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
               vpls->info[i] = fs.strategy << PG_VPL_STRATEGY_SHIFT;
               vpl_paths_[i].sampler_pdf = fs.pdf;
             }
-            if (!is_black(p.throughput) && is_finite(p.throughput)) {
+            if (!is_black(throughput) && is_finite(throughput)) {
+              if (vpls) {
+                vpl_paths_[i].first_throughput = throughput;
+                p.throughput = glm::vec3(1.0f);  // measured from y on (VplPath)
+              } else {
+                p.throughput = throughput;
+              }
               Ray r;
               r.origin = origin;
               r.direction = fs.direction;
@@ -266,6 +275,19 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
           p.rng = rng.state;
         }
       });
+}
+
+void PathTracer::add_found_light(PathState& p, std::uint32_t i, int depth, const glm::vec3& found) {
+  // With next-event estimation at x0 the light's own direction is NEE's job: the guide
+  // learns only what arrives indirectly (y's emission stays out of the VPL, and the pixel
+  // keeps it: VplPath), or the light with the MIS weight this sample got
+  // (direct_light_in_vpls). found is then the emission itself (the path's throughput from y is
+  // 1 at y).
+  if (depth == 1 && keep_vpls_ && next_event_on_ && !settings_.direct_light_in_vpls) {
+    vpl_paths_[i].before_y += vpl_paths_[i].first_throughput * found;
+  } else {
+    p.radiance += found;
+  }
 }
 
 void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays) {
@@ -292,20 +314,14 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       if (!hit.valid()) {
         const glm::vec3 le = lights_.escaped_radiance(dir);
         const float w = nee ? power_heuristic(p.prev_pdf, lights_.pdf_escaped(dir)) : 1.0f;
-        p.radiance += p.throughput * le * w;
+        add_found_light(p, i, depth, p.throughput * le * w);
         if (depth == 1) {
-          // With next-event estimation at x0 the light's own direction is NEE's job: the
-          // guide learns only what arrives indirectly (emission at y stays out), or the light
-          // with the MIS weight this sample got (direct_light_in_vpls).
           if (vpls) {
-            if (!nee || settings_.direct_light_in_vpls) vpl_paths_[i].radiance += le * w;
             const float strategy_pdf = vpls->strategy_pdf[i];
             vpls->position[i] = glm::vec4(dir, strategy_pdf);
             vpls->normal[i] = glm::vec4(0.0f, 0.0f, 0.0f, vpl_paths_[i].sampler_pdf);
             if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
           }
-        } else if (vpls) {
-          vpl_paths_[i].radiance += vpl_paths_[i].throughput * le * w;
         }
         continue;
       }
@@ -316,12 +332,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
                                   lights_.pdf_triangle(hit.mesh, hit.triangle, p.prev_position,
                                                        sp.position, sp.geometric_normal))
                 : 1.0f;
-        p.radiance += p.throughput * sp.emission * w;
-        if (vpls && depth > 1) {
-          vpl_paths_[i].radiance += vpl_paths_[i].throughput * sp.emission * w;
-        } else if (vpls && (!nee || settings_.direct_light_in_vpls)) {
-          vpl_paths_[i].radiance += sp.emission * w;  // see the escaped case above
-        }
+        add_found_light(p, i, depth, p.throughput * sp.emission * w);
       }
       if (depth == 1 && vpls) {
         // Density in area measure at y: solid angle at x0 times cos(theta_y) / d^2.
@@ -346,8 +357,6 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       const shared::pg_lobes lobes = shared::pg_make_lobes(sp.material, wo);
       const glm::vec3 origin =
           offset_ray_origin(sp.position, sp.geometric_normal, sp.offset_distance);
-      const glm::vec3 vpl_throughput =
-          depth == 1 || !vpls ? glm::vec3(1.0f) : vpl_paths_[i].throughput;
 
       const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
                   u2 = shared::pg_rng_next(&rng);
@@ -369,7 +378,6 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       if (nee && next_event(sp.position, sp.geometric_normal, frame, wo, lobes, origin, u_sel, u1,
                             u2, vertex_pdf, c, shadow)) {
         shadow_contribution_[j] = p.throughput * c;
-        if (vpls) shadow_vpl_contribution_[j] = vpl_throughput * c;
         shadow_rays_[j] = shadow;
         has_shadow_[j] = 1;
       }
@@ -407,16 +415,19 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       if (glm::dot(wi_world, sp.geometric_normal) <= 0.0f) continue;
       const glm::vec3 weight = shared::pg_bsdf_eval(lobes, wo, bs.wi) * (bs.wi.z / bs.pdf);
       p.throughput *= weight;
-      glm::vec3 next_vpl_throughput = vpl_throughput * weight;
+      // Russian roulette and the end of a black path look at the throughput from the camera
+      // (measured from y where VPLs are kept: VplPath).
+      const auto from_camera = [&] {
+        return vpls ? vpl_paths_[i].first_throughput * p.throughput : p.throughput;
+      };
       if (depth >= settings_.roulette_start) {
-        const float q =
-            std::min(0.95f, std::max(p.throughput.x, std::max(p.throughput.y, p.throughput.z)));
+        const glm::vec3 t = from_camera();
+        const float q = std::min(0.95f, std::max(t.x, std::max(t.y, t.z)));
         if (!(u_rr < q)) continue;
         p.throughput /= q;
-        next_vpl_throughput /= q;
       }
-      if (vpls) vpl_paths_[i].throughput = next_vpl_throughput;
-      if (is_black(p.throughput) || !is_finite(p.throughput)) continue;
+      const glm::vec3 t = from_camera();
+      if (is_black(t) || !is_finite(t)) continue;
       p.prev_pdf = bs.pdf;
       p.prev_position = sp.position;
       Ray next;
@@ -520,8 +531,13 @@ void PathTracer::apply_shadow_rays_and_compact(std::size_t count,
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
       const std::uint32_t owner = owners ? (*owners)[j] : static_cast<std::uint32_t>(j);
       if (has_shadow_[j] && !occluded_[j]) {
-        paths_[owner].radiance += shadow_contribution_[j];
-        if (keep_vpls_) vpl_paths_[owner].radiance += shadow_vpl_contribution_[j];
+        // At x0 (no owners) a path kept from y (VplPath) adds it to what the pixel found
+        // before y.
+        if (keep_vpls_ && !owners) {
+          vpl_paths_[owner].before_y += shadow_contribution_[j];
+        } else {
+          paths_[owner].radiance += shadow_contribution_[j];
+        }
       }
       if (alive_[j]) {
         next_rays_[slot_[j]] = rays_[j];
@@ -542,14 +558,19 @@ void PathTracer::gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls,
       [&](const auto& range, std::uint64_t bad) {
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
           const PathState& p = paths_[i];
-          if (is_finite(p.radiance)) {
-            radiance[i] = p.radiance;
+          // Where VPLs are kept the path measured from y (VplPath): its radiance is the VPL's,
+          // and the pixel's estimate adds what x0 found.
+          const glm::vec3 estimate =
+              vpls ? vpl_paths_[i].before_y + vpl_paths_[i].first_throughput * p.radiance
+                   : p.radiance;
+          if (is_finite(estimate)) {
+            radiance[i] = estimate;
           } else {
             radiance[i] = glm::vec3(0.0f);
             ++bad;
           }
           if (vpls) {
-            const glm::vec3 vpl_l = vpl_paths_[i].radiance;
+            const glm::vec3 vpl_l = p.radiance;
             if (!is_finite(vpl_l)) vpls->info[i] &= ~PG_VPL_VALID;
             // The kernels read the info bits from radiance_info.w (exact: small integers).
             vpls->radiance_info[i] = glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f),

@@ -110,19 +110,23 @@ class PathTracer {
  private:
   // What every path carries from vertex to vertex (44 bytes: a path touches one cache line).
   struct PathState {
-    glm::vec3 throughput;     // from the camera
-    glm::vec3 radiance;       // accumulated pixel estimate
+    glm::vec3 throughput;     // from the camera (from y where VPLs are kept: VplPath)
+    glm::vec3 radiance;       // accumulated pixel estimate (the VPL's radiance: VplPath)
     float prev_pdf;           // density of the direction that led here (for MIS)
     glm::vec3 prev_position;  // origin of the current ray
     std::uint32_t rng;        // pg_rng state
   };
-  // What a path carries only where its VPL is kept (trace() with vpls): apart, so that the
-  // passes that keep none do not move it (docs/host-path-tracer.md, "The VPL's radiance
-  // apart").
+  // Where a pass keeps VPLs (trace() with vpls), a path's PathState measures from the
+  // first-bounce hit y instead of from the camera: its throughput is y's onwards (1 at y) and
+  // its radiance is what leaves y towards x0, the VPL's radiance, so no second set of sums
+  // follows the path. What the pixel needs besides is kept per pixel, written at x0 and read
+  // at the end (docs/host-path-tracer.md, "The VPL's radiance as the path's own"): the pixel's
+  // estimate is before_y + first_throughput * radiance.
   struct VplPath {
-    glm::vec3 throughput;  // from the first-bounce hit y
-    glm::vec3 radiance;    // accumulated radiance leaving y towards x0
-    float sampler_pdf;     // the first-bounce sampler's density D of the direction x0 -> y
+    glm::vec3 first_throughput;  // from the camera through x0's bounce: f cos / D at x0
+    glm::vec3 before_y;  // the pixel's own before y: x0's emission and light sample (and y's
+                         // emission where the VPLs leave it out)
+    float sampler_pdf;   // the first-bounce sampler's density D of the direction x0 -> y
   };
 
   // The steps of trace(), in order.
@@ -147,10 +151,15 @@ class PathTracer {
                   const glm::vec3& origin, float u_select, float u1, float u2,
                   const CompetingPdf& competing_pdf, glm::vec3& contribution, Ray& shadow) const;
   void run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times);
-  // Adds each unoccluded shadow ray's contribution to its path, and keeps the rays of the
-  // paths still alive at the front of rays_; active_ becomes their pixels (owners[j] of slot
-  // j, or j itself when owners is null).
+  // Adds each unoccluded shadow ray's contribution to its path (to the pixel's before_y at
+  // x0, owners null, where VPLs are kept), and keeps the rays of the paths still alive at the
+  // front of rays_; active_ becomes their pixels (owners[j] of slot j, or j itself when owners
+  // is null).
   void apply_shadow_rays_and_compact(std::size_t count, const std::vector<std::uint32_t>* owners);
+  // Light a bounce found at path vertex `depth` (emission with its MIS weight, times the
+  // path's throughput), added to the path's radiance, or to the pixel's own where the VPL
+  // leaves it out.
+  void add_found_light(PathState& p, std::uint32_t i, int depth, const glm::vec3& found);
   // What borrow_guide() reads of the pixel a later vertex projects to, in one cache line:
   // the vertices land all over the image, and the G-buffer's channels and the sampler's
   // mixture, read apart, cost a cache miss each (docs/guiding.md, "Later vertices, revisited").
@@ -199,9 +208,8 @@ class PathTracer {
   std::vector<Hit> hits_;
   std::vector<std::uint8_t> occluded_;
   std::vector<std::uint8_t> has_shadow_;  // per slot: 1 where shadow_rays_ holds a segment
-  // Per slot with a shadow segment: what it adds to its path, and to the path's VPL radiance
-  // (keep_vpls_), if unoccluded.
-  std::vector<glm::vec3> shadow_contribution_, shadow_vpl_contribution_;
+  // Per slot with a shadow segment: what it adds to its path's radiance if unoccluded.
+  std::vector<glm::vec3> shadow_contribution_;
   std::vector<BorrowablePixel> borrowable_;  // per pixel, with guide_secondary
 };
 

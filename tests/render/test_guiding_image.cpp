@@ -43,6 +43,7 @@ struct RunShape {
   bool guide_secondary = false;  // later vertices borrow their pixel's mixture
   bool pi_learning = false;      // the variance-aware mixing weight (GuidingSettings)
   FirstBounceMis first_bounce_mis = FirstBounceMis::bsdf;  // PathTracerSettings
+  bool direct_light_in_vpls = true;                        // PathTracerSettings
 };
 
 // A guided sampler whose first-bounce samples claim a density 5% too high: every path that
@@ -72,6 +73,7 @@ TileSeries run(const Scene& scene, Method method, int size, int frames, ClRuntim
   settings.camera_path = shape.camera_path;
   settings.path_tracer.guide_secondary = guided && shape.guide_secondary;
   settings.path_tracer.first_bounce_mis = shape.first_bounce_mis;
+  settings.path_tracer.direct_light_in_vpls = shape.direct_light_in_vpls;
   settings.jitter = false;  // both methods estimate the same integral per pixel
   settings.seed = guided ? 11u : 12u;
   settings.path_tracer.max_bounces = scene.max_bounces > 0 ? scene.max_bounces : 8;
@@ -254,7 +256,9 @@ TEST(GuidingImage, UnbiasedWithLearnedMixingWeightAlongCameraPathAtTwoSpp) {
 // its emission scaled down by the area), where the light sample's and the first bounce's
 // densities are of one size and the guide learns the light: either MIS density must leave the
 // image unbiased. Here the weights that do not sum to one (mutant first-bounce-mis-mixed) are
-// seen, where the small light's were not: its light sample's density dwarfs both others.
+// seen, where the small light's were not: its light sample's density dwarfs both others. The
+// third run leaves the light y emits out of the VPLs (--guide-direct-light off), so that the
+// pixel keeps it apart from its path (PathTracer::VplPath; mutant vpl-left-out-light-unweighted).
 TEST(GuidingImage, UnbiasedUnderALargeLightWithEitherMisDensity) {
   Scene scene = load_scene(scene_file("cornell-box.json"));
   for (Mesh& mesh : scene.meshes) {
@@ -266,12 +270,21 @@ TEST(GuidingImage, UnbiasedUnderALargeLightWithEitherMisDensity) {
     for (glm::vec3& v : mesh.positions) v = centre + (v - centre) * 3.6f;
     material.emission /= 3.6f * 3.6f;
   }
-  for (const FirstBounceMis mis : {FirstBounceMis::mixture, FirstBounceMis::bsdf}) {
+  struct Variant {
+    FirstBounceMis mis;
+    bool direct_light_in_vpls;
+  };
+  for (const Variant v :
+       {Variant{FirstBounceMis::mixture, true}, Variant{FirstBounceMis::bsdf, true},
+        Variant{FirstBounceMis::bsdf, false}}) {
     RunShape shape{2, "pan"};
-    shape.first_bounce_mis = mis;
+    shape.first_bounce_mis = v.mis;
+    shape.direct_light_in_vpls = v.direct_light_in_vpls;
     const Comparison c =
         compare_means("cornell-box.json, large light", scene, Method::Guided, 120, shape);
-    for (const std::string& r : c.rejected) ADD_FAILURE() << static_cast<int>(mis) << " " << r;
+    for (const std::string& r : c.rejected)
+      ADD_FAILURE() << "mis " << static_cast<int>(v.mis) << ", direct light in VPLs "
+                    << v.direct_light_in_vpls << ": " << r;
     EXPECT_LE(c.whole_relative_se, 0.0015);
   }
 }
