@@ -18,10 +18,12 @@
 namespace rtpg {
 namespace {
 
-// BSDF sampling that records every call it receives.
+// BSDF sampling that records every call it receives (and asks for VPLs, as a guide would, unless
+// told not to).
 class RecordingSampler final : public FirstBounceSampler {
  public:
-  explicit RecordingSampler(std::vector<std::string>& log) : log_(log) {}
+  explicit RecordingSampler(std::vector<std::string>& log, bool wants_vpls = true)
+      : log_(log), wants_vpls_(wants_vpls) {}
   void begin_frame(const GBuffer&, const SampleCoordinates& at) override {
     log_.push_back("begin " + std::to_string(at.frame));
   }
@@ -30,7 +32,7 @@ class RecordingSampler final : public FirstBounceSampler {
     for (std::uint32_t info : vpls.info) valid += (info & PG_VPL_VALID) != 0u;
     log_.push_back("end " + std::to_string(at.frame) + (valid > 0 ? " with vpls" : " no vpls"));
   }
-  bool wants_vpls() const override { return true; }
+  bool wants_vpls() const override { return wants_vpls_; }
   FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
     log_.push_back("sample " + std::to_string(at.frame) + "." + std::to_string(at.sample));
     return bsdf_.sample(g, at);
@@ -42,6 +44,7 @@ class RecordingSampler final : public FirstBounceSampler {
 
  private:
   std::vector<std::string>& log_;
+  bool wants_vpls_;
   BsdfFirstBounce bsdf_;
 };
 
@@ -73,15 +76,19 @@ TEST(FrameOrder, TrainingFollowsTheFramesLastSample) {
 // Two samples a pixel, a moving camera, an odd size: every frame's image is the same to the bit
 // whether the first bounce comes from BsdfFirstBounce's own pass (RecordingSampler runs it; the
 // renderer leaves it out for BsdfFirstBounce itself, samples_the_bsdf()) or from the path
-// tracer's.
+// tracer's. Both keep no VPLs (a pass that keeps them sums its paths from the first bounce's hit,
+// equal up to rounding: PathTracer::VplPath) and weigh the primary hit's MIS with the sampler's
+// own density (under FirstBounceMis::bsdf a sampler that is not BsdfFirstBounce itself has the
+// BSDF's density recomputed from the direction, equal up to rounding).
 TEST(FrameOrder, BsdfAtThePrimaryHitEqualsItsOwnPass) {
   const Scene scene = cornell_box();
   RenderSettings settings = odd_size(2);
   settings.camera_path = "pan";
+  settings.path_tracer.first_bounce_mis = FirstBounceMis::mixture;
   Renderer in_place(scene, settings), separate(scene, settings);
   ASSERT_TRUE(BsdfFirstBounce().samples_the_bsdf());
   std::vector<std::string> log;
-  separate.set_first_bounce_sampler(std::make_unique<RecordingSampler>(log));
+  separate.set_first_bounce_sampler(std::make_unique<RecordingSampler>(log, false));
   for (int frame = 0; frame < 3; ++frame) {
     in_place.render_frame(frame);
     separate.render_frame(frame);
