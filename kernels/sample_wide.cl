@@ -75,27 +75,13 @@ __kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint 
     m.valid &= ~sky;
   }
 
+  pg_store_row_float4_rows(direction_pdf + row_start, x0, w, direction.x, direction.y, direction.z,
+                           pdf);
+  pg_store_row_uints(strategy + row_start, x0, w, strategy_w);
   /* pg_pmm_mixture_a and _b: an invalid model (and a sky pixel) is all zeros. */
-  float out[10][PG_LANES];
-  uint strategy_lanes[PG_LANES];
-  pg_vstorew(direction.x, 0, out[0]);
-  pg_vstorew(direction.y, 0, out[1]);
-  pg_vstorew(direction.z, 0, out[2]);
-  pg_vstorew(pdf, 0, out[3]);
-  pg_vstorew(select(zero, m.pi, m.valid), 0, out[4]);
-  pg_vstorew(select(zero, m.mx, m.valid), 0, out[5]);
-  pg_vstorew(select(zero, m.my, m.valid), 0, out[6]);
-  pg_vstorew(select(zero, m.l11, m.valid), 0, out[7]);
-  pg_vstorew(select(zero, m.l21, m.valid), 0, out[8]);
-  pg_vstorew(select(zero, m.l22, m.valid), 0, out[9]);
-  pg_vstorew(strategy_w, 0, strategy_lanes);
-  for (int l = 0; l < PG_LANES; ++l) {
-    int x = x0 + l;
-    if (x >= w) break;
-    int i = row_start + x;
-    direction_pdf[i] = (float4)(out[0][l], out[1][l], out[2][l], out[3][l]);
-    strategy[i] = strategy_lanes[l];
-    mixture_a[i] = (float4)(out[4][l], out[5][l], out[6][l], out[7][l]);
-    mixture_b[i] = (float2)(out[8][l], out[9][l]);
-  }
+  pg_store_row_float4_rows(mixture_a + row_start, x0, w, select(zero, m.pi, m.valid),
+                           select(zero, m.mx, m.valid), select(zero, m.my, m.valid),
+                           select(zero, m.l11, m.valid));
+  pg_store_row_float2_rows(mixture_b + row_start, x0, w, select(zero, m.l21, m.valid),
+                           select(zero, m.l22, m.valid));
 }

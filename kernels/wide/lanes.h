@@ -7,7 +7,8 @@
  * where the mask is set, and a lane whose work is done or absent is masked, never branched
  * around. A work-item's lanes are consecutive pixels of a row, so their G-buffer and state
  * channels load as vectors (pg_load_row_float4_rows), lane by lane only at the row's right end;
- * the kernels store results lane by lane from private rows. */
+ * the sample kernel stores its results the same way (pg_store_row_float4_rows; the train
+ * kernel's state, stored so, was 3% slower: docs/guiding.md, "Samples stored as vectors"). */
 #ifndef RTPG_WIDE_LANES_H
 #define RTPG_WIDE_LANES_H
 
@@ -168,6 +169,106 @@ static inline void pg_store_row_floats(__global float* row, int x0, int width, p
     return;
   }
   float lanes[PG_LANES];
+  pg_vstorew(v, 0, lanes);
+  for (int l = 0; x0 + l < width; ++l) row[x0 + l] = lanes[l];
+}
+
+/* The inverse of pg_load_float4_rows: the x, y, z and w rows of every lane stored as PG_LANES
+ * consecutive float4 (a transposition by swizzles and whole-vector stores, where storing lane by
+ * lane from private rows took a scalar store per field). */
+PG_ROW_LOAD void pg_store_float4_rows(__global float4* p, pg_floatw x, pg_floatw y, pg_floatw z,
+                                      pg_floatw w) {
+  __global float* f = (__global float*)p;
+#if PG_LANES == 16
+  vstore16((float16)(x.s0, y.s0, z.s0, w.s0, x.s1, y.s1, z.s1, w.s1, x.s2, y.s2, z.s2, w.s2, x.s3,
+                     y.s3, z.s3, w.s3),
+           0, f);
+  vstore16((float16)(x.s4, y.s4, z.s4, w.s4, x.s5, y.s5, z.s5, w.s5, x.s6, y.s6, z.s6, w.s6, x.s7,
+                     y.s7, z.s7, w.s7),
+           1, f);
+  vstore16((float16)(x.s8, y.s8, z.s8, w.s8, x.s9, y.s9, z.s9, w.s9, x.sa, y.sa, z.sa, w.sa, x.sb,
+                     y.sb, z.sb, w.sb),
+           2, f);
+  vstore16((float16)(x.sc, y.sc, z.sc, w.sc, x.sd, y.sd, z.sd, w.sd, x.se, y.se, z.se, w.se, x.sf,
+                     y.sf, z.sf, w.sf),
+           3, f);
+#elif PG_LANES == 8
+  vstore16((float16)(x.s0, y.s0, z.s0, w.s0, x.s1, y.s1, z.s1, w.s1, x.s2, y.s2, z.s2, w.s2, x.s3,
+                     y.s3, z.s3, w.s3),
+           0, f);
+  vstore16((float16)(x.s4, y.s4, z.s4, w.s4, x.s5, y.s5, z.s5, w.s5, x.s6, y.s6, z.s6, w.s6, x.s7,
+                     y.s7, z.s7, w.s7),
+           1, f);
+#elif PG_LANES == 4
+  vstore16((float16)(x.s0, y.s0, z.s0, w.s0, x.s1, y.s1, z.s1, w.s1, x.s2, y.s2, z.s2, w.s2, x.s3,
+                     y.s3, z.s3, w.s3),
+           0, f);
+#elif PG_LANES == 2
+  vstore8((float8)(x.s0, y.s0, z.s0, w.s0, x.s1, y.s1, z.s1, w.s1), 0, f);
+#else
+#error "PG_LANES must be 2, 4, 8 or 16"
+#endif
+}
+
+/* The same for two rows stored as PG_LANES consecutive float2. */
+PG_ROW_LOAD void pg_store_float2_rows(__global float2* p, pg_floatw x, pg_floatw y) {
+  __global float* f = (__global float*)p;
+#if PG_LANES == 16
+  vstore16((float16)(x.s0, y.s0, x.s1, y.s1, x.s2, y.s2, x.s3, y.s3, x.s4, y.s4, x.s5, y.s5, x.s6,
+                     y.s6, x.s7, y.s7),
+           0, f);
+  vstore16((float16)(x.s8, y.s8, x.s9, y.s9, x.sa, y.sa, x.sb, y.sb, x.sc, y.sc, x.sd, y.sd, x.se,
+                     y.se, x.sf, y.sf),
+           1, f);
+#elif PG_LANES == 8
+  vstore16((float16)(x.s0, y.s0, x.s1, y.s1, x.s2, y.s2, x.s3, y.s3, x.s4, y.s4, x.s5, y.s5, x.s6,
+                     y.s6, x.s7, y.s7),
+           0, f);
+#elif PG_LANES == 4
+  vstore8((float8)(x.s0, y.s0, x.s1, y.s1, x.s2, y.s2, x.s3, y.s3), 0, f);
+#elif PG_LANES == 2
+  vstore4((float4)(x.s0, y.s0, x.s1, y.s1), 0, f);
+#else
+#error "PG_LANES must be 2, 4, 8 or 16"
+#endif
+}
+
+/* Four rows stored as the float4 channel of the pixels x0 .. x0 + PG_LANES - 1 of one row (x0 >=
+ * 0): vector stores where every lane lies inside the row, lane by lane up to its end otherwise. */
+PG_ROW_LOAD void pg_store_row_float4_rows(__global float4* row, int x0, int width, pg_floatw x,
+                                          pg_floatw y, pg_floatw z, pg_floatw w) {
+  if (x0 + PG_LANES <= width) {
+    pg_store_float4_rows(row + x0, x, y, z, w);
+    return;
+  }
+  float v[4][PG_LANES];
+  pg_vstorew(x, 0, v[0]);
+  pg_vstorew(y, 0, v[1]);
+  pg_vstorew(z, 0, v[2]);
+  pg_vstorew(w, 0, v[3]);
+  for (int l = 0; x0 + l < width; ++l) row[x0 + l] = (float4)(v[0][l], v[1][l], v[2][l], v[3][l]);
+}
+
+/* Two rows stored as a float2 channel (the same rule). */
+PG_ROW_LOAD void pg_store_row_float2_rows(__global float2* row, int x0, int width, pg_floatw x,
+                                          pg_floatw y) {
+  if (x0 + PG_LANES <= width) {
+    pg_store_float2_rows(row + x0, x, y);
+    return;
+  }
+  float v[2][PG_LANES];
+  pg_vstorew(x, 0, v[0]);
+  pg_vstorew(y, 0, v[1]);
+  for (int l = 0; x0 + l < width; ++l) row[x0 + l] = (float2)(v[0][l], v[1][l]);
+}
+
+/* A uint row stored to the same pixels (the same rule). */
+static inline void pg_store_row_uints(__global uint* row, int x0, int width, pg_uintw v) {
+  if (x0 + PG_LANES <= width) {
+    pg_vstorew(v, 0, row + x0);
+    return;
+  }
+  uint lanes[PG_LANES];
   pg_vstorew(v, 0, lanes);
   for (int l = 0; x0 + l < width; ++l) row[x0 + l] = lanes[l];
 }
