@@ -173,65 +173,49 @@ static inline void pg_store_row_floats(__global float* row, int x0, int width, p
   for (int l = 0; x0 + l < width; ++l) row[x0 + l] = lanes[l];
 }
 
+/* The x, y, z and w of four lanes (a, b, c, d: their swizzle digits), interleaved. */
+#define PG_XYZW_OF_4(a, b, c, d)                                                            \
+  (float16)(x.s##a, y.s##a, z.s##a, w.s##a, x.s##b, y.s##b, z.s##b, w.s##b, x.s##c, y.s##c, \
+            z.s##c, w.s##c, x.s##d, y.s##d, z.s##d, w.s##d)
 /* The inverse of pg_load_float4_rows: the x, y, z and w rows of every lane stored as PG_LANES
  * consecutive float4 (a transposition by swizzles and whole-vector stores, where storing lane by
  * lane from private rows took a scalar store per field). */
 PG_ROW_LOAD void pg_store_float4_rows(__global float4* p, pg_floatw x, pg_floatw y, pg_floatw z,
                                       pg_floatw w) {
   __global float* f = (__global float*)p;
-#if PG_LANES == 16
-  vstore16((float16)(x.s0, y.s0, z.s0, w.s0, x.s1, y.s1, z.s1, w.s1, x.s2, y.s2, z.s2, w.s2, x.s3,
-                     y.s3, z.s3, w.s3),
-           0, f);
-  vstore16((float16)(x.s4, y.s4, z.s4, w.s4, x.s5, y.s5, z.s5, w.s5, x.s6, y.s6, z.s6, w.s6, x.s7,
-                     y.s7, z.s7, w.s7),
-           1, f);
-  vstore16((float16)(x.s8, y.s8, z.s8, w.s8, x.s9, y.s9, z.s9, w.s9, x.sa, y.sa, z.sa, w.sa, x.sb,
-                     y.sb, z.sb, w.sb),
-           2, f);
-  vstore16((float16)(x.sc, y.sc, z.sc, w.sc, x.sd, y.sd, z.sd, w.sd, x.se, y.se, z.se, w.se, x.sf,
-                     y.sf, z.sf, w.sf),
-           3, f);
-#elif PG_LANES == 8
-  vstore16((float16)(x.s0, y.s0, z.s0, w.s0, x.s1, y.s1, z.s1, w.s1, x.s2, y.s2, z.s2, w.s2, x.s3,
-                     y.s3, z.s3, w.s3),
-           0, f);
-  vstore16((float16)(x.s4, y.s4, z.s4, w.s4, x.s5, y.s5, z.s5, w.s5, x.s6, y.s6, z.s6, w.s6, x.s7,
-                     y.s7, z.s7, w.s7),
-           1, f);
-#elif PG_LANES == 4
-  vstore16((float16)(x.s0, y.s0, z.s0, w.s0, x.s1, y.s1, z.s1, w.s1, x.s2, y.s2, z.s2, w.s2, x.s3,
-                     y.s3, z.s3, w.s3),
-           0, f);
-#elif PG_LANES == 2
+#if PG_LANES == 2
   vstore8((float8)(x.s0, y.s0, z.s0, w.s0, x.s1, y.s1, z.s1, w.s1), 0, f);
 #else
-#error "PG_LANES must be 2, 4, 8 or 16"
+  vstore16(PG_XYZW_OF_4(0, 1, 2, 3), 0, f);
+#if PG_LANES >= 8
+  vstore16(PG_XYZW_OF_4(4, 5, 6, 7), 1, f);
+#endif
+#if PG_LANES == 16
+  vstore16(PG_XYZW_OF_4(8, 9, a, b), 2, f);
+  vstore16(PG_XYZW_OF_4(c, d, e, f), 3, f);
+#endif
 #endif
 }
+#undef PG_XYZW_OF_4
 
 /* The same for two rows stored as PG_LANES consecutive float2. */
+#define PG_XY_OF_8(a, b, c, d, e, g, h, i)                                                  \
+  (float16)(x.s##a, y.s##a, x.s##b, y.s##b, x.s##c, y.s##c, x.s##d, y.s##d, x.s##e, y.s##e, \
+            x.s##g, y.s##g, x.s##h, y.s##h, x.s##i, y.s##i)
 PG_ROW_LOAD void pg_store_float2_rows(__global float2* p, pg_floatw x, pg_floatw y) {
   __global float* f = (__global float*)p;
-#if PG_LANES == 16
-  vstore16((float16)(x.s0, y.s0, x.s1, y.s1, x.s2, y.s2, x.s3, y.s3, x.s4, y.s4, x.s5, y.s5, x.s6,
-                     y.s6, x.s7, y.s7),
-           0, f);
-  vstore16((float16)(x.s8, y.s8, x.s9, y.s9, x.sa, y.sa, x.sb, y.sb, x.sc, y.sc, x.sd, y.sd, x.se,
-                     y.se, x.sf, y.sf),
-           1, f);
-#elif PG_LANES == 8
-  vstore16((float16)(x.s0, y.s0, x.s1, y.s1, x.s2, y.s2, x.s3, y.s3, x.s4, y.s4, x.s5, y.s5, x.s6,
-                     y.s6, x.s7, y.s7),
-           0, f);
+#if PG_LANES == 2
+  vstore4((float4)(x.s0, y.s0, x.s1, y.s1), 0, f);
 #elif PG_LANES == 4
   vstore8((float8)(x.s0, y.s0, x.s1, y.s1, x.s2, y.s2, x.s3, y.s3), 0, f);
-#elif PG_LANES == 2
-  vstore4((float4)(x.s0, y.s0, x.s1, y.s1), 0, f);
 #else
-#error "PG_LANES must be 2, 4, 8 or 16"
+  vstore16(PG_XY_OF_8(0, 1, 2, 3, 4, 5, 6, 7), 0, f);
+#if PG_LANES == 16
+  vstore16(PG_XY_OF_8(8, 9, a, b, c, d, e, f), 1, f);
+#endif
 #endif
 }
+#undef PG_XY_OF_8
 
 /* Four rows stored as the float4 channel of the pixels x0 .. x0 + PG_LANES - 1 of one row (x0 >=
  * 0): vector stores where every lane lies inside the row, lane by lane up to its end otherwise. */

@@ -17,6 +17,7 @@
 #include "scene/scene_loader.h"
 #include "shared/pmm.h"
 #include "support/pmm_checks.h"
+#include "support/scene_edits.h"
 
 namespace rtpg {
 namespace {
@@ -109,15 +110,9 @@ GuidedRun run_guided(const Scene& scene, int size, int frames, const std::string
 
 TEST(Extremes, TinyLightOfEmissionAMillion) {
   Scene scene = cornell_box();
-  for (Mesh& mesh : scene.meshes) {
-    Material& mat = scene.materials[mesh.material];
-    if (!mat.is_emissive()) continue;
-    glm::vec3 centre(0.0f);
-    for (const glm::vec3& v : mesh.positions) centre += v;
-    centre /= static_cast<float>(mesh.positions.size());
-    for (glm::vec3& v : mesh.positions) v = centre + (v - centre) * 1e-3f;
-    mat.emission = glm::vec3(1e6f);
-  }
+  test::resize_emitters(scene, 1e-3f, 1.0f);
+  for (Material& material : scene.materials)
+    if (material.is_emissive()) material.emission = glm::vec3(1e6f);
   const GuidedRun r = run_guided(scene, 32, 64, "", 8);
   EXPECT_EQ(r.frames_checked, 8);
   EXPECT_GT(r.pixels_with_model, 32u * 32u / 2) << "the guide should learn the small light";

@@ -17,6 +17,7 @@
 #include "render/image_io.h"
 #include "render/renderer.h"
 #include "scene/scene_loader.h"
+#include "support/scene_edits.h"
 
 namespace rtpg {
 namespace {
@@ -261,15 +262,7 @@ TEST(GuidingImage, UnbiasedWithLearnedMixingWeightAlongCameraPathAtTwoSpp) {
 // pixel keeps it apart from its path (PathTracer::VplPath; mutant vpl-left-out-light-unweighted).
 TEST(GuidingImage, UnbiasedUnderALargeLightWithEitherMisDensity) {
   Scene scene = load_scene(scene_file("cornell-box.json"));
-  for (Mesh& mesh : scene.meshes) {
-    Material& material = scene.materials[mesh.material];
-    if (!material.is_emissive()) continue;
-    glm::vec3 centre(0.0f);
-    for (const glm::vec3& v : mesh.positions) centre += v;
-    centre /= static_cast<float>(mesh.positions.size());
-    for (glm::vec3& v : mesh.positions) v = centre + (v - centre) * 3.6f;
-    material.emission /= 3.6f * 3.6f;
-  }
+  test::resize_emitters(scene, 3.6f, 1.0f / (3.6f * 3.6f));
   struct Variant {
     FirstBounceMis mis;
     bool direct_light_in_vpls;
