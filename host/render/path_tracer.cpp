@@ -416,18 +416,16 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       const glm::vec3 weight = shared::pg_bsdf_eval(lobes, wo, bs.wi) * (bs.wi.z / bs.pdf);
       p.throughput *= weight;
       // Russian roulette and the end of a black path look at the throughput from the camera
-      // (measured from y where VPLs are kept: VplPath).
-      const auto from_camera = [&] {
-        return vpls ? vpl_paths_[i].first_throughput * p.throughput : p.throughput;
-      };
+      // (measured from y where VPLs are kept: VplPath; times 1, exact, where not).
+      const glm::vec3 to_y = vpls ? vpl_paths_[i].first_throughput : glm::vec3(1.0f);
       if (depth >= settings_.roulette_start) {
-        const glm::vec3 t = from_camera();
+        const glm::vec3 t = to_y * p.throughput;
         const float q = std::min(0.95f, std::max(t.x, std::max(t.y, t.z)));
         if (!(u_rr < q)) continue;
         p.throughput /= q;
       }
-      const glm::vec3 t = from_camera();
-      if (is_black(t) || !is_finite(t)) continue;
+      const glm::vec3 from_camera = to_y * p.throughput;
+      if (is_black(from_camera) || !is_finite(from_camera)) continue;
       p.prev_pdf = bs.pdf;
       p.prev_position = sp.position;
       Ray next;
