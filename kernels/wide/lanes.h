@@ -161,17 +161,22 @@ static inline pg_floatw pg_load_row_floats(__global const float* row, int x0, in
   return pg_vloadw(0, v);
 }
 
-/* Stores v to the pixels x0 .. x0 + PG_LANES - 1 of a float row (x0 >= 0): one vector store
- * where every lane lies inside the row, lane by lane up to its end otherwise. */
-static inline void pg_store_row_floats(__global float* row, int x0, int width, pg_floatw v) {
-  if (x0 + PG_LANES <= width) {
-    pg_vstorew(v, 0, row + x0);
-    return;
+/* Stores v to the pixels x0 .. x0 + PG_LANES - 1 of a float (uint) row (x0 >= 0): one vector
+ * store where every lane lies inside the row, lane by lane up to its end otherwise. One body for
+ * both element types (OpenCL C has no templates). */
+#define PG_STORE_ROW(name, type, typew)                                     \
+  static inline void name(__global type* row, int x0, int width, typew v) { \
+    if (x0 + PG_LANES <= width) {                                           \
+      pg_vstorew(v, 0, row + x0);                                           \
+      return;                                                               \
+    }                                                                       \
+    type lanes[PG_LANES];                                                   \
+    pg_vstorew(v, 0, lanes);                                                \
+    for (int l = 0; x0 + l < width; ++l) row[x0 + l] = lanes[l];            \
   }
-  float lanes[PG_LANES];
-  pg_vstorew(v, 0, lanes);
-  for (int l = 0; x0 + l < width; ++l) row[x0 + l] = lanes[l];
-}
+PG_STORE_ROW(pg_store_row_floats, float, pg_floatw)
+PG_STORE_ROW(pg_store_row_uints, uint, pg_uintw)
+#undef PG_STORE_ROW
 
 /* The x, y, z and w of four lanes (a, b, c, d: their swizzle digits), interleaved. */
 #define PG_XYZW_OF_4(a, b, c, d)                                                            \
@@ -244,17 +249,6 @@ PG_ROW_LOAD void pg_store_row_float2_rows(__global float2* row, int x0, int widt
   pg_vstorew(x, 0, v[0]);
   pg_vstorew(y, 0, v[1]);
   for (int l = 0; x0 + l < width; ++l) row[x0 + l] = (float2)(v[0][l], v[1][l]);
-}
-
-/* A uint row stored to the same pixels (the same rule). */
-static inline void pg_store_row_uints(__global uint* row, int x0, int width, pg_uintw v) {
-  if (x0 + PG_LANES <= width) {
-    pg_vstorew(v, 0, row + x0);
-    return;
-  }
-  uint lanes[PG_LANES];
-  pg_vstorew(v, 0, lanes);
-  for (int l = 0; x0 + l < width; ++l) row[x0 + l] = lanes[l];
 }
 
 /* Zeroes the pixels x0 .. x0 + PG_LANES - 1 of a uchar row (x0 >= 0) up to the row's end: one
