@@ -41,12 +41,14 @@
 //   reproject  flags 4 + base_color_roughness 16 + state out 32; guided pixels + motion 8;
 //              inside the image + position_depth 2x16 + normal 2x16 + material 2x4;
 //              accepted + last frame's state 32
-//   sample     flags 4 + direction_pdf/strategy out 20; surfaces + bcr, normal, view,
-//              metallic 4x16; guided + state 32
-//   train      state in 32 + out 32 + flags 4 + bcr 16 + trained 1 + VPLs 48; guided +
-//              position, normal, view, metallic 4x16
+//   sample     flags 4 + direction_pdf/strategy out 20 (the renderer's SampleOutputs::
+//              directions: no mixture); surfaces + bcr, normal, view, metallic 4x16; guided +
+//              state 32
+//   train      state in 32 + out 32 + flags 4 + bcr 16 + VPLs 48; guided + position, normal,
+//              view, metallic 4x16 (the work-groups' count records: a few bytes per group)
 // FrameTraffic/WxH/{pageable,pinned}: one guided frame's copies between host and device when
-// they do not share memory (G-buffer and VPLs up, samples down: bytes_per_pixel) and the rate
+// they do not share memory (G-buffer and VPLs up, the samples' directions, densities and
+// strategies down, as the renderer moves them without the mixture: bytes_per_pixel) and the rate
 // they reach (host_device_GBps), from std::vector or from pinned staging memory.
 // TrainTbb runs train.cl's loop (global-memory variant) as plain C++ over TBB on the same
 // inputs, calling the same shared functions, and reports kernel_over_tbb = kernel ms / TBB ms
@@ -285,7 +287,7 @@ void count_bytes(Inputs& in, const pg_kernel_settings& p) {
       }
       in.reproject_bytes += r;
       in.sample_bytes += 4 + 20 + (sky ? 0 : 4 * 16) + (applies ? 32 : 0);
-      in.train_bytes += 32 + 32 + 4 + 16 + 1 + 48 + (applies ? 4 * 16 : 0);
+      in.train_bytes += 32 + 32 + 4 + 16 + 48 + (applies ? 4 * 16 : 0);
     }
 }
 
@@ -416,7 +418,7 @@ double launch(Guider& g, Inputs& in, Kernel k, std::uint32_t frame) {
       g.reproject(in.d_cur, in.d_prev);  // its cost does not depend on the state's values
       return g.last_times().reproject_ms;
     case Kernel::Sample:
-      g.sample(in.d_cur, 1u, frame, 0u, in.d_samples);
+      g.sample(in.d_cur, 1u, frame, 0u, in.d_samples, SampleOutputs::directions);
       return g.last_times().sample_ms;
     case Kernel::Train:
       g.write_state(in.state);  // the same trained-like states every time (untimed)
@@ -653,7 +655,9 @@ double frame_traffic(Inputs& in, const G& gbuffer, const V& vpls, S& samples) {
   cl::CommandQueue& q = runtime().queue();
   enqueue_upload(q, gbuffer, in.d_cur);
   enqueue_upload(q, vpls, in.d_vpls);
-  enqueue_download(q, in.d_samples, samples);
+  // The renderer's download without the mixture: direction_pdf and strategy.
+  detail::enqueue_read<16>(q, in.d_samples.direction_pdf, samples.direction_pdf);
+  detail::enqueue_read<4>(q, in.d_samples.strategy, samples.strategy);
   q.finish();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -663,8 +667,7 @@ void BM_FrameTraffic(benchmark::State& state, int w, int h, bool pinned) {
   Inputs& in = inputs_for(w, h);
   constexpr std::size_t kBytes =
 #define RTPG_BENCH_ADD(name, type, bytes) +(bytes)
-      0 PG_GBUFFER_CHANNELS(RTPG_BENCH_ADD) PG_VPL_CHANNELS(RTPG_BENCH_ADD)
-          PG_SAMPLE_CHANNELS(RTPG_BENCH_ADD);
+      0 PG_GBUFFER_CHANNELS(RTPG_BENCH_ADD) PG_VPL_CHANNELS(RTPG_BENCH_ADD) + 16 + 4;
 #undef RTPG_BENCH_ADD
   std::unique_ptr<PinnedFrame> staged;
   HostSamples host_samples;

@@ -1,24 +1,28 @@
 /* The first-bounce direction of every surface pixel from its mixture (paper eq. 2, 3.1):
  * the Gaussian with probability pi, else the BSDF; skipped pixels and pixels without a model
  * sample the BSDF. Writes the world direction with the mixture density (one-sample MIS), the
- * strategy that produced it, and the mixture itself (for the host's MIS weights). */
+ * strategy that produced it, the mixture itself where write_mixture is 1 (for a host that
+ * evaluates it in its MIS weights), and the work-group's counts (include/rtpg/guiding_layout.h,
+ * "Counts"). */
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
 #include "shared/pmm.h"
 #include "shared/rng.h"
+#include "shared/work_group_sum.h"
 
-__kernel void sample(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint width, uint height,
-                     uint seed, uint frame, uint sample_index, pg_kernel_settings settings) {
-  uint x = get_global_id(0), y = get_global_id(1);
-  if (x >= width || y >= height) return;
-  uint i = y * width + x;
+/* One pixel inside the image; returns its counts (surface, guided, pi, 0). */
+static float4 pg_sample_pixel(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint i, uint seed,
+                              uint frame, uint sample_index, uint write_mixture,
+                              pg_kernel_settings settings) {
   uint f = flags[i];
   if ((f & PG_GBUF_SKY) != 0u) {
     direction_pdf[i] = (float4)(0.0f, 0.0f, 1.0f, 0.0f);
     strategy[i] = PG_STRATEGY_NONE;
-    mixture_a[i] = (float4)(0.0f);
-    mixture_b[i] = (float2)(0.0f);
-    return;
+    if (write_mixture) {
+      mixture_a[i] = (float4)(0.0f);
+      mixture_b[i] = (float2)(0.0f);
+    }
+    return (float4)(0.0f);
   }
   float4 bcr = base_color_roughness[i];
   pg_pmm_state state = pg_pmm_initial_state();
@@ -38,6 +42,20 @@ __kernel void sample(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint width
   float3 w = pg_to_world(frame_x, s.wi);
   direction_pdf[i] = (float4)(w.x, w.y, w.z, s.pdf);
   strategy[i] = s.strategy;
-  mixture_a[i] = pg_pmm_mixture_a(model);
-  mixture_b[i] = pg_pmm_mixture_b(model);
+  if (write_mixture) {
+    mixture_a[i] = pg_pmm_mixture_a(model);
+    mixture_b[i] = pg_pmm_mixture_b(model);
+  }
+  return model.valid ? (float4)(1.0f, 1.0f, model.pi, 0.0f) : (float4)(1.0f, 0.0f, 0.0f, 0.0f);
+}
+
+__kernel void sample(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES __global float4* counts,
+                     uint width, uint height, uint seed, uint frame, uint sample_index,
+                     uint write_mixture, pg_kernel_settings settings, __local float4* scratch) {
+  uint x = get_global_id(0), y = get_global_id(1);
+  float4 count = (float4)(0.0f);
+  if (x < width && y < height)
+    count = pg_sample_pixel(PG_PASS_GBUFFER PG_PASS_IN_STATE PG_PASS_SAMPLES y * width + x, seed,
+                            frame, sample_index, write_mixture, settings);
+  pg_store_work_group_counts(counts, scratch, count);
 }

@@ -4,14 +4,14 @@
  * Every lane runs both components' samplers and keeps its own by a select (kernels/wide/
  * pmm_wide.h); a work-item skips the Gaussian when none of its lanes picks it and the GGX lobe
  * when none of its lanes has one. Sky pixels and pixels guiding skips are written as sample.cl
- * writes them. */
+ * writes them; so are the mixture (where write_mixture is 1) and the work-group's counts. */
 /* No fused multiply-adds (as in train_wide.cl): near the peak of a narrow GGX lobe D's
  * denominator is a difference of nearly equal numbers, where one fused product moves the
  * density by percents (tests/guiding/test_guiding_kernels.cpp). */
 /* Per pixel (hand count; docs/guiding.md, "The roofline"): 232 flops for a Lambert pixel
  * sampling its BSDF (11 divisions, 6 sqrt/sin/cos), +181 where a lane has a GGX lobe, +72 for a
  * trained model's density, +59 where a lane picks the Gaussian (544 at most); 68-100 bytes read,
- * 44 written. */
+ * 20 written (44 with the mixture). */
 #pragma OPENCL FP_CONTRACT OFF
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
@@ -19,12 +19,14 @@
 #include "shared/rng.h"
 #include "wide/guiding_pixel_wide.h"
 #include "wide/pmm_wide.h"
+#include "shared/work_group_sum.h"
 #include "wide/rng_wide.h"
 
-__kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint width, uint height,
-                          uint seed, uint frame, uint sample_index, pg_kernel_settings settings) {
-  int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
-  if (x0 >= (int)width || y >= (int)height) return;
+/* The lanes' pixels x0 .. x0 + PG_LANES - 1 of row y (x0 inside the image); returns their
+ * counts (surfaces, guided, pi, 0). */
+static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES int x0, int y,
+                              uint width, uint seed, uint frame, uint sample_index,
+                              uint write_mixture, pg_kernel_settings settings) {
   int w = (int)width, row_start = y * w;
 
   /* The lanes' inputs, loaded as vectors (kernels/wide/lanes.h). A lane past the row's end
@@ -78,10 +80,29 @@ __kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint 
   pg_store_row_float4_rows(direction_pdf + row_start, x0, w, direction.x, direction.y, direction.z,
                            pdf);
   pg_store_row_uints(strategy + row_start, x0, w, strategy_w);
-  /* pg_pmm_mixture_a and _b: an invalid model (and a sky pixel) is all zeros. */
-  pg_store_row_float4_rows(mixture_a + row_start, x0, w, select(zero, m.pi, m.valid),
-                           select(zero, m.mx, m.valid), select(zero, m.my, m.valid),
-                           select(zero, m.l11, m.valid));
-  pg_store_row_float2_rows(mixture_b + row_start, x0, w, select(zero, m.l21, m.valid),
-                           select(zero, m.l22, m.valid));
+  pg_intw inside = x0 + pg_lane_numbers() < w;
+  if (write_mixture) {
+    /* pg_pmm_mixture_a and _b: an invalid model (and a sky pixel) is all zeros. */
+    pg_store_row_float4_rows(mixture_a + row_start, x0, w, select(zero, m.pi, m.valid),
+                             select(zero, m.mx, m.valid), select(zero, m.my, m.valid),
+                             select(zero, m.l11, m.valid));
+    pg_store_row_float2_rows(mixture_b + row_start, x0, w, select(zero, m.l21, m.valid),
+                             select(zero, m.l22, m.valid));
+  }
+  pg_intw guided = inside & m.valid;
+  return (float4)(pg_sum_lanes(select(zero, (pg_floatw)(1.0f), inside & ~sky)),
+                  pg_sum_lanes(select(zero, (pg_floatw)(1.0f), guided)),
+                  pg_sum_lanes(select(zero, m.pi, guided)), 0.0f);
+}
+
+__kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES __global float4* counts,
+                          uint width, uint height, uint seed, uint frame, uint sample_index,
+                          uint write_mixture, pg_kernel_settings settings,
+                          __local float4* scratch) {
+  int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
+  float4 count = (float4)(0.0f);
+  if (x0 < (int)width && y < (int)height)
+    count = pg_sample_lanes(PG_PASS_GBUFFER PG_PASS_IN_STATE PG_PASS_SAMPLES x0, y, width, seed,
+                            frame, sample_index, write_mixture, settings);
+  pg_store_work_group_counts(counts, scratch, count);
 }

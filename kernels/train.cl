@@ -2,56 +2,33 @@
  * 4.2). Built in two variants (build option PG_TRAIN_LOCAL_TILE): 1 loads the work-group's
  * VPL tile plus an apron of `apron` pixels into local memory first (what GPUs need); 0 reads
  * the same VPLs straight from global memory (faster on PoCL's CPU device, docs/guiding.md).
- * Both give identical results. trained[i] is 1 where the state changed.
- * The state is updated in place: a pixel reads and writes only its own, so a pixel that does
- * not train this frame (no guiding, or a mature pixel off its turn) reads its flags, roughness
- * and k and writes nothing but its trained flag (docs/guiding.md, "Training in place; row loads
- * inlined"). */
+ * Both give identical results. The work-group's record counts the pixels whose state changed
+ * (include/rtpg/guiding_layout.h, "Counts"). The state is updated in place: a pixel reads and
+ * writes only its own, so a pixel that does not train this frame (no guiding, or a mature pixel off
+ * its turn) reads its flags, roughness and k and writes nothing (docs/guiding.md, "Training in
+ * place; row loads inlined"). */
 #include "shared/kernel_args.h"
 #include "shared/pmm_train.h"
+#include "shared/work_group_sum.h"
 
 #ifndef PG_TRAIN_LOCAL_TILE
 #define PG_TRAIN_LOCAL_TILE 1
 #endif
 
-__kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uchar* trained, uint width,
-                    uint height, uint seed, uint frame, pg_kernel_settings settings,
-                    __local float4* tile_position, __local float4* tile_normal,
-                    __local float4* tile_radiance) {
-  int x = (int)get_global_id(0), y = (int)get_global_id(1);
+/* Pixel (x, y) inside the image, its window's VPLs in the tile (PG_TRAIN_LOCAL_TILE 1) or in
+ * global memory; returns 1 where its state changed. */
+static int pg_train_pixel_at(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x, int y, uint width,
+                             uint height, uint seed, uint frame, pg_kernel_settings settings,
+                             __local const float4* tile_position, __local const float4* tile_normal,
+                             __local const float4* tile_radiance) {
   int apron = settings.apron;
 #if PG_TRAIN_LOCAL_TILE
-  int lw = (int)get_local_size(0), lh = (int)get_local_size(1);
-  int tw = lw + 2 * apron, th = lh + 2 * apron;
-  int ox = (int)(get_group_id(0) * get_local_size(0)) - apron;
-  int oy = (int)(get_group_id(1) * get_local_size(1)) - apron;
-  for (int t = (int)(get_local_id(1) * get_local_size(0) + get_local_id(0)); t < tw * th;
-       t += lw * lh) {
-    int sx = ox + t % tw, sy = oy + t / tw;
-    if (sx >= 0 && sy >= 0 && sx < (int)width && sy < (int)height) {
-      int j = sy * (int)width + sx;
-      tile_position[t] = vpl_position[j];
-      tile_normal[t] = vpl_normal[j];
-      tile_radiance[t] = vpl_radiance_info[j];
-    } else {
-      tile_position[t] = (float4)(0.0f);
-      tile_normal[t] = (float4)(0.0f);
-      tile_radiance[t] = (float4)(0.0f); /* info 0: not a VPL */
-    }
-  }
-  barrier(CLK_LOCAL_MEM_FENCE);
+  int tw = (int)get_local_size(0) + 2 * apron;
 #endif
-  if (x >= (int)width || y >= (int)height) return;
   int i = y * (int)width + x;
   float4 bcr = base_color_roughness[i];
-  if (!pg_guiding_applies(flags[i], bcr.w, settings)) {
-    trained[i] = 0;
-    return;
-  }
-  if (!pg_train_this_frame(state1[i].w, x, y, frame, settings)) {
-    trained[i] = 0;
-    return;
-  }
+  if (!pg_guiding_applies(flags[i], bcr.w, settings)) return 0;
+  if (!pg_train_this_frame(state1[i].w, x, y, frame, settings)) return 0;
   pg_pmm_state state;
   state.s0 = state0[i];
   state.s1 = state1[i];
@@ -86,5 +63,40 @@ __kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uchar* t
                        &updated);
   state0[i] = state.s0;
   state1[i] = state.s1;
-  trained[i] = (uchar)updated;
+  return updated;
+}
+
+__kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global float4* counts, uint width,
+                    uint height, uint seed, uint frame, pg_kernel_settings settings,
+                    __local float4* tile_position, __local float4* tile_normal,
+                    __local float4* tile_radiance, __local float4* scratch) {
+  int x = (int)get_global_id(0), y = (int)get_global_id(1);
+#if PG_TRAIN_LOCAL_TILE
+  int apron = settings.apron;
+  int lw = (int)get_local_size(0), lh = (int)get_local_size(1);
+  int tw = lw + 2 * apron, th = lh + 2 * apron;
+  int ox = (int)(get_group_id(0) * get_local_size(0)) - apron;
+  int oy = (int)(get_group_id(1) * get_local_size(1)) - apron;
+  for (int t = (int)(get_local_id(1) * get_local_size(0) + get_local_id(0)); t < tw * th;
+       t += lw * lh) {
+    int sx = ox + t % tw, sy = oy + t / tw;
+    if (sx >= 0 && sy >= 0 && sx < (int)width && sy < (int)height) {
+      int j = sy * (int)width + sx;
+      tile_position[t] = vpl_position[j];
+      tile_normal[t] = vpl_normal[j];
+      tile_radiance[t] = vpl_radiance_info[j];
+    } else {
+      tile_position[t] = (float4)(0.0f);
+      tile_normal[t] = (float4)(0.0f);
+      tile_radiance[t] = (float4)(0.0f); /* info 0: not a VPL */
+    }
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+#endif
+  float trained = 0.0f;
+  if (x < (int)width && y < (int)height)
+    trained =
+        (float)pg_train_pixel_at(PG_PASS_GBUFFER PG_PASS_VPLS PG_PASS_STATE x, y, width, height,
+                                 seed, frame, settings, tile_position, tile_normal, tile_radiance);
+  pg_store_work_group_counts(counts, scratch, (float4)(trained, 0.0f, 0.0f, 0.0f));
 }

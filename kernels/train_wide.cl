@@ -5,9 +5,10 @@
  * pixel, N neighbour VPLs of the (2*apron+1)^2 window turned into samples, then
  * pg_pmm_train's E-step passes and M-steps. Trip counts are the largest of the lanes; a lane
  * past its own count is masked. VPLs are read from global memory (no tile: a CPU device's
- * caches hold the window). trained[i] is 1 where the state changed. The state is updated in
- * place, as in train.cl: a work-item none of whose lanes trains this frame reads the lanes'
- * flags, roughness and k and writes only their trained flags. */
+ * caches hold the window). The work-group's record counts the pixels whose state changed
+ * (include/rtpg/guiding_layout.h, "Counts"). The state is updated in place, as in train.cl: a
+ * work-item none of whose lanes trains this frame reads the lanes' flags, roughness and k and
+ * writes nothing. */
 /* No fused multiply-adds, here or in the shared functions: the host reference runs them
  * unfused, and near the peak of a narrow GGX lobe (alpha 0.03) D's denominator is a difference
  * of nearly equal numbers, where one fused product moves D, and a sample's weight, by 1e-4
@@ -18,20 +19,20 @@
  * P = 3 with GGX (each M^-1 9 flops fewer since it lost its disk detour, two of them square
  * roots and one a division); with pi_learning 8 flops and 2 divisions more per neighbour and
  * pass. Bytes: 116 of its own + 48 N of neighbour VPLs read (each VPL once per
- * image from memory, the rest from cache), 33 written: compute-bound. A pixel that does not
- * train this frame: 36 read (20 where guiding does not apply), 1 written. */
+ * image from memory, the rest from cache), 32 written: compute-bound. A pixel that does not
+ * train this frame: 36 read (20 where guiding does not apply), none written. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
 #include "shared/pmm_train.h"
+#include "shared/work_group_sum.h"
 #include "wide/guiding_pixel_wide.h"
 #include "wide/pmm_train_wide.h"
 
-__kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uchar* trained,
-                         uint width, uint height, uint seed, uint frame,
-                         pg_kernel_settings settings) {
-  int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
-  if (x0 >= (int)width || y >= (int)height) return;
+/* The lanes' pixels x0 .. x0 + PG_LANES - 1 of row y (x0 inside the image); returns how many
+ * of them changed their state. */
+static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x0, int y, uint width,
+                            uint height, uint seed, uint frame, pg_kernel_settings settings) {
   int w = (int)width, row_start = y * w, apron = settings.apron, side = 2 * apron + 1;
 
   /* Per lane, as train.cl per work-item, loaded as vectors (kernels/wide/lanes.h): whether
@@ -46,10 +47,7 @@ __kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uch
   /* pg_guiding_applies and pg_train_this_frame per lane; the lanes share one run of
    * PG_TRAIN_RUN pixels, so the frame's rotation decides for all of them at once. */
   pg_intw active = (x0 + lane < w) & pg_guiding_applies_w(pixel_flags, roughness, settings);
-  if (!any(active)) {
-    pg_zero_row_uchars(trained + row_start, x0, w);
-    return;
-  }
+  if (!any(active)) return 0.0f;
   pg_pmm_state_w original;
   pg_load_row_float4_rows(state1 + row_start, x0, w, &original.sxx, &original.syy, &original.sxy,
                           &original.k);
@@ -59,10 +57,7 @@ __kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uch
       ((uint)x0 / PG_TRAIN_RUN + 3u * (uint)y + frame) % (uint)settings.train_interval == 0u;
   pg_intw mature = k >= 0.25f * settings.k_max;
   if (!run_trains) active &= ~mature;
-  if (!any(active)) {
-    pg_zero_row_uchars(trained + row_start, x0, w);
-    return;
-  }
+  if (!any(active)) return 0.0f;
   pg_load_row_float4_rows(state0 + row_start, x0, w, &original.w, &original.s0, &original.sx,
                           &original.sy);
   /* pg_pmm_neighbour_count, bounded by the window and the sample array. */
@@ -184,12 +179,25 @@ __kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global uch
   pg_vstorew(result.sxy, 0, st[6]);
   pg_vstorew(result.k, 0, st[7]);
   pg_vstorew(updated & 1, 0, changed);
+  float trained = 0.0f;
   for (int l = 0; l < PG_LANES; ++l) {
     int x = x0 + l;
     if (x >= w) break;
     int i = row_start + x;
     state0[i] = (float4)(st[0][l], st[1][l], st[2][l], st[3][l]);
     state1[i] = (float4)(st[4][l], st[5][l], st[6][l], st[7][l]);
-    trained[i] = (uchar)changed[l];
+    trained += (float)changed[l];
   }
+  return trained;
+}
+
+__kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global float4* counts,
+                         uint width, uint height, uint seed, uint frame,
+                         pg_kernel_settings settings, __local float4* scratch) {
+  int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
+  float trained = 0.0f;
+  if (x0 < (int)width && y < (int)height)
+    trained = pg_train_lanes(PG_PASS_GBUFFER PG_PASS_VPLS PG_PASS_STATE x0, y, width, height, seed,
+                             frame, settings);
+  pg_store_work_group_counts(counts, scratch, (float4)(trained, 0.0f, 0.0f, 0.0f));
 }

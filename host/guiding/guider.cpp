@@ -132,7 +132,14 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
       s.state0 = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, n * 16);
       s.state1 = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, n * 16);
     }
-    trained_ = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, n);
+    sample_launch_ = launch_of(sample_lanes_, /*pixel_kernel=*/true);
+    train_launch_ = launch_of(train_lanes_, /*pixel_kernel=*/false);
+    sample_groups_ = sample_launch_.groups;
+    train_groups_ = train_launch_.groups;
+    sample_counts_ =
+        cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, sample_groups_ * PG_COUNT_RECORD_BYTES);
+    train_counts_ =
+        cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, train_groups_ * PG_COUNT_RECORD_BYTES);
   });
   reset();
 }
@@ -144,14 +151,17 @@ void Guider::reset() {
   // memory as uninitialised even after a kernel has overwritten it, so every later kernel that
   // reads the state is flagged under --uninitialized (a false positive hiding real findings).
   const std::size_t n = static_cast<std::size_t>(width_) * height_;
-  const std::vector<float> zeros(n * 4, 0.0f);
-  const std::vector<cl_uchar> none(n, 0);
+  const std::vector<float> zeros(std::max(n, std::max(sample_groups_, train_groups_)) * 4, 0.0f);
   translate_cl_errors([&] {
     for (State& s : state_) {
       runtime_.queue().enqueueWriteBuffer(s.state0, CL_FALSE, 0, n * 16, zeros.data());
       runtime_.queue().enqueueWriteBuffer(s.state1, CL_FALSE, 0, n * 16, zeros.data());
     }
-    runtime_.queue().enqueueWriteBuffer(trained_, CL_FALSE, 0, n, none.data());
+    // No counts before the first sample() and train().
+    runtime_.queue().enqueueWriteBuffer(sample_counts_, CL_FALSE, 0,
+                                        sample_groups_ * PG_COUNT_RECORD_BYTES, zeros.data());
+    runtime_.queue().enqueueWriteBuffer(train_counts_, CL_FALSE, 0,
+                                        train_groups_ * PG_COUNT_RECORD_BYTES, zeros.data());
     runtime_.queue().finish();  // the host vectors must outlive the writes
   });
 }
@@ -175,16 +185,37 @@ void Guider::check_gbuffer(const GuiderGBuffer& g, const char* which) const {
 #undef RTPG_CHECK
 }
 
-double Guider::run(cl::Kernel& kernel, int lanes, bool pixel_kernel) {
+Guider::Launch Guider::launch_of(int lanes, bool pixel_kernel) const {
   const WorkGroupShape shape = pixel_kernel && pixel_rows_
                                    ? WorkGroupShape{true, row_items_, 1}
                                    : WorkGroupShape{false, group_x_, group_y_};
   const ImageLaunch launch = image_launch(width_, height_, lanes, shape);
+  Launch l{launch.global, launch.local, 1, 1};
+  for (int d = 0; d < 2; ++d) {
+    l.groups *= launch.global[d] / launch.local[d];
+    l.group_items *= launch.local[d];
+  }
+  return l;
+}
+
+double Guider::run(cl::Kernel& kernel, const Launch& launch) {
   cl::Event done;
   runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, launch.global, launch.local, nullptr,
                                         &done);
   done.wait();
   return ClRuntime::event_ms(done);
+}
+
+std::vector<double> Guider::sum_count_records(const cl::Buffer& records, std::size_t groups) {
+  std::vector<float> r(groups * 4);
+  translate_cl_errors([&] {
+    runtime_.queue().enqueueReadBuffer(records, CL_TRUE, 0, groups * PG_COUNT_RECORD_BYTES,
+                                       r.data());
+  });
+  std::vector<double> sum(4, 0.0);
+  for (std::size_t g = 0; g < groups; ++g)
+    for (int c = 0; c < 4; ++c) sum[c] += r[g * 4 + c];
+  return sum;
 }
 
 void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous) {
@@ -195,24 +226,26 @@ void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previo
     KernelArgs(reproject_) << current << previous << from.state0 << from.state1 << to.state0
                            << to.state1 << static_cast<cl_uint>(width_)
                            << static_cast<cl_uint>(height_) << kernel_settings_;
-    times_.reproject_ms = run(reproject_, 1, /*pixel_kernel=*/true);
+    times_.reproject_ms = run(reproject_, launch_of(1, /*pixel_kernel=*/true));
   });
   current_ = 1 - current_;
 }
 
 void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint32_t frame,
-                    std::uint32_t sample_index, const GuiderSamples& out) {
+                    std::uint32_t sample_index, const GuiderSamples& out, SampleOutputs outputs) {
   check_gbuffer(current, "current");
 #define RTPG_CHECK(name, type, bytes) check_buffer(out.name, bytes, "samples." #name);
   PG_SAMPLE_CHANNELS(RTPG_CHECK)
 #undef RTPG_CHECK
   const State& state = state_[current_];
   translate_cl_errors([&] {
-    KernelArgs(sample_) << current << state.state0 << state.state1 << out
+    const cl_uint write_mixture = outputs == SampleOutputs::directions_and_mixture ? 1 : 0;
+    KernelArgs(sample_) << current << state.state0 << state.state1 << out << sample_counts_
                         << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
                         << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame)
-                        << static_cast<cl_uint>(sample_index) << kernel_settings_;
-    times_.sample_ms = run(sample_, sample_lanes_, /*pixel_kernel=*/true);
+                        << static_cast<cl_uint>(sample_index) << write_mixture << kernel_settings_
+                        << cl::Local(sample_launch_.group_items * PG_COUNT_RECORD_BYTES);
+    times_.sample_ms = run(sample_, sample_launch_);
   });
 }
 
@@ -229,11 +262,12 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
                                        : 16;
   translate_cl_errors([&] {
     KernelArgs args(train_);
-    args << current << vpls << state.state0 << state.state1 << trained_
+    args << current << vpls << state.state0 << state.state1 << train_counts_
          << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
          << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame) << kernel_settings_;
     if (train_lanes_ == 1) args << cl::Local(tile) << cl::Local(tile) << cl::Local(tile);
-    times_.train_ms = run(train_, train_lanes_, /*pixel_kernel=*/false);
+    args << cl::Local(train_launch_.group_items * PG_COUNT_RECORD_BYTES);
+    times_.train_ms = run(train_, train_launch_);
   });
 }
 
@@ -271,11 +305,13 @@ void Guider::write_state(const std::vector<float>& state) {
 }
 
 std::size_t Guider::count_trained() {
-  const std::size_t n = static_cast<std::size_t>(width_) * height_;
-  std::vector<std::uint8_t> flags(n);
-  translate_cl_errors(
-      [&] { runtime_.queue().enqueueReadBuffer(trained_, CL_TRUE, 0, n, flags.data()); });
-  return static_cast<std::size_t>(std::count(flags.begin(), flags.end(), 1));
+  return static_cast<std::size_t>(sum_count_records(train_counts_, train_groups_)[0]);
+}
+
+GuiderSampleCounts Guider::sample_counts() {
+  const std::vector<double> sum = sum_count_records(sample_counts_, sample_groups_);
+  return GuiderSampleCounts{static_cast<std::size_t>(sum[0]), static_cast<std::size_t>(sum[1]),
+                            sum[2]};
 }
 
 }  // namespace rtpg

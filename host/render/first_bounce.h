@@ -70,6 +70,14 @@ class FirstBounceSampler {
   // frame's end_frame() (its reprojection reads last frame's): the renderer then writes each
   // frame into the other of two G-buffers, leaving last frame's untouched.
   virtual bool reads_gbuffers_in_place() const { return false; }
+  // What the path tracer will ask besides sample(): pdf() (under FirstBounceMis::mixture) and
+  // pixel_guide() (guided later vertices). The renderer announces it when the sampler is set;
+  // a sampler may then skip making what nobody reads (the guided one: the mixture's stores and
+  // copies, docs/design.md, "What crosses the bus"). Until told, a sampler answers both.
+  struct HostQueries {
+    bool pdf = true, pixel_guide = true;
+  };
+  virtual void expect_queries(const HostQueries& queries) {}
   // Figures of the last frame: times (ms) by kernel name, and other figures by name.
   virtual void report(std::map<std::string, double>& time_ms,
                       std::map<std::string, double>& extra) {}

@@ -3,10 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
+#include <string_view>
 
 #include "render/pinned_staging.h"
 #include "rtpg/cl_runtime.h"
@@ -25,6 +22,12 @@ constexpr std::size_t kGBufferBytes = 0 PG_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kVplBytes = 0 PG_VPL_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kSampleBytes = 0 PG_SAMPLE_CHANNELS(RTPG_ADD_BYTES);
 #undef RTPG_ADD_BYTES
+// Of which the mixture's channels (mixture_*), written only where the host reads them.
+#define RTPG_ADD_MIXTURE_BYTES(name, type, bytes) \
+  +(std::string_view(#name).substr(0, 8) == "mixture_" ? (bytes) : 0)
+constexpr std::size_t kMixtureBytes = 0 PG_SAMPLE_CHANNELS(RTPG_ADD_MIXTURE_BYTES);
+#undef RTPG_ADD_MIXTURE_BYTES
+static_assert(kMixtureBytes == 16 + 8, "mixture_a (float4) and mixture_b (float2)");
 #define RTPG_COUNT(name, type, bytes) +1
 constexpr std::size_t kGBufferChannels = 0 PG_GBUFFER_CHANNELS(RTPG_COUNT);
 constexpr std::size_t kVplChannels = 0 PG_VPL_CHANNELS(RTPG_COUNT);
@@ -111,8 +114,10 @@ void GuidedFirstBounce::unmap_samples() {
     cl::CommandQueue& q = runtime_.queue();
     q.enqueueUnmapMemObject(samples_.direction_pdf, const_cast<glm::vec4*>(view_.direction_pdf));
     q.enqueueUnmapMemObject(samples_.strategy, const_cast<std::uint32_t*>(view_.strategy));
-    q.enqueueUnmapMemObject(samples_.mixture_a, const_cast<glm::vec4*>(view_.mixture_a));
-    q.enqueueUnmapMemObject(samples_.mixture_b, const_cast<glm::vec2*>(view_.mixture_b));
+    if (view_.mixture_a != nullptr) {
+      q.enqueueUnmapMemObject(samples_.mixture_a, const_cast<glm::vec4*>(view_.mixture_a));
+      q.enqueueUnmapMemObject(samples_.mixture_b, const_cast<glm::vec2*>(view_.mixture_b));
+    }
   });
   view_ = SampleView{};
 }
@@ -148,9 +153,15 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   trained_fraction_ = 0.0;
 }
 
+void GuidedFirstBounce::expect_queries(const HostQueries& queries) {
+  host_reads_mixture_ = queries.pdf || queries.pixel_guide;
+}
+
 FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at) {
   unmap_samples();  // the kernel overwrites them
-  guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_);
+  guider_->sample(
+      current_gbuffer_, at.seed, at.frame, at.sample, samples_,
+      host_reads_mixture_ ? SampleOutputs::directions_and_mixture : SampleOutputs::directions);
   sample_ms_ += guider_->last_times().sample_ms;
   const std::size_t n = g.pixel_count();
   const auto t = Clock::now();
@@ -162,19 +173,26 @@ FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoord
       };
       view_.direction_pdf = static_cast<const glm::vec4*>(map(samples_.direction_pdf, 16));
       view_.strategy = static_cast<const std::uint32_t*>(map(samples_.strategy, 4));
-      view_.mixture_a = static_cast<const glm::vec4*>(map(samples_.mixture_a, 16));
-      view_.mixture_b = static_cast<const glm::vec2*>(map(samples_.mixture_b, 8));
+      if (host_reads_mixture_) {
+        view_.mixture_a = static_cast<const glm::vec4*>(map(samples_.mixture_a, 16));
+        view_.mixture_b = static_cast<const glm::vec2*>(map(samples_.mixture_b, 8));
+      }
       mapped_ = true;
       q.finish();
     });
   } else {
-    enqueue_download(runtime_.queue(), samples_, staged_);
+    if (host_reads_mixture_) {
+      enqueue_download(runtime_.queue(), samples_, staged_);
+      view_.mixture_a = staged_.mixture_a.data();
+      view_.mixture_b = staged_.mixture_b.data();
+    } else {
+      detail::enqueue_read<16>(runtime_.queue(), samples_.direction_pdf, staged_.direction_pdf);
+      detail::enqueue_read<4>(runtime_.queue(), samples_.strategy, staged_.strategy);
+    }
     translate_cl_errors([&] { runtime_.queue().finish(); });
-    bytes_ += kSampleBytes * n;
+    bytes_ += (host_reads_mixture_ ? kSampleBytes : kSampleBytes - kMixtureBytes) * n;
     view_.direction_pdf = staged_.direction_pdf.data();
     view_.strategy = staged_.strategy.data();
-    view_.mixture_a = staged_.mixture_a.data();
-    view_.mixture_b = staged_.mixture_b.data();
   }
   readback_ms_ += ms_since(t);
   // The path tracer reads the directions as the kernel wrote them (no copy); the statistics
@@ -182,33 +200,11 @@ FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoord
   return FirstBounceSamples{view_.direction_pdf, view_.strategy};
 }
 
-void GuidedFirstBounce::count_models(const GBuffer& g) {
+void GuidedFirstBounce::count_models() {
   // The share of surface pixels that sampled a trained Gaussian and their mean pi, from the
-  // mixtures of the frame's last sample() (statistics only).
-  if (view_.mixture_a == nullptr) return;
-  struct Counts {
-    std::size_t surfaces = 0, guided = 0;
-    double pi_sum = 0.0;
-  };
-  const Counts counts = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, std::min(g.pixel_count(), pixels_), 8192), Counts{},
-      [&](const tbb::blocked_range<std::size_t>& r, Counts c) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          if (!g.has_surface(i)) continue;
-          ++c.surfaces;
-          const glm::vec4 mixture = view_.mixture_a[i];
-          if (!(mixture.w > 0.0f)) continue;
-          ++c.guided;
-          c.pi_sum += mixture.x;
-        }
-        return c;
-      },
-      [](Counts a, const Counts& b) {
-        a.surfaces += b.surfaces;
-        a.guided += b.guided;
-        a.pi_sum += b.pi_sum;
-        return a;
-      });
+  // sample kernel's counts of the frame's last sample() (statistics only).
+  const GuiderSampleCounts counts = guider_->sample_counts();
+  bytes_ += guider_->sample_count_record_bytes();
   surfaces_ = counts.surfaces;
   guided_fraction_ = counts.surfaces
                          ? static_cast<double>(counts.guided) / static_cast<double>(counts.surfaces)
@@ -217,6 +213,10 @@ void GuidedFirstBounce::count_models(const GBuffer& g) {
 }
 
 shared::pg_pmm_model GuidedFirstBounce::model_at(std::size_t i) const {
+  if (!host_reads_mixture_)
+    throw GuiderError(
+        "guided first bounce: the mixture was not written (the renderer announced neither "
+        "pdf() nor pixel_guide(), FirstBounceSampler::expect_queries)");
   const glm::vec4 a = view_.mixture_a[i];
   const glm::vec2 b = view_.mixture_b[i];
   return shared::pg_pmm_model_from_mixture(shared::float4(a.x, a.y, a.z, a.w),
@@ -229,7 +229,7 @@ float GuidedFirstBounce::pdf(const GBuffer&, std::size_t i, const shared::pg_lob
 }
 
 bool GuidedFirstBounce::pixel_guide(const GBuffer& g, std::size_t i, PixelGuide& out) const {
-  if (view_.mixture_a == nullptr || i >= pixels_) return false;
+  if (host_reads_mixture_ && (view_.mixture_a == nullptr || i >= pixels_)) return false;
   out.model = model_at(i);
   if (!out.model.valid) return false;
   out.frame = gbuffer_frame(g, i);
@@ -241,7 +241,7 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   // Last frame's G-buffer is done with (reproject read it): in place, the host writes that
   // memory next frame, so its buffers are released first.
   previous_gbuffer_ = GuiderGBuffer{};
-  count_models(g);
+  count_models();
   if (!training_) return;
   const auto t = Clock::now();
   GuiderVpls device_vpls = owned_vpls_;
@@ -252,7 +252,7 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   }
   upload_ms_ += ms_since(t);
   guider_->train(current_gbuffer_, device_vpls, at.seed, at.frame);
-  bytes_ += g.pixel_count();  // the trained flags count_trained reads
+  bytes_ += guider_->train_count_record_bytes();  // what count_trained reads
   trained_fraction_ =
       surfaces_ ? static_cast<double>(guider_->count_trained()) / static_cast<double>(surfaces_)
                 : 0.0;

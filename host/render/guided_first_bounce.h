@@ -35,6 +35,9 @@ class GuidedFirstBounce final : public FirstBounceSampler {
                  const SampleCoordinates& at) override;
   bool wants_vpls() const override { return true; }
   bool reads_gbuffers_in_place() const override { return zero_copy_; }
+  // Without pdf() or pixel_guide() to answer, the sample kernel leaves the mixture unwritten
+  // and nothing of it is copied or mapped; the statistics come from the kernels' counts.
+  void expect_queries(const HostQueries& queries) override;
   HostTransfer host_transfer() const { return transfer_; }  // automatic resolved
   // This frame's G-buffer on the device where begin_frame copied g there (not in place): the
   // denoiser reads it instead of copying it again (SvgfDenoiser::denoise). Valid until the next
@@ -50,10 +53,11 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void set_training(bool on) { training_ = on; }
 
  private:
-  // The model pixel i sampled this frame (from the mixture the sample kernel wrote).
+  // The model pixel i sampled this frame (from the mixture the sample kernel wrote); throws
+  // GuiderError where the mixture was not asked for (expect_queries).
   shared::pg_pmm_model model_at(std::size_t i) const;
-  // surfaces_, guided_fraction_ and mean_pi_ from the mixtures of the last sample().
-  void count_models(const GBuffer& g);
+  // surfaces_, guided_fraction_ and mean_pi_ from the counts of the last sample().
+  void count_models();
   // Copies a host G-buffer or VPL buffer into its device buffers (pinned or pageable), waits,
   // and counts the bytes.
   template <class Host, class Device>
@@ -81,6 +85,7 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void unmap_samples();
   HostTransfer transfer_ = HostTransfer::automatic;
   bool zero_copy_ = false, mapped_ = false;
+  bool host_reads_mixture_ = true;  // expect_queries: pdf() or pixel_guide() will be asked
   GuiderSamples staging_;
   // HostTransfer::pinned: where the G-buffer and then the VPLs are copied on their way up.
   std::unique_ptr<PinnedStaging> upload_staging_;

@@ -62,6 +62,8 @@ void Renderer::set_first_bounce_sampler(std::unique_ptr<FirstBounceSampler> samp
                                                  " pixels");
     }
   }
+  sampler->expect_queries({settings_.path_tracer.first_bounce_mis == FirstBounceMis::mixture,
+                           settings_.path_tracer.guide_secondary});
   sampler_ = std::move(sampler);
 }
 

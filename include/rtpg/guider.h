@@ -154,6 +154,20 @@ GuiderVpls wrap_host_vpls(cl::Context& context, const HostVpls& host) {
   return dev;
 }
 
+// What sample() writes besides the directions, their densities and strategies: the mixture each
+// pixel sampled (GuiderSamples' mixture_a and mixture_b), for a host that evaluates it in its
+// MIS weights (include/rtpg/guiding_distribution.h); or nothing, which leaves those channels as
+// they were and saves the kernel 24 bytes a pixel of stores (and a discrete GPU's host their
+// copy).
+enum class SampleOutputs { directions_and_mixture, directions };
+
+// The statistics of the last sample() (include/rtpg/guiding_layout.h, "Counts"): surface pixels,
+// those whose mixture has a Gaussian, and the sum of their pi.
+struct GuiderSampleCounts {
+  std::size_t surfaces = 0, guided = 0;
+  double pi_sum = 0.0;
+};
+
 struct GuiderTimes {
   double reproject_ms = 0.0, sample_ms = 0.0, train_ms = 0.0;  // from profiling events
 };
@@ -185,7 +199,8 @@ class Guider {
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
   void reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous);
   void sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint32_t frame,
-              std::uint32_t sample_index, const GuiderSamples& out);
+              std::uint32_t sample_index, const GuiderSamples& out,
+              SampleOutputs outputs = SampleOutputs::directions_and_mixture);
   void train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::uint32_t seed,
              std::uint32_t frame);
 
@@ -193,17 +208,30 @@ class Guider {
   // include/rtpg/guiding_layout.h).
   void read_state(std::vector<float>& state);
   void write_state(const std::vector<float>& state);
-  // Pixels whose state the last train() changed (reads a byte per pixel back).
+  // Pixels whose state the last train() changed, and the counts of the last sample(): each
+  // reads the kernel's records back, PG_COUNT_RECORD_BYTES per work-group (count_record_bytes).
   std::size_t count_trained();
+  GuiderSampleCounts sample_counts();
+  std::size_t sample_count_record_bytes() const { return sample_groups_ * PG_COUNT_RECORD_BYTES; }
+  std::size_t train_count_record_bytes() const { return train_groups_ * PG_COUNT_RECORD_BYTES; }
 
   const GuiderTimes& last_times() const { return times_; }
 
  private:
   void check_gbuffer(const GuiderGBuffer& g, const char* which) const;
   void check_buffer(const cl::Buffer& b, std::size_t element_size, const std::string& name) const;
-  // Launches over the image, `lanes` pixels of a row per work-item, waits, returns profiled ms.
-  // pixel_kernel: the kernel reads its own pixels only (KernelReach::Pixel).
-  double run(cl::Kernel& kernel, int lanes, bool pixel_kernel);
+  // A kernel's launch over the image (host/cl/work_groups.h): `lanes` pixels of a row per
+  // work-item; pixel_kernel: it reads its own pixels only (KernelReach::Pixel), so it may run in
+  // rows.
+  struct Launch {
+    cl::NDRange global, local;
+    std::size_t groups = 0, group_items = 0;
+  };
+  Launch launch_of(int lanes, bool pixel_kernel) const;
+  // Launches, waits, returns profiled ms.
+  double run(cl::Kernel& kernel, const Launch& launch);
+  // Reads a kernel's count records (one float4 per work-group) and sums each component.
+  std::vector<double> sum_count_records(const cl::Buffer& records, std::size_t groups);
 
   ClRuntime& runtime_;
   ClRuntime::Use runtime_use_{runtime_};  // the runtime must outlive this
@@ -223,7 +251,10 @@ class Guider {
     cl::Buffer state0, state1;
   };
   State state_[2];  // reproject's source and destination (train updates the current in place)
-  cl::Buffer trained_;
+  // The sample and train kernels' count records, one float4 per work-group of their launches.
+  Launch sample_launch_, train_launch_;
+  std::size_t sample_groups_ = 0, train_groups_ = 0;
+  cl::Buffer sample_counts_, train_counts_;
   int current_ = 0;  // index of the buffers holding this frame's state
   cl::Kernel reproject_, sample_, train_;
   GuiderTimes times_;

@@ -66,12 +66,24 @@
  *                (0: no Gaussian, the pixel samples its BSDF alone)
  * mixture_b      x l21, y l22: the rest of the Cholesky factor of Sigma
  * With the mixture a host renderer evaluates the density for its MIS weights
- * (include/rtpg/guiding_distribution.h) without the state or its regularisation. */
+ * (include/rtpg/guiding_distribution.h) without the state or its regularisation; a renderer
+ * that does not can ask the kernel to leave mixture_a and mixture_b unwritten
+ * (rtpg::SampleOutputs::directions in include/rtpg/guider.h). */
 #define PG_SAMPLE_CHANNELS(X)  \
   X(direction_pdf, float4, 16) \
   X(strategy, uint, 4)         \
   X(mixture_a, float4, 16)     \
   X(mixture_b, float2, 8)
+
+/* ---- Counts: what the host's statistics need, one record per work-group ---------------
+ * The sample and train kernels each sum, over their work-group, one float4 of counts into the
+ * group's record (group g = get_group_id(1) * get_num_groups(0) + get_group_id(0)), so the host
+ * reads a few bytes per frame instead of a per-pixel buffer (docs/design.md, "What crosses the
+ * bus"). Whole counts are exact in float: a group holds at most a few thousand pixels.
+ * sample  x surface pixels (not PG_GBUF_SKY), y those whose mixture has a Gaussian (a valid
+ *         model: mixture_a.w > 0), z the sum of their pi, w 0 (written at every sample)
+ * train   x pixels whose state the step changed, yzw 0 */
+#define PG_COUNT_RECORD_BYTES 16
 
 #define PG_STRATEGY_NONE 0u  /* no surface, or no sample */
 #define PG_STRATEGY_BSDF 1u  /* the BSDF component: the only samples that train (paper 3.2) */

@@ -3,7 +3,8 @@
  * and the buffers themselves come from one description. OpenCL C only.
  *
  * A guiding kernel's parameters come in this order: the current G-buffer (every channel, in
- * list order), then whatever lists the kernel needs (PG_ARGS_*), then its scalars. */
+ * list order), then whatever lists the kernel needs (PG_ARGS_*), then its per-work-group
+ * counts (include/rtpg/guiding_layout.h, "Counts"), then its scalars, then its local memory. */
 #ifndef RTPG_SHARED_KERNEL_ARGS_H
 #define RTPG_SHARED_KERNEL_ARGS_H
 
@@ -25,5 +26,16 @@
 /* The state updated in place (train: each work-item reads and writes only its own pixels). */
 #define PG_ARGS_STATE PG_STATE_CHANNELS(PG_ARG_STATE)
 #define PG_ARGS_SAMPLES PG_SAMPLE_CHANNELS(PG_ARG_OUT)
+
+/* The same lists as arguments of a call, for a kernel that hands its buffers to a function of
+ * its own (a kernel with a work-group reduction at its end cannot return early). */
+#define PG_PASS_CHANNEL(name, type, bytes) name,
+#define PG_PASS_VPL_CHANNEL(name, type, bytes) vpl_##name,
+#define PG_PASS_IN_STATE_CHANNEL(name, type, bytes) in_##name,
+#define PG_PASS_GBUFFER PG_GBUFFER_CHANNELS(PG_PASS_CHANNEL)
+#define PG_PASS_VPLS PG_VPL_CHANNELS(PG_PASS_VPL_CHANNEL)
+#define PG_PASS_STATE PG_STATE_CHANNELS(PG_PASS_CHANNEL)
+#define PG_PASS_IN_STATE PG_STATE_CHANNELS(PG_PASS_IN_STATE_CHANNEL)
+#define PG_PASS_SAMPLES PG_SAMPLE_CHANNELS(PG_PASS_CHANNEL)
 
 #endif

@@ -32,7 +32,6 @@
 #define pg_floatw PG_PASTE(float, PG_LANES)
 #define pg_intw PG_PASTE(int, PG_LANES)
 #define pg_uintw PG_PASTE(uint, PG_LANES)
-#define pg_ucharw PG_PASTE(uchar, PG_LANES)
 #define pg_vloadw PG_PASTE(vload, PG_LANES)
 #define pg_vstorew PG_PASTE(vstore, PG_LANES)
 #define pg_convert_uintw PG_PASTE(convert_uint, PG_LANES)
@@ -251,14 +250,13 @@ PG_ROW_LOAD void pg_store_row_float2_rows(__global float2* row, int x0, int widt
   for (int l = 0; x0 + l < width; ++l) row[x0 + l] = (float2)(v[0][l], v[1][l]);
 }
 
-/* Zeroes the pixels x0 .. x0 + PG_LANES - 1 of a uchar row (x0 >= 0) up to the row's end: one
- * vector store where every lane lies inside the row. */
-static inline void pg_zero_row_uchars(__global uchar* row, int x0, int width) {
-  if (x0 + PG_LANES <= width) {
-    pg_vstorew((pg_ucharw)(0), 0, row + x0);
-    return;
-  }
-  for (int l = 0; x0 + l < width; ++l) row[x0 + l] = 0;
+/* The sum of a float vector's lanes, lane 0 first. */
+static inline float pg_sum_lanes(pg_floatw v) {
+  float a[PG_LANES];
+  pg_vstorew(v, 0, a);
+  float sum = a[0];
+  for (int l = 1; l < PG_LANES; ++l) sum += a[l];
+  return sum;
 }
 
 /* The largest lane of an int vector. */

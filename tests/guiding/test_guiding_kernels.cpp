@@ -713,6 +713,39 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
       rt.queue().enqueueReadBuffer(samples.strategy, CL_TRUE, 0, g.n() * 4, got_strategy.data());
       rt.queue().enqueueReadBuffer(samples.mixture_a, CL_TRUE, 0, g.n() * 16, got_mixture_a.data());
       rt.queue().enqueueReadBuffer(samples.mixture_b, CL_TRUE, 0, g.n() * 8, got_mixture_b.data());
+      // The work-groups' counts (include/rtpg/guiding_layout.h, "Counts") are those of the
+      // pixels' own outputs: every work-group shape and lane count sums every pixel once.
+      const GuiderSampleCounts counts = guider.sample_counts();
+      std::size_t surfaces = 0, with_gaussian = 0;
+      double pi_sum = 0.0;
+      for (std::size_t i = 0; i < g.n(); ++i) {
+        if ((g.flags[i] & PG_GBUF_SKY) != 0u) continue;
+        ++surfaces;
+        if (!(got_mixture_a[i].w > 0.0f)) continue;
+        ++with_gaussian;
+        pi_sum += got_mixture_a[i].x;
+      }
+      EXPECT_EQ(counts.surfaces, surfaces) << name(kc) << ", " << settings.sample_lanes << " lanes";
+      EXPECT_EQ(counts.guided, with_gaussian) << name(kc) << ", " << settings.sample_lanes;
+      EXPECT_NEAR(counts.pi_sum, pi_sum, 1e-5 * pi_sum)
+          << name(kc) << ", " << settings.sample_lanes;
+      // Without the mixture the kernel draws the same samples and leaves the mixture's
+      // channels as they were.
+      const std::vector<float4> marker(g.n(), float4(-7.0f));
+      rt.queue().enqueueWriteBuffer(samples.mixture_a, CL_TRUE, 0, g.n() * 16, marker.data());
+      guider.sample(dg, seed, frame, frame % 2u, samples, SampleOutputs::directions);
+      std::vector<float4> bare_dir(g.n()), bare_mixture_a(g.n());
+      std::vector<std::uint32_t> bare_strategy(g.n());
+      rt.queue().enqueueReadBuffer(samples.direction_pdf, CL_TRUE, 0, g.n() * 16, bare_dir.data());
+      rt.queue().enqueueReadBuffer(samples.strategy, CL_TRUE, 0, g.n() * 4, bare_strategy.data());
+      rt.queue().enqueueReadBuffer(samples.mixture_a, CL_TRUE, 0, g.n() * 16,
+                                   bare_mixture_a.data());
+      EXPECT_EQ(0, std::memcmp(bare_dir.data(), got_dir.data(), g.n() * 16)) << name(kc);
+      EXPECT_EQ(bare_strategy, got_strategy) << name(kc);
+      EXPECT_EQ(0, std::memcmp(bare_mixture_a.data(), marker.data(), g.n() * 16)) << name(kc);
+      const GuiderSampleCounts bare_counts = guider.sample_counts();
+      EXPECT_EQ(bare_counts.guided, counts.guided);
+      EXPECT_EQ(bare_counts.pi_sum, counts.pi_sum);
       host_sample(state, g, seed, frame, frame % 2u, p, want_dir, want_strategy, mixture);
       for (std::size_t i = 0; i < g.n(); ++i) {
         const float4 a = want_dir[i], b = got_dir[i];

@@ -298,7 +298,10 @@ TEST(GuidingImage, RejectsAFivePercentPdfError) {
 // reads the G-buffer and VPLs in place (the renderer alternating two G-buffers) and the host
 // reads the samples in place; elsewhere all three are copied. Both give the same image to the
 // bit, at 2 spp (the samples' mapping is released and renewed between samples) along a moving
-// camera, at an odd size, over enough frames for each G-buffer to be reused.
+// camera, at an odd size, over enough frames for each G-buffer to be reused. So does a sampler
+// told that the host reads the mixture (the sample kernel then writes it and the host copies or
+// maps it, which the renderer's default MIS does not need: FirstBounceSampler::expect_queries);
+// without that, asking for the mixture is an error, not a read of stale memory.
 TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
   ClRuntime cl;
   const Scene scene = load_scene(scene_file("cornell-box.json"));
@@ -307,28 +310,42 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
   settings.height = 23;
   settings.spp = 2;
   settings.camera_path = scene.camera.paths.begin()->first;
-  const HostTransfer transfers[] = {HostTransfer::in_place, HostTransfer::pinned,
-                                    HostTransfer::pageable, HostTransfer::automatic};
-  std::vector<glm::vec3> images[4];
-  for (int t = 0; t < 4; ++t) {
-    SCOPED_TRACE(host_transfer_name(transfers[t]));
+  struct Case {
+    HostTransfer transfer;
+    bool mixture;  // the host announced as reading the mixture
+  };
+  const Case cases[] = {{HostTransfer::in_place, false}, {HostTransfer::pinned, false},
+                        {HostTransfer::pageable, false}, {HostTransfer::automatic, false},
+                        {HostTransfer::in_place, true},  {HostTransfer::pinned, true}};
+  constexpr int kCases = static_cast<int>(std::size(cases));
+  std::vector<glm::vec3> images[kCases];
+  for (int t = 0; t < kCases; ++t) {
+    SCOPED_TRACE(std::string(host_transfer_name(cases[t].transfer)) +
+                 (cases[t].mixture ? ", mixture read" : ""));
     Renderer renderer(scene, settings);
     auto guided = std::make_unique<GuidedFirstBounce>(cl, settings.width, settings.height,
-                                                      GuidingSettings{}, transfers[t]);
+                                                      GuidingSettings{}, cases[t].transfer);
+    GuidedFirstBounce* sampler = guided.get();
     const HostTransfer used = guided->host_transfer();
+    const double count_records = static_cast<double>(sampler->guider().sample_count_record_bytes() +
+                                                     sampler->guider().train_count_record_bytes()) /
+                                 (settings.width * settings.height);
     renderer.set_first_bounce_sampler(std::move(guided));
+    if (cases[t].mixture) sampler->expect_queries({true, true});
     for (int f = 0; f < 5; ++f) {
       const FrameStats stats = renderer.render_frame(f);
       const bool in_place = used == HostTransfer::in_place;
       EXPECT_EQ(stats.extra.at("zero_copy"), in_place ? 1.0 : 0.0);
       EXPECT_EQ(stats.extra.at("host_transfer"), static_cast<double>(used));
-      // In place only the trained flags (a byte per pixel) are copied; otherwise the G-buffer
-      // (96 bytes a pixel) and VPLs (48) go up and each sample's 44 bytes come down
-      // (include/rtpg/guiding_layout.h).
-      EXPECT_EQ(stats.extra.at("host_device_bytes_per_pixel"),
-                in_place ? 1.0 : 96.0 + 44.0 * settings.spp + 48.0 + 1.0);
+      // In place only the kernels' count records are copied; otherwise the G-buffer (96 bytes
+      // a pixel) and VPLs (48) go up and each sample's direction, density and strategy (20) come
+      // down, with the mixture (24) where the host reads it (include/rtpg/guiding_layout.h).
+      const double sample_bytes = cases[t].mixture ? 44.0 : 20.0;
+      EXPECT_DOUBLE_EQ(
+          stats.extra.at("host_device_bytes_per_pixel"),
+          (in_place ? 0.0 : 96.0 + sample_bytes * settings.spp + 48.0) + count_records);
     }
-    if (transfers[t] == HostTransfer::automatic) {
+    if (cases[t].transfer == HostTransfer::automatic) {
       // RTPG_HOST_TRANSFER chooses where set (the tests' second run sets it to pinned).
       const char* env = std::getenv("RTPG_HOST_TRANSFER");
       const HostTransfer expected = env && *env && std::string(env) != "auto"
@@ -337,14 +354,27 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
                                                                     : HostTransfer::pinned;
       EXPECT_EQ(used, expected);
     }
+    const GBuffer& g = renderer.gbuffer();
+    const std::size_t pixel = g.pixel_count() / 2;
+    ASSERT_TRUE(g.has_surface(pixel));
+    const shared::pg_lobes lobes{};
+    if (cases[t].mixture) {
+      EXPECT_NO_THROW(sampler->pdf(g, pixel, lobes, glm::vec3(0, 0, 1), glm::vec3(0, 0, 1)));
+    } else {
+      EXPECT_THROW(sampler->pdf(g, pixel, lobes, glm::vec3(0, 0, 1), glm::vec3(0, 0, 1)),
+                   GuiderError);
+      PixelGuide guide;
+      EXPECT_THROW(sampler->pixel_guide(g, pixel, guide), GuiderError);
+    }
     images[t] = renderer.image();
   }
-  for (int t = 1; t < 4; ++t) {
+  for (int t = 1; t < kCases; ++t) {
     ASSERT_EQ(images[0].size(), images[t].size());
     std::size_t differ = 0;
     for (std::size_t i = 0; i < images[0].size(); ++i) differ += images[0][i] != images[t][i];
-    EXPECT_EQ(differ, 0u) << host_transfer_name(transfers[t]) << ": of " << images[0].size()
-                          << " pixels";
+    EXPECT_EQ(differ, 0u) << host_transfer_name(cases[t].transfer)
+                          << (cases[t].mixture ? ", mixture read" : "") << ": of "
+                          << images[0].size() << " pixels";
   }
 }
 
