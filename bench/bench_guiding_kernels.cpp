@@ -323,9 +323,9 @@ void count_flops(Inputs& in, const pg_kernel_settings& p) {
         in.reproject_flops += 78;
         if (sh::pg_pmm_needs_reframe(sh::pg_frame_from_normal(m), frame)) in.reproject_flops += 399;
       }
-      // sample: BSDF sampling and its density (232), the GGX lobe (181), a trained model's
-      // density (81) and the Gaussian's sampler (59, counted for every trained pixel).
-      in.sample_flops += 232 + (ggx ? 181 : 0) + (k > 0.0f ? 81 + 59 : 0);
+      // sample: BSDF sampling and its density (248), the GGX lobe (213), a trained model's
+      // density (72) and the Gaussian's sampler (107, counted for every trained pixel).
+      in.sample_flops += 248 + (ggx ? 213 : 0) + (k > 0.0f ? 72 + 107 : 0);
       // train: 162 + b N + 63 N P + 182 P (b = 128, 234 with GGX; P passes; N neighbours), the
       // count beside kernels/train_wide.cl.
       const int n_samples =

@@ -8,9 +8,11 @@
 /* No fused multiply-adds (as in train_wide.cl): near the peak of a narrow GGX lobe D's
  * denominator is a difference of nearly equal numbers, where one fused product moves the
  * density by percents (tests/guiding/test_guiding_kernels.cpp). */
-/* Per pixel (hand count; docs/guiding.md, "The roofline"): 232 flops for a Lambert pixel
- * sampling its BSDF (11 divisions, 6 sqrt/sin/cos), +181 where a lane has a GGX lobe, +72 for a
- * trained model's density, +59 where a lane picks the Gaussian (544 at most); 68-100 bytes read,
+/* Per pixel (hand count; docs/guiding.md, "The roofline"): 248 flops for a Lambert pixel
+ * sampling its BSDF (11 divisions, 4 sqrt; cos and sin by polynomials, kernels/wide/
+ * sincos_wide.h: 17 flops for an angle of the octant, 35 for a fraction of a turn), +213 where a
+ * lane has a GGX lobe, +72 for a trained model's density, +107 where a lane picks the Gaussian
+ * (640 at most); 68-100 bytes read,
  * 20 written (44 with the mixture). */
 #pragma OPENCL FP_CONTRACT OFF
 #include "shared/guiding_pixel.h"

@@ -10,6 +10,7 @@
 
 #include "shared/compat.h"
 #include "shared/mapping.h"
+#include "shared/sincos.h"
 
 PG_NAMESPACE_BEGIN
 
@@ -124,9 +125,9 @@ PG_FN float3 pg_ggx_sample_visible_normal(float3 wo, float alpha, float u1, floa
                            : pg_make_float3(1.0f, 0.0f, 0.0f);
   float3 t2 = cross(vh, t1);
   float r = sqrt(u1);
-  float phi = 2.0f * PG_PI * u2;
-  float p1 = r * cos(phi);
-  float p2 = r * sin(phi);
+  float2 cs = pg_cos_sin_turn(u2); /* phi = 2 pi u2 */
+  float p1 = r * cs.x;
+  float p2 = r * cs.y;
   float s = 0.5f * (1.0f + vh.z);
   p2 = (1.0f - s) * pg_safe_sqrt(1.0f - p1 * p1) + s * p2;
   float3 nh = t1 * p1 + t2 * p2 + vh * pg_safe_sqrt(1.0f - p1 * p1 - p2 * p2);

@@ -6,6 +6,7 @@
 #define RTPG_SHARED_MAPPING_H
 
 #include "shared/compat.h"
+#include "shared/sincos.h"
 
 PG_NAMESPACE_BEGIN
 
@@ -14,15 +15,14 @@ PG_FN float2 pg_square_to_disk(float2 u) {
   float ox = 2.0f * u.x - 1.0f;
   float oy = 2.0f * u.y - 1.0f;
   if (ox == 0.0f && oy == 0.0f) return pg_make_float2(0.0f, 0.0f);
-  float r, theta;
   if (fabs(ox) > fabs(oy)) {
-    r = ox;
-    theta = (PG_PI / 4.0f) * (oy / ox);
-  } else {
-    r = oy;
-    theta = (PG_PI / 2.0f) - (PG_PI / 4.0f) * (ox / oy);
+    /* theta = (pi/4) oy / ox */
+    float2 cs = pg_cos_sin_octant((PG_PI / 4.0f) * (oy / ox));
+    return pg_make_float2(ox * cs.x, ox * cs.y);
   }
-  return pg_make_float2(r * cos(theta), r * sin(theta));
+  /* theta = pi/2 - a with a = (pi/4) ox / oy: cos theta = sin a, sin theta = cos a */
+  float2 cs = pg_cos_sin_octant((PG_PI / 4.0f) * (ox / oy));
+  return pg_make_float2(oy * cs.y, oy * cs.x);
 }
 
 /* atan(z) for |z| <= 1 by the polynomial of Abramowitz and Stegun 4.4.49 (|error| <= 2e-8):

@@ -17,6 +17,7 @@
 #include "shared/bsdf.h"
 #include "shared/compat.h"
 #include "shared/mapping.h"
+#include "shared/sincos.h"
 #include "rtpg/guiding_layout.h"
 
 PG_NAMESPACE_BEGIN
@@ -142,8 +143,8 @@ typedef struct {
  * sample is lost (pdf 0), never moved. */
 PG_FN float2 pg_pmm_sample_square(pg_pmm_model m, float u1, float u2, PG_PRIVATE int* inside) {
   float r = sqrt(-2.0f * log(fmax(1.0f - u1, 1e-30f)));
-  float phi = PG_TWO_PI * u2;
-  float z1 = r * cos(phi), z2 = r * sin(phi);
+  float2 cs = pg_cos_sin_turn(u2); /* phi = 2 pi u2 */
+  float z1 = r * cs.x, z2 = r * cs.y;
   float ux = m.mx + m.l11 * z1;
   float uy = m.my + m.l21 * z1 + m.l22 * z2;
   *inside = ux >= 0.0f && ux <= 1.0f && uy >= 0.0f && uy <= 1.0f;

@@ -10,6 +10,7 @@
 #include "shared/compat.h"
 #include "wide/lanes.h"
 #include "wide/mapping_wide.h"
+#include "wide/sincos_wide.h"
 
 /* pg_lobes per lane. */
 typedef struct {
@@ -111,9 +112,10 @@ static inline pg_float3w pg_ggx_sample_visible_normal_w(pg_float3w wo, pg_floatw
                                   select((pg_floatw)(0.0f), vh.x * inv, tilted), (pg_floatw)(0.0f));
   pg_float3w t2 = pg_cross3w(vh, t1);
   pg_floatw r = sqrt(u1);
-  pg_floatw phi = 2.0f * PG_PI * u2;
-  pg_floatw p1 = r * cos(phi);
-  pg_floatw p2 = r * sin(phi);
+  pg_floatw c, sn;
+  pg_cos_sin_turn_w(u2, &c, &sn); /* phi = 2 pi u2 */
+  pg_floatw p1 = r * c;
+  pg_floatw p2 = r * sn;
   pg_floatw s = 0.5f * (1.0f + vh.z);
   p2 = (1.0f - s) * sqrt(fmax(1.0f - p1 * p1, 0.0f)) + s * p2;
   pg_float3w nh = pg_add3w(pg_add3w(pg_scale3w(t1, p1), pg_scale3w(t2, p2)),

@@ -6,6 +6,7 @@
 
 #include "shared/compat.h"
 #include "wide/lanes.h"
+#include "wide/sincos_wide.h"
 
 /* pg_frame per lane (pg_frame_from_normal: Duff et al. 2017). */
 typedef struct {
@@ -37,11 +38,13 @@ static inline void pg_square_to_disk_w(pg_floatw ux, pg_floatw uy, __private pg_
   pg_floatw ox = 2.0f * ux - 1.0f, oy = 2.0f * uy - 1.0f;
   pg_intw wide_x = fabs(ox) > fabs(oy);
   pg_floatw r = select(oy, ox, wide_x);
-  pg_floatw theta =
-      select((PG_PI / 2.0f) - (PG_PI / 4.0f) * (ox / oy), (PG_PI / 4.0f) * (oy / ox), wide_x);
+  /* theta = a in the wide-x wedges, else pi/2 - a (cos theta = sin a, sin theta = cos a). */
+  pg_floatw c, s;
+  pg_cos_sin_octant_w(select((PG_PI / 4.0f) * (ox / oy), (PG_PI / 4.0f) * (oy / ox), wide_x), &c,
+                      &s);
   pg_intw centre = (ox == 0.0f) & (oy == 0.0f);
-  *dx = select(r * cos(theta), (pg_floatw)(0.0f), centre);
-  *dy = select(r * sin(theta), (pg_floatw)(0.0f), centre);
+  *dx = select(r * select(s, c, wide_x), (pg_floatw)(0.0f), centre);
+  *dy = select(r * select(c, s, wide_x), (pg_floatw)(0.0f), centre);
 }
 
 /* M (pg_square_to_hemisphere): square -> hemisphere, equal-area. */

@@ -10,6 +10,7 @@
 #include "wide/bsdf_wide.h"
 #include "wide/lanes.h"
 #include "wide/mapping_wide.h"
+#include "wide/sincos_wide.h"
 
 /* Mixture models of PG_LANES pixels (pg_pmm_model per lane). */
 typedef struct {
@@ -127,8 +128,9 @@ static inline pg_float3w pg_pmm_sample_w(pg_pmm_model_w m, pg_lobes_w l, pg_floa
   wi = pg_select3w(pg_make_float3w(0.0f, 0.0f, 1.0f), wi, sampled);
   if (any(guide)) {
     pg_floatw r = sqrt(-2.0f * log(fmax(1.0f - u1, 1e-30f)));
-    pg_floatw phi = PG_TWO_PI * u2;
-    pg_floatw z1 = r * cos(phi), z2 = r * sin(phi);
+    pg_floatw c, sn;
+    pg_cos_sin_turn_w(u2, &c, &sn); /* phi = 2 pi u2 */
+    pg_floatw z1 = r * c, z2 = r * sn;
     pg_floatw ux = m.mx + m.l11 * z1;
     pg_floatw uy = m.my + m.l21 * z1 + m.l22 * z2;
     pg_intw inside = (ux >= 0.0f) & (ux <= 1.0f) & (uy >= 0.0f) & (uy <= 1.0f);
