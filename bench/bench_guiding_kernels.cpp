@@ -321,7 +321,7 @@ void count_flops(Inputs& in, const pg_kernel_settings& p) {
         const std::size_t j = static_cast<std::size_t>(py) * w + px;
         const float3 m = sh::pg_float4_xyz(in.prev.shading_normal[j]);
         in.reproject_flops += 78;
-        if (sh::pg_pmm_needs_reframe(sh::pg_frame_from_normal(m), frame)) in.reproject_flops += 399;
+        if (sh::pg_pmm_needs_reframe(sh::pg_frame_from_normal(m), frame)) in.reproject_flops += 420;
       }
       // sample: BSDF sampling and its density (248), the GGX lobe (213), a trained model's
       // density (72) and the Gaussian's sampler (107, counted for every trained pixel).

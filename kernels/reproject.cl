@@ -6,11 +6,12 @@
  * (pg_pmm_view_aged_k). Rejected, disoccluded and skipped pixels restart from the initial
  * state (k = 0). */
 /* Per pixel (hand count; rules and roofline: docs/guiding.md, "The roofline"): 78 flops (2
- * divisions, 1 sqrt) where history is kept, 372 more (13 divisions, 12 sqrt/sin/cos) where the
- * state is reframed, about 72 more (the lobes, two lengths, an atan2, an exp, a division) and
- * 48 bytes more read where a model ages (reproject_view_memory > 0); 132 bytes read, 32
- * written: memory-bound. Where the pixel the motion vector lands on fails the history test,
- * each further candidate costs about 20 flops and 36 bytes (mostly from cache). */
+ * divisions, 1 sqrt) where history is kept, 420 more (13 divisions, 6 sqrt; M's cos and sin by
+ * polynomials, kernels/shared/sincos.h, 3 x 16 flops) where the state is reframed, about 72 more
+ * (the lobes, two lengths, an atan2, an exp, a division) and 48 bytes more read where a model ages
+ * (reproject_view_memory > 0); 132 bytes read, 32 written: memory-bound. Where the pixel the motion
+ * vector lands on fails the history test, each further candidate costs about 20 flops and 36 bytes
+ * (mostly from cache). */
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
 #include "shared/pmm.h"
