@@ -655,9 +655,7 @@ double frame_traffic(Inputs& in, const G& gbuffer, const V& vpls, S& samples) {
   cl::CommandQueue& q = runtime().queue();
   enqueue_upload(q, gbuffer, in.d_cur);
   enqueue_upload(q, vpls, in.d_vpls);
-  // The renderer's download without the mixture: direction_pdf and strategy.
-  detail::enqueue_read<16>(q, in.d_samples.direction_pdf, samples.direction_pdf);
-  detail::enqueue_read<4>(q, in.d_samples.strategy, samples.strategy);
+  enqueue_download(q, in.d_samples, samples, SampleOutputs::directions);  // as the renderer
   q.finish();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -667,7 +665,8 @@ void BM_FrameTraffic(benchmark::State& state, int w, int h, bool pinned) {
   Inputs& in = inputs_for(w, h);
   constexpr std::size_t kBytes =
 #define RTPG_BENCH_ADD(name, type, bytes) +(bytes)
-      0 PG_GBUFFER_CHANNELS(RTPG_BENCH_ADD) PG_VPL_CHANNELS(RTPG_BENCH_ADD) + 16 + 4;
+      0 PG_GBUFFER_CHANNELS(RTPG_BENCH_ADD) PG_VPL_CHANNELS(RTPG_BENCH_ADD) +
+      sample_bytes_per_pixel(SampleOutputs::directions);
 #undef RTPG_BENCH_ADD
   std::unique_ptr<PinnedFrame> staged;
   HostSamples host_samples;

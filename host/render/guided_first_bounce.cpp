@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <string_view>
 
 #include "render/pinned_staging.h"
 #include "rtpg/cl_runtime.h"
@@ -20,14 +19,7 @@ double ms_since(Clock::time_point start) {
 #define RTPG_ADD_BYTES(name, type, bytes) +(bytes)
 constexpr std::size_t kGBufferBytes = 0 PG_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kVplBytes = 0 PG_VPL_CHANNELS(RTPG_ADD_BYTES);
-constexpr std::size_t kSampleBytes = 0 PG_SAMPLE_CHANNELS(RTPG_ADD_BYTES);
 #undef RTPG_ADD_BYTES
-// Of which the mixture's channels (mixture_*), written only where the host reads them.
-#define RTPG_ADD_MIXTURE_BYTES(name, type, bytes) \
-  +(std::string_view(#name).substr(0, 8) == "mixture_" ? (bytes) : 0)
-constexpr std::size_t kMixtureBytes = 0 PG_SAMPLE_CHANNELS(RTPG_ADD_MIXTURE_BYTES);
-#undef RTPG_ADD_MIXTURE_BYTES
-static_assert(kMixtureBytes == 16 + 8, "mixture_a (float4) and mixture_b (float2)");
 #define RTPG_COUNT(name, type, bytes) +1
 constexpr std::size_t kGBufferChannels = 0 PG_GBUFFER_CHANNELS(RTPG_COUNT);
 constexpr std::size_t kVplChannels = 0 PG_VPL_CHANNELS(RTPG_COUNT);
@@ -159,9 +151,9 @@ void GuidedFirstBounce::expect_queries(const HostQueries& queries) {
 
 FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at) {
   unmap_samples();  // the kernel overwrites them
-  guider_->sample(
-      current_gbuffer_, at.seed, at.frame, at.sample, samples_,
-      host_reads_mixture_ ? SampleOutputs::directions_and_mixture : SampleOutputs::directions);
+  const SampleOutputs outputs =
+      host_reads_mixture_ ? SampleOutputs::directions_and_mixture : SampleOutputs::directions;
+  guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_, outputs);
   sample_ms_ += guider_->last_times().sample_ms;
   const std::size_t n = g.pixel_count();
   const auto t = Clock::now();
@@ -181,16 +173,13 @@ FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoord
       q.finish();
     });
   } else {
+    enqueue_download(runtime_.queue(), samples_, staged_, outputs);
+    translate_cl_errors([&] { runtime_.queue().finish(); });
+    bytes_ += sample_bytes_per_pixel(outputs) * n;
     if (host_reads_mixture_) {
-      enqueue_download(runtime_.queue(), samples_, staged_);
       view_.mixture_a = staged_.mixture_a.data();
       view_.mixture_b = staged_.mixture_b.data();
-    } else {
-      detail::enqueue_read<16>(runtime_.queue(), samples_.direction_pdf, staged_.direction_pdf);
-      detail::enqueue_read<4>(runtime_.queue(), samples_.strategy, staged_.strategy);
     }
-    translate_cl_errors([&] { runtime_.queue().finish(); });
-    bytes_ += (host_reads_mixture_ ? kSampleBytes : kSampleBytes - kMixtureBytes) * n;
     view_.direction_pdf = staged_.direction_pdf.data();
     view_.strategy = staged_.strategy.data();
   }

@@ -23,6 +23,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "rtpg/cl_error.h"
@@ -46,6 +47,24 @@ struct GuiderSamples {  // what sample() writes (PG_SAMPLE_CHANNELS)
   PG_SAMPLE_CHANNELS(RTPG_DEVICE_CHANNEL)
 };
 #undef RTPG_DEVICE_CHANNEL
+
+// What sample() writes besides the directions, their densities and strategies: the mixture each
+// pixel sampled (GuiderSamples' mixture_a and mixture_b), for a host that evaluates it in its
+// MIS weights (include/rtpg/guiding_distribution.h); or nothing, which leaves those channels as
+// they were and saves the kernel 24 bytes a pixel of stores (and a discrete GPU's host their
+// copy).
+enum class SampleOutputs { directions_and_mixture, directions };
+// Whether a channel of PG_SAMPLE_CHANNELS is part of the mixture (mixture_a, mixture_b).
+constexpr bool is_mixture_channel(std::string_view name) {
+  return name.substr(0, 8) == "mixture_";
+}
+// Bytes per pixel of what sample() writes with these outputs (include/rtpg/guiding_layout.h).
+constexpr std::size_t sample_bytes_per_pixel(SampleOutputs outputs) {
+#define RTPG_SAMPLE_BYTES(name, type, bytes) \
+  +(outputs == SampleOutputs::directions && is_mixture_channel(#name) ? 0 : (bytes))
+  return 0 PG_SAMPLE_CHANNELS(RTPG_SAMPLE_BYTES);
+#undef RTPG_SAMPLE_BYTES
+}
 
 // Buffers for width x height pixels (inputs read-only, samples write-only for the kernels).
 // host_flags are added to the flags: with CL_MEM_ALLOC_HOST_PTR, on a device that shares host
@@ -121,9 +140,13 @@ void enqueue_upload(cl::CommandQueue& queue, const HostVpls& host, const GuiderV
 #undef RTPG_UPLOAD
 }
 // host's channels must already have their size (width * height).
+// With SampleOutputs::directions the mixture's channels are left out (host's may then be empty).
 template <class HostSamples>
-void enqueue_download(cl::CommandQueue& queue, const GuiderSamples& dev, HostSamples& host) {
-#define RTPG_DOWNLOAD(name, type, bytes) detail::enqueue_read<bytes>(queue, dev.name, host.name);
+void enqueue_download(cl::CommandQueue& queue, const GuiderSamples& dev, HostSamples& host,
+                      SampleOutputs outputs = SampleOutputs::directions_and_mixture) {
+#define RTPG_DOWNLOAD(name, type, bytes)                                              \
+  if (outputs == SampleOutputs::directions_and_mixture || !is_mixture_channel(#name)) \
+    detail::enqueue_read<bytes>(queue, dev.name, host.name);
   PG_SAMPLE_CHANNELS(RTPG_DOWNLOAD)
 #undef RTPG_DOWNLOAD
 }
@@ -153,13 +176,6 @@ GuiderVpls wrap_host_vpls(cl::Context& context, const HostVpls& host) {
 #undef RTPG_WRAP
   return dev;
 }
-
-// What sample() writes besides the directions, their densities and strategies: the mixture each
-// pixel sampled (GuiderSamples' mixture_a and mixture_b), for a host that evaluates it in its
-// MIS weights (include/rtpg/guiding_distribution.h); or nothing, which leaves those channels as
-// they were and saves the kernel 24 bytes a pixel of stores (and a discrete GPU's host their
-// copy).
-enum class SampleOutputs { directions_and_mixture, directions };
 
 // The statistics of the last sample() (include/rtpg/guiding_layout.h, "Counts"): surface pixels,
 // those whose mixture has a Gaussian, and the sum of their pi.
