@@ -108,6 +108,8 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
     group_x_ = window.x;
     group_y_ = window.y;
     const std::size_t group = static_cast<std::size_t>(group_x_) * group_y_;
+    sample_launch_ = launch_of(sample_lanes_, /*pixel_kernel=*/true);
+    train_launch_ = launch_of(train_lanes_, /*pixel_kernel=*/false);
     for (cl::Kernel* k : {&reproject_, &sample_, &train_}) {
       const std::size_t limit = k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device());
       if (group > limit || static_cast<std::size_t>(group_x_) > max_items.at(0) ||
@@ -120,7 +122,9 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
     if (local_tile_) {
       const std::size_t tile = static_cast<std::size_t>(group_x_ + 2 * settings.apron) *
                                (group_y_ + 2 * settings.apron) * 3 * 16;
-      const std::size_t used = train_.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(runtime.device());
+      // Plus the work-group's count records (kernels/shared/work_group_sum.h).
+      const std::size_t used = train_.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(runtime.device()) +
+                               group * PG_COUNT_RECORD_BYTES;
       if (tile + used > info.local_mem_size)
         throw GuiderError("the VPL tile (" + std::to_string(tile) + " bytes for " +
                           std::to_string(group_x_) + "x" + std::to_string(group_y_) +
@@ -132,14 +136,10 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
       s.state0 = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, n * 16);
       s.state1 = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, n * 16);
     }
-    sample_launch_ = launch_of(sample_lanes_, /*pixel_kernel=*/true);
-    train_launch_ = launch_of(train_lanes_, /*pixel_kernel=*/false);
-    sample_groups_ = sample_launch_.groups;
-    train_groups_ = train_launch_.groups;
-    sample_counts_ =
-        cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, sample_groups_ * PG_COUNT_RECORD_BYTES);
-    train_counts_ =
-        cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, train_groups_ * PG_COUNT_RECORD_BYTES);
+    sample_counts_ = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE,
+                                sample_launch_.groups * PG_COUNT_RECORD_BYTES);
+    train_counts_ = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE,
+                               train_launch_.groups * PG_COUNT_RECORD_BYTES);
   });
   reset();
 }
@@ -151,17 +151,18 @@ void Guider::reset() {
   // memory as uninitialised even after a kernel has overwritten it, so every later kernel that
   // reads the state is flagged under --uninitialized (a false positive hiding real findings).
   const std::size_t n = static_cast<std::size_t>(width_) * height_;
-  const std::vector<float> zeros(std::max(n, std::max(sample_groups_, train_groups_)) * 4, 0.0f);
+  const std::vector<float> zeros(
+      std::max(n, std::max(sample_launch_.groups, train_launch_.groups)) * 4, 0.0f);
   translate_cl_errors([&] {
     for (State& s : state_) {
       runtime_.queue().enqueueWriteBuffer(s.state0, CL_FALSE, 0, n * 16, zeros.data());
       runtime_.queue().enqueueWriteBuffer(s.state1, CL_FALSE, 0, n * 16, zeros.data());
     }
     // No counts before the first sample() and train().
-    runtime_.queue().enqueueWriteBuffer(sample_counts_, CL_FALSE, 0,
-                                        sample_groups_ * PG_COUNT_RECORD_BYTES, zeros.data());
-    runtime_.queue().enqueueWriteBuffer(train_counts_, CL_FALSE, 0,
-                                        train_groups_ * PG_COUNT_RECORD_BYTES, zeros.data());
+    runtime_.queue().enqueueWriteBuffer(sample_counts_, CL_FALSE, 0, sample_count_record_bytes(),
+                                        zeros.data());
+    runtime_.queue().enqueueWriteBuffer(train_counts_, CL_FALSE, 0, train_count_record_bytes(),
+                                        zeros.data());
     runtime_.queue().finish();  // the host vectors must outlive the writes
   });
 }
@@ -305,11 +306,11 @@ void Guider::write_state(const std::vector<float>& state) {
 }
 
 std::size_t Guider::count_trained() {
-  return static_cast<std::size_t>(sum_count_records(train_counts_, train_groups_)[0]);
+  return static_cast<std::size_t>(sum_count_records(train_counts_, train_launch_.groups)[0]);
 }
 
 GuiderSampleCounts Guider::sample_counts() {
-  const std::vector<double> sum = sum_count_records(sample_counts_, sample_groups_);
+  const std::vector<double> sum = sum_count_records(sample_counts_, sample_launch_.groups);
   return GuiderSampleCounts{static_cast<std::size_t>(sum[0]), static_cast<std::size_t>(sum[1]),
                             sum[2]};
 }

@@ -228,8 +228,12 @@ class Guider {
   // reads the kernel's records back, PG_COUNT_RECORD_BYTES per work-group (count_record_bytes).
   std::size_t count_trained();
   GuiderSampleCounts sample_counts();
-  std::size_t sample_count_record_bytes() const { return sample_groups_ * PG_COUNT_RECORD_BYTES; }
-  std::size_t train_count_record_bytes() const { return train_groups_ * PG_COUNT_RECORD_BYTES; }
+  std::size_t sample_count_record_bytes() const {
+    return sample_launch_.groups * PG_COUNT_RECORD_BYTES;
+  }
+  std::size_t train_count_record_bytes() const {
+    return train_launch_.groups * PG_COUNT_RECORD_BYTES;
+  }
 
   const GuiderTimes& last_times() const { return times_; }
 
@@ -269,7 +273,6 @@ class Guider {
   State state_[2];  // reproject's source and destination (train updates the current in place)
   // The sample and train kernels' count records, one float4 per work-group of their launches.
   Launch sample_launch_, train_launch_;
-  std::size_t sample_groups_ = 0, train_groups_ = 0;
   cl::Buffer sample_counts_, train_counts_;
   int current_ = 0;  // index of the buffers holding this frame's state
   cl::Kernel reproject_, sample_, train_;
