@@ -8,8 +8,10 @@ protocol of the variant tables in docs/guiding.md.
 Per scene and seed: `rtpg render` of --frames 1-spp frames with --guiding off and with each variant's
 extra arguments, against a cached reference (`rtpg reference`, --ref-spp, seed 777); the figure is
 the mean relMSE of the last --window frames, PG/PT per seed, then the mean over seeds with the
-standard error of that mean. Renders are cached in --out by scene, variant and seed (delete the
-folder after changing the renderer), references in --out/references by the renderer's source hash.
+standard error of that mean. Renders are cached in --out by scene, variant name and seed, keyed by
+the variant's arguments, the size and frame count, and the binary (runner.binary_fingerprint: the
+executable's bytes and any RTPG_KERNEL_DIR), so a rebuilt renderer or changed arguments render
+again; references in --out/references by the renderer's source hash.
 Prints a line per scene and variant and a Markdown table; writes --out/sweep.json.
 
 With --camera-path every run follows the scene's first camera path (reprojection, history
@@ -20,6 +22,7 @@ static ones):
     python3 bench/variant_sweep.py --camera-path --checkpoints 23 31 --variants '{"default": []}'
 """
 import argparse
+import hashlib
 import json
 import statistics
 import sys
@@ -75,6 +78,12 @@ def main():
 
     out = Path(args.out)
     refs = runner.ReferenceCache(out / "references")
+    binary = runner.binary_fingerprint()
+
+    def run_key(extra, frames):
+        """The cache key of a run: what else decides it besides scene, variant name and seed."""
+        key = json.dumps([binary, [str(a) for a in extra], args.res, frames])
+        return hashlib.sha256(key.encode()).hexdigest()[:10]
 
     def path_relmse(scene, tag, seed, guiding, extra):
         """Mean relMSE of the checkpoint frames along the scene's first camera path."""
@@ -82,12 +91,13 @@ def main():
         if not name:
             raise SystemExit(f"variant_sweep.py: {runner.scene_path(scene)} has no camera path (--camera-path)")
         run_dir = out / scene
-        cached = run_dir / f"path-{tag}-{seed}.relmse.json"
+        run_tag = f"path-{tag}-{seed}-{run_key(extra, max(checkpoints) + 1)}"
+        cached = run_dir / f"{run_tag}.relmse.json"
         if cached.exists():
             figures = json.loads(cached.read_text())
             if figures["checkpoints"] == checkpoints and figures["camera_path"] == name:
                 return figures["relmse"]
-        _, image = runner.render(scene, args.res, max(checkpoints) + 1, guiding, run_dir, f"path-{tag}-{seed}",
+        _, image = runner.render(scene, args.res, max(checkpoints) + 1, guiding, run_dir, run_tag,
                                  extra=["--seed", seed, "--camera-path", name, "--save-frames",
                                         ",".join(map(str, checkpoints)), *extra])
         errors = [metrics.relmse(metrics.load_exr(runner.saved_frame(image, f)),
@@ -104,11 +114,12 @@ def main():
             return path_relmse(scene, tag, seed, guiding, extra)
         reference = refs.get(scene, args.res, args.ref_spp, seed=777)
         run_dir = out / scene
-        cached = run_dir / f"{tag}-{seed}.json"
+        run_tag = f"{tag}-{seed}-{run_key(extra, args.frames)}"
+        cached = run_dir / f"{run_tag}.json"
         if cached.exists():
             stats = json.loads(cached.read_text())
         else:
-            stats, _ = runner.render(scene, args.res, args.frames, guiding, run_dir, f"{tag}-{seed}", reference=reference,
+            stats, _ = runner.render(scene, args.res, args.frames, guiding, run_dir, run_tag, reference=reference,
                                      extra=["--seed", seed, *extra])
         return window_relmse(stats, args.window)
 

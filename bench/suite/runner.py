@@ -50,6 +50,24 @@ def renderer_source_hash(root=ROOT):
     return h.hexdigest()[:16]
 
 
+def binary_fingerprint():
+    """What decides a render besides its arguments: the rtpg executable's bytes (its kernels are embedded)
+    and, where RTPG_KERNEL_DIR overrides those, the kernel files read from there and the public headers
+    beside them (<dir>/../include/rtpg, as host/cl/kernel_source.cpp reads them). 16 hex digits."""
+    h = hashlib.sha256()
+    with open(rtpg_binary(), "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    kernel_dir = os.environ.get("RTPG_KERNEL_DIR")
+    if kernel_dir:
+        for d in (Path(kernel_dir), Path(kernel_dir).parent / "include" / "rtpg"):
+            for p in sorted(d.rglob("*")):
+                if p.is_file():
+                    h.update(p.relative_to(d).as_posix().encode())
+                    h.update(p.read_bytes())
+    return h.hexdigest()[:16]
+
+
 def run(args, quiet=True):
     cmd = [str(rtpg_binary())] + [str(a) for a in args]
     result = subprocess.run(cmd, capture_output=True, text=True)

@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Checks of the reference cache's source hash (bench/suite/runner.py; run by ctest): which sources can
-change what `rtpg reference` renders, and that the hash follows them and only them."""
+change what `rtpg reference` renders, and that the hash follows them and only them; and of the binary
+fingerprint the variant sweep keys its renders by."""
+import os
 import shutil
 import sys
 import tempfile
@@ -9,6 +11,42 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from suite import runner  # noqa: E402
+
+
+class BinaryFingerprintTests(unittest.TestCase):
+    def test_follows_the_executable_and_an_overriding_kernel_folder(self):
+        with tempfile.TemporaryDirectory() as d:
+            root = Path(d)
+            binary = root / "rtpg"
+            binary.write_bytes(b"first build")
+            kernels = root / "k" / "kernels"
+            (kernels / "wide").mkdir(parents=True)
+            (root / "k" / "include" / "rtpg").mkdir(parents=True)
+            (kernels / "wide" / "lanes.h").write_text("// lanes\n")
+            (root / "k" / "include" / "rtpg" / "guiding_layout.h").write_text("// layout\n")
+            saved = {k: os.environ.get(k) for k in ("RTPG_BINARY", "RTPG_KERNEL_DIR")}
+            try:
+                os.environ["RTPG_BINARY"] = str(binary)
+                os.environ.pop("RTPG_KERNEL_DIR", None)
+                base = runner.binary_fingerprint()
+                self.assertEqual(runner.binary_fingerprint(), base)
+                binary.write_bytes(b"second build")
+                rebuilt = runner.binary_fingerprint()
+                self.assertNotEqual(rebuilt, base)
+                os.environ["RTPG_KERNEL_DIR"] = str(kernels)
+                with_dir = runner.binary_fingerprint()
+                self.assertNotEqual(with_dir, rebuilt)
+                (kernels / "wide" / "lanes.h").write_text("// lanes, edited\n")
+                self.assertNotEqual(runner.binary_fingerprint(), with_dir)
+                edited = runner.binary_fingerprint()
+                (root / "k" / "include" / "rtpg" / "guiding_layout.h").write_text("// layout, edited\n")
+                self.assertNotEqual(runner.binary_fingerprint(), edited)
+            finally:
+                for k, v in saved.items():
+                    if v is None:
+                        os.environ.pop(k, None)
+                    else:
+                        os.environ[k] = v
 
 
 class ReferenceSourceTests(unittest.TestCase):

@@ -4,6 +4,7 @@ cases, a tiny sweep end to end (a finite ratio per variant; a rerun from the cac
 the same table) and the refusal of malformed variants."""
 import json
 import math
+import os
 import subprocess
 import sys
 import tempfile
@@ -44,8 +45,17 @@ class EndToEnd(unittest.TestCase):
                    "--res", "24x16", "--frames", "4", "--window", "2", "--ref-spp", "16", "--out", out, "--variants",
                    json.dumps({"guided": [], "interval 2": ["--pg-train-interval", "2"]})]
             first = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+            runs = sorted((Path(out) / "cornell-box").glob("*.json"))
             again = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
             self.assertEqual(first, again)  # the rerun reads the cached renders
+            self.assertEqual(sorted((Path(out) / "cornell-box").glob("*.json")), runs)
+            # Another binary (the same one with a byte appended) renders every run again.
+            other = Path(out) / "rtpg-other"
+            other.write_bytes(runner.rtpg_binary().read_bytes() + b"\0")
+            other.chmod(0o755)
+            env = dict(os.environ, RTPG_BINARY=str(other))
+            subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
+            self.assertEqual(len(list((Path(out) / "cornell-box").glob("*.json"))), 2 * len(runs))
             table = json.loads((Path(out) / "sweep.json").read_text())["table"]
             for name in ("guided", "interval 2"):
                 ratio, se = table[name]["cornell-box"]
@@ -62,7 +72,7 @@ class EndToEnd(unittest.TestCase):
             self.assertEqual(first, again)  # the rerun reads the cached figures
             ratio, se = json.loads((Path(out) / "sweep.json").read_text())["table"]["guided"]["cornell-box"]
             self.assertTrue(math.isfinite(ratio) and ratio > 0.0 and se >= 0.0, (ratio, se))
-            run = json.loads((Path(out) / "cornell-box" / "path-pg-guided-1.relmse.json").read_text())
+            run = json.loads(next((Path(out) / "cornell-box").glob("path-pg-guided-1-*.relmse.json")).read_text())
             self.assertEqual(run["camera_path"], runner.first_camera_path("cornell-box"))
             self.assertEqual(run["checkpoints"], [1, 3])
             self.assertAlmostEqual(run["relmse"], sum(run["relmse_per_checkpoint"]) / 2, places=12)
@@ -71,7 +81,7 @@ class EndToEnd(unittest.TestCase):
             # Other checkpoints: the cached figure of the same runs is not reused.
             cmd[cmd.index("--checkpoints") + 1] = "2"
             subprocess.run(cmd, check=True, capture_output=True, text=True)
-            run = json.loads((Path(out) / "cornell-box" / "path-pg-guided-1.relmse.json").read_text())
+            run = json.loads(next((Path(out) / "cornell-box").glob("path-pg-guided-1-*.relmse.json")).read_text())
             self.assertEqual(run["checkpoints"], [2, 3])
 
     def test_bad_checkpoints_are_refused(self):
