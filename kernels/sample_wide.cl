@@ -91,10 +91,10 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES i
     pg_store_row_float2_rows(mixture_b + row_start, x0, w, select(zero, m.l21, m.valid),
                              select(zero, m.l22, m.valid));
   }
-  pg_intw guided = inside & m.valid;
+  pg_intw with_model = inside & m.valid; /* counted as guided: the pixel has a Gaussian */
   return (float4)(pg_sum_lanes(select(zero, (pg_floatw)(1.0f), inside & ~sky)),
-                  pg_sum_lanes(select(zero, (pg_floatw)(1.0f), guided)),
-                  pg_sum_lanes(select(zero, m.pi, guided)), 0.0f);
+                  pg_sum_lanes(select(zero, (pg_floatw)(1.0f), with_model)),
+                  pg_sum_lanes(select(zero, m.pi, with_model)), 0.0f);
 }
 
 __kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES __global float4* counts,

@@ -207,13 +207,13 @@ double Guider::run(cl::Kernel& kernel, const Launch& launch) {
   return ClRuntime::event_ms(done);
 }
 
-std::vector<double> Guider::sum_count_records(const cl::Buffer& records, std::size_t groups) {
+std::array<double, 4> Guider::sum_count_records(const cl::Buffer& records, std::size_t groups) {
   std::vector<float> r(groups * 4);
   translate_cl_errors([&] {
     runtime_.queue().enqueueReadBuffer(records, CL_TRUE, 0, groups * PG_COUNT_RECORD_BYTES,
                                        r.data());
   });
-  std::vector<double> sum(4, 0.0);
+  std::array<double, 4> sum{};
   for (std::size_t g = 0; g < groups; ++g)
     for (int c = 0; c < 4; ++c) sum[c] += r[g * 4 + c];
   return sum;
@@ -310,7 +310,7 @@ std::size_t Guider::count_trained() {
 }
 
 GuiderSampleCounts Guider::sample_counts() {
-  const std::vector<double> sum = sum_count_records(sample_counts_, sample_launch_.groups);
+  const std::array<double, 4> sum = sum_count_records(sample_counts_, sample_launch_.groups);
   return GuiderSampleCounts{static_cast<std::size_t>(sum[0]), static_cast<std::size_t>(sum[1]),
                             sum[2]};
 }

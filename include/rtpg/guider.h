@@ -20,6 +20,7 @@
 // ClError (include/rtpg/cl_error.h) when OpenCL fails.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -251,7 +252,7 @@ class Guider {
   // Launches, waits, returns profiled ms.
   double run(cl::Kernel& kernel, const Launch& launch);
   // Reads a kernel's count records (one float4 per work-group) and sums each component.
-  std::vector<double> sum_count_records(const cl::Buffer& records, std::size_t groups);
+  std::array<double, 4> sum_count_records(const cl::Buffer& records, std::size_t groups);
 
   ClRuntime& runtime_;
   ClRuntime::Use runtime_use_{runtime_};  // the runtime must outlive this
