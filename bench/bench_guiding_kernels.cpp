@@ -204,7 +204,9 @@ void make_gbuffer(Inputs& in, std::mt19937& g) {
 }
 
 // One VPL per surface pixel: a cosine bounce about the shading normal that hits a surface
-// 0.3..6 units away (normal facing back within 60 degrees), or escapes (10%).
+// 0.3..6 units away (normal facing back within 60 degrees), or escapes (10%). Its mixture
+// density D (what trains with the default train_all_samples) is the strategy's for a guided
+// sample and 0.5..1.5 times it for a BSDF one (as a mixture of the BSDF and a lobe gives).
 void make_vpls(Inputs& in, std::mt19937& g) {
   std::uniform_real_distribution<float> u;
   in.vpls.resize(in.n);
@@ -220,15 +222,17 @@ void make_vpls(Inputs& in, std::mt19937& g) {
     const std::uint32_t strategy = u(g) < 0.8f ? PG_STRATEGY_BSDF : PG_STRATEGY_GUIDE;
     std::uint32_t info = PG_VPL_VALID | (strategy << PG_VPL_STRATEGY_SHIFT);
     const float bright = u(g) < 0.03f ? 50.0f : 1.0f;
+    const float mixture = strategy == PG_STRATEGY_GUIDE ? 1.0f : 0.5f + u(g);
     if (u(g) < 0.1f) {
       info |= PG_VPL_DISTANT;
       in.vpls.position[i] = float4(w, pdf);
+      in.vpls.normal[i] = float4(0.0f, 0.0f, 0.0f, mixture * pdf);
     } else {
       const float d = 0.3f + 5.7f * u(g);
       const float3 ny = tilt(g, -w, 60.0f);
       const float cos_y = std::max(1e-3f, -sh::dot(ny, w));
       in.vpls.position[i] = float4(x + w * d, pdf * cos_y / (d * d));
-      in.vpls.normal[i] = float4(ny, 0.0f);
+      in.vpls.normal[i] = float4(ny, mixture * pdf * cos_y / (d * d));
     }
     in.vpls.radiance_info[i] =
         float4(bright * u(g), bright * u(g), bright * u(g), static_cast<float>(info));
