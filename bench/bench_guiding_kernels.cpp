@@ -223,19 +223,20 @@ void make_vpls(Inputs& in, std::mt19937& g) {
     std::uint32_t info = PG_VPL_VALID | (strategy << PG_VPL_STRATEGY_SHIFT);
     const float bright = u(g) < 0.03f ? 50.0f : 1.0f;
     const float mixture = strategy == PG_STRATEGY_GUIDE ? 1.0f : 0.5f + u(g);
+    float3 ny(0.0f);
+    float to_area = 1.0f;  // solid angle at x to area measure at y (1: a distant VPL)
     if (u(g) < 0.1f) {
       info |= PG_VPL_DISTANT;
       in.vpls.position[i] = float4(w, pdf);
-      in.vpls.normal[i] = float4(0.0f, 0.0f, 0.0f, mixture * pdf);
     } else {
       const float d = 0.3f + 5.7f * u(g);
-      const float3 ny = tilt(g, -w, 60.0f);
-      const float cos_y = std::max(1e-3f, -sh::dot(ny, w));
-      in.vpls.position[i] = float4(x + w * d, pdf * cos_y / (d * d));
-      in.vpls.normal[i] = float4(ny, mixture * pdf * cos_y / (d * d));
+      ny = tilt(g, -w, 60.0f);
+      to_area = std::max(1e-3f, -sh::dot(ny, w)) / (d * d);
+      in.vpls.position[i] = float4(x + w * d, pdf * to_area);
     }
-    in.vpls.radiance_info[i] =
-        float4(bright * u(g), bright * u(g), bright * u(g), static_cast<float>(info));
+    const float3 radiance(bright * u(g), bright * u(g), bright * u(g));
+    in.vpls.normal_radiance[i] =
+        sh::pg_pack_vpl_normal_radiance(ny, mixture * pdf * to_area, radiance, info);
   }
 }
 
@@ -291,7 +292,7 @@ void count_bytes(Inputs& in, const pg_kernel_settings& p) {
       }
       in.reproject_bytes += r;
       in.sample_bytes += 4 + 20 + (sky ? 0 : 4 * 16) + (applies ? 32 : 0);
-      in.train_bytes += 32 + 32 + 4 + 16 + 48 + (applies ? 4 * 16 : 0);
+      in.train_bytes += 32 + 32 + 4 + 16 + 32 + (applies ? 4 * 16 : 0);
     }
 }
 
@@ -330,13 +331,13 @@ void count_flops(Inputs& in, const pg_kernel_settings& p) {
       // sample: BSDF sampling and its density (248), the GGX lobe (213), a trained model's
       // density (72) and the Gaussian's sampler (107, counted for every trained pixel).
       in.sample_flops += 248 + (ggx ? 213 : 0) + (k > 0.0f ? 72 + 107 : 0);
-      // train: 162 + b N + 63 N P + 182 P (b = 128, 234 with GGX; P passes; N neighbours), the
+      // train: 162 + b N + 63 N P + 182 P (b = 158, 264 with GGX; P passes; N neighbours), the
       // count beside kernels/train_wide.cl.
       const int n_samples =
           std::min(std::min(sh::pg_pmm_neighbour_count(k, p), side * side), PG_MAX_TRAIN_SAMPLES);
       const int passes = k >= 0.25f * p.k_max ? 1 : p.em_passes;
       in.train_flops +=
-          162.0 + (ggx ? 234.0 : 128.0) * n_samples + 63.0 * n_samples * passes + 182.0 * passes;
+          162.0 + (ggx ? 264.0 : 158.0) * n_samples + 63.0 * n_samples * passes + 182.0 * passes;
     }
 }
 
@@ -527,9 +528,9 @@ void tbb_train(const Inputs& in, const pg_kernel_settings& params, std::uint32_t
             const int sx = x + wi % side - apron, sy = y + wi / side - apron;
             if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
             const int j = sy * w + sx;
-            kept += sh::pg_train_sample_from_vpl(px, in.vpls.position[j], in.vpls.normal[j],
-                                                 in.vpls.radiance_info[j], params, &samples[kept],
-                                                 &densities[kept]);
+            kept +=
+                sh::pg_train_sample_from_vpl(px, in.vpls.position[j], in.vpls.normal_radiance[j],
+                                             params, &samples[kept], &densities[kept]);
           }
           int updated = 0;
           st = sh::pg_pmm_train(st, samples, densities, kept, params, static_cast<float>(n),

@@ -6,9 +6,9 @@
 // Static camera, 1 spp, BSDF sampling at the first bounce (plain path tracing, at the scene's full
 // depth). OUT.bin: a 16-byte header (magic "RTPGVPL1", width, height as uint32), then per frame
 // and pixel 28 float32: position_depth, shading_normal, base_color_roughness and the G-buffer
-// flags (as a float, then three zeros), the VPL's position, normal and radiance_info
-// (include/rtpg/guiding_layout.h: position.w the BSDF sample's density in area measure at y,
-// radiance_info.w the info bits).
+// flags (as a float, then three zeros), the VPL's position (include/rtpg/guiding_layout.h: w the
+// BSDF sample's density in area measure at y), its normal and mixture density, its radiance and
+// info bits (as a float), unpacked from normal_radiance.
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -20,6 +20,7 @@
 #include "render/renderer.h"
 #include "render/vpl_buffer.h"
 #include "scene/scene_loader.h"
+#include "shared/vpl_packing.h"
 
 namespace {
 
@@ -48,8 +49,10 @@ class DumpingSampler final : public FirstBounceSampler {
       put(8, g.base_color_roughness[i]);
       put(12, glm::vec4(static_cast<float>(g.flags[i]), 0.0f, 0.0f, 0.0f));
       put(16, vpls.position[i]);
-      put(20, vpls.normal[i]);
-      put(24, vpls.radiance_info[i]);
+      const glm::uvec4 packed = vpls.normal_radiance[i];
+      put(20, glm::vec4(shared::pg_vpl_normal(packed), shared::pg_vpl_mixture_density(packed)));
+      put(24, glm::vec4(shared::pg_vpl_radiance(packed),
+                        static_cast<float>(shared::pg_vpl_info(packed))));
     }
     if (std::fwrite(row.data(), sizeof(float), row.size(), out_) != row.size())
       throw std::runtime_error("vpl_dump: write failed");

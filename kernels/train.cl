@@ -19,8 +19,8 @@
  * global memory; returns 1 where its state changed. */
 static int pg_train_pixel_at(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x, int y, uint width,
                              uint height, uint seed, uint frame, pg_kernel_settings settings,
-                             __local const float4* tile_position, __local const float4* tile_normal,
-                             __local const float4* tile_radiance) {
+                             __local const float4* tile_position,
+                             __local const uint4* tile_normal_radiance) {
   int apron = settings.apron;
 #if PG_TRAIN_LOCAL_TILE
   int tw = (int)get_local_size(0) + 2 * apron;
@@ -48,14 +48,14 @@ static int pg_train_pixel_at(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x, i
     int dx = w % side - apron, dy = w / side - apron;
 #if PG_TRAIN_LOCAL_TILE
     int t = ((int)get_local_id(1) + apron + dy) * tw + (int)get_local_id(0) + apron + dx;
-    kept += pg_train_sample_from_vpl(px, tile_position[t], tile_normal[t], tile_radiance[t],
-                                     settings, &samples[kept], &densities[kept]);
+    kept += pg_train_sample_from_vpl(px, tile_position[t], tile_normal_radiance[t], settings,
+                                     &samples[kept], &densities[kept]);
 #else
     int sx = x + dx, sy = y + dy;
     if (sx < 0 || sy < 0 || sx >= (int)width || sy >= (int)height) continue;
     int j = sy * (int)width + sx;
-    kept += pg_train_sample_from_vpl(px, vpl_position[j], vpl_normal[j], vpl_radiance_info[j],
-                                     settings, &samples[kept], &densities[kept]);
+    kept += pg_train_sample_from_vpl(px, vpl_position[j], vpl_normal_radiance[j], settings,
+                                     &samples[kept], &densities[kept]);
 #endif
   }
   int updated = 0;
@@ -68,8 +68,8 @@ static int pg_train_pixel_at(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x, i
 
 __kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global float4* counts, uint width,
                     uint height, uint seed, uint frame, pg_kernel_settings settings,
-                    __local float4* tile_position, __local float4* tile_normal,
-                    __local float4* tile_radiance, __local float4* scratch) {
+                    __local float4* tile_position, __local uint4* tile_normal_radiance,
+                    __local float4* scratch) {
   int x = (int)get_global_id(0), y = (int)get_global_id(1);
 #if PG_TRAIN_LOCAL_TILE
   int apron = settings.apron;
@@ -83,12 +83,10 @@ __kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global float4* 
     if (sx >= 0 && sy >= 0 && sx < (int)width && sy < (int)height) {
       int j = sy * (int)width + sx;
       tile_position[t] = vpl_position[j];
-      tile_normal[t] = vpl_normal[j];
-      tile_radiance[t] = vpl_radiance_info[j];
+      tile_normal_radiance[t] = vpl_normal_radiance[j];
     } else {
       tile_position[t] = (float4)(0.0f);
-      tile_normal[t] = (float4)(0.0f);
-      tile_radiance[t] = (float4)(0.0f); /* info 0: not a VPL */
+      tile_normal_radiance[t] = (uint4)(0u); /* info 0: not a VPL */
     }
   }
   barrier(CLK_LOCAL_MEM_FENCE);
@@ -97,6 +95,6 @@ __kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global float4* 
   if (x < (int)width && y < (int)height)
     trained =
         (float)pg_train_pixel_at(PG_PASS_GBUFFER PG_PASS_VPLS PG_PASS_STATE x, y, width, height,
-                                 seed, frame, settings, tile_position, tile_normal, tile_radiance);
+                                 seed, frame, settings, tile_position, tile_normal_radiance);
   pg_store_work_group_counts(counts, scratch, (float4)(trained, 0.0f, 0.0f, 0.0f));
 }

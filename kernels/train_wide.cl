@@ -14,13 +14,15 @@
  * of nearly equal numbers, where one fused product moves D, and a sample's weight, by 1e-4
  * relative (tests/guiding/test_guiding_kernels.cpp). */
 /* Per pixel (hand count; docs/guiding.md, "The roofline"): 162 + b N + 63 N P + 182 P flops for
- * N neighbours and P E-step passes (a lane runs to its work-item's largest N and P), b = 128 for
- * Lambert lobes, 234 where a lane has a GGX lobe: 1299-1829 at N = 5, P = 1; 9168 at N = 20,
+ * N neighbours and P E-step passes (a lane runs to its work-item's largest N and P), b = 158 for
+ * Lambert lobes, 264 where a lane has a GGX lobe: 1449-1979 at N = 5, P = 1; 9768 at N = 20,
  * P = 3 with GGX (each M^-1 9 flops fewer since it lost its disk detour, two of them square
- * roots and one a division); with pi_learning 8 flops and 2 divisions more per neighbour and
- * pass. Bytes: 116 of its own + 48 N of neighbour VPLs read (each VPL once per
- * image from memory, the rest from cache), 32 written: compute-bound. A pixel that does not
- * train this frame: 36 read (20 where guiding does not apply), none written. */
+ * roots and one a division; b includes the 30 of unpacking a VPL's normal, one square root and
+ * one division among them, and none for its radiance, which is integer shifts); with
+ * pi_learning 8 flops and 2 divisions more per neighbour and pass. Bytes: 116 of its own + 32 N
+ * of neighbour VPLs read (each VPL once per image from memory, the rest from cache), 32
+ * written: compute-bound. A pixel that does not train this frame: 36 read (20 where guiding
+ * does not apply), none written. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
@@ -28,6 +30,7 @@
 #include "shared/work_group_sum.h"
 #include "wide/guiding_pixel_wide.h"
 #include "wide/pmm_train_wide.h"
+#include "wide/vpl_packing_wide.h"
 
 /* The lanes' pixels x0 .. x0 + PG_LANES - 1 of row y (x0 inside the image); returns how many
  * of them changed their state. */
@@ -103,41 +106,41 @@ static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x0, i
     int row_inside = sy >= 0 && sy < (int)height;
     pg_intw sx = sx0 + lane;
     pg_intw asked_w = (s < counts) & (sx >= 0) & (sx < (int)width) & (pg_intw)(-row_inside);
-    pg_floatw row[12];
+    /* The VPLs' two channels as eight rows: position and its density, then the packed
+     * channel's four words (loaded through a float pointer and reinterpreted: the bits are all
+     * that a load moves). */
+    pg_floatw row[8];
     if (!row_inside) {
-      for (int f = 0; f < 12; ++f) row[f] = (pg_floatw)(0.0f);
+      for (int f = 0; f < 8; ++f) row[f] = (pg_floatw)(0.0f);
     } else if (sx0 >= 0 && sx0 + PG_LANES <= (int)width) {
       int j = sy * (int)width + sx0;
       pg_load_float4_rows(vpl_position + j, &row[0], &row[1], &row[2], &row[3]);
-      pg_load_float4_rows(vpl_normal + j, &row[4], &row[5], &row[6], &row[7]);
-      pg_load_float4_rows(vpl_radiance_info + j, &row[8], &row[9], &row[10], &row[11]);
-      for (int f = 0; f < 12; ++f) row[f] = select((pg_floatw)(0.0f), row[f], asked_w);
+      pg_load_float4_rows((__global const float4*)(vpl_normal_radiance + j), &row[4], &row[5],
+                          &row[6], &row[7]);
+      for (int f = 0; f < 8; ++f) row[f] = select((pg_floatw)(0.0f), row[f], asked_w);
     } else {
       int asked[PG_LANES];
       pg_vstorew(asked_w, 0, asked);
-      float vpl[12][PG_LANES];
+      float vpl[8][PG_LANES];
       for (int l = 0; l < PG_LANES; ++l) {
-        float4 position_pdf = (float4)(0.0f), normal = (float4)(0.0f);
-        float4 radiance_info = (float4)(0.0f); /* info 0: not a VPL */
+        float4 position_pdf = (float4)(0.0f), packed = (float4)(0.0f); /* info 0: not a VPL */
         if (asked[l]) {
           int j = sy * (int)width + sx0 + l;
           position_pdf = vpl_position[j];
-          normal = vpl_normal[j];
-          radiance_info = vpl_radiance_info[j];
+          packed = as_float4(vpl_normal_radiance[j]);
         }
         pg_put4_rows(vpl, 0, l, position_pdf);
-        pg_put4_rows(vpl, 4, l, normal);
-        pg_put4_rows(vpl, 8, l, radiance_info);
+        pg_put4_rows(vpl, 4, l, packed);
       }
-      for (int f = 0; f < 12; ++f) row[f] = pg_vloadw(0, vpl[f]);
+      for (int f = 0; f < 8; ++f) row[f] = pg_vloadw(0, vpl[f]);
     }
     pg_vpls_w v;
     v.position = pg_make_float3w(row[0], row[1], row[2]);
     v.position_pdf = row[3];
-    v.normal = pg_make_float3w(row[4], row[5], row[6]);
-    v.mixture_pdf = row[7];
-    v.radiance = pg_make_float3w(row[8], row[9], row[10]);
-    v.info = row[11];
+    v.normal = pg_unpack_unit_vector_w(pg_as_uintw(row[4]));
+    v.mixture_pdf = row[5];
+    v.radiance = pg_vpl_radiance_w(pg_as_uintw(row[6]), pg_as_uintw(row[7]));
+    v.info = pg_as_uintw(row[7]) >> 16;
     samples[s] = pg_train_samples_from_vpls_w(px, v, asked_w, settings, any_specular);
   }
 

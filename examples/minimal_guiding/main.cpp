@@ -16,6 +16,7 @@
 
 #include "rtpg/cl_runtime.h"
 #include "rtpg/guider.h"
+#include "rtpg/vpl_packing.h"
 
 namespace {
 
@@ -24,6 +25,7 @@ namespace host {
 using float4 = std::array<float, 4>;
 using float2 = std::array<float, 2>;
 using uint = std::uint32_t;
+using uint4 = std::array<std::uint32_t, 4>;
 }  // namespace host
 #define HOST_CHANNEL(name, type, bytes) std::vector<host::type> name;
 struct HostGBuffer {
@@ -111,8 +113,7 @@ double run(rtpg::ClRuntime& rt, int size, int frames, bool guided) {
 
   HostSamples s{std::vector<host::float4>(n), std::vector<host::uint>(n),
                 std::vector<host::float4>(n), std::vector<host::float2>(n)};
-  HostVpls v{std::vector<host::float4>(n), std::vector<host::float4>(n),
-             std::vector<host::float4>(n)};
+  HostVpls v{std::vector<host::float4>(n), std::vector<host::uint4>(n)};
   double error_sum = 0.0;
   for (int frame = 0; frame < frames; ++frame) {
     if (frame > 0) guider.reproject(gbuffer, gbuffer);
@@ -131,21 +132,22 @@ double run(rtpg::ClRuntime& rt, int size, int frames, bool guided) {
       error += (estimate - ref) * (estimate - ref) / (ref * ref + 0.01);
       // The VPL: where the bounce landed, its densities in area measure there (the strategy's:
       // the BSDF's for a BSDF sample, cos / pi for Lambert; and the whole mixture's, pdf), the
-      // radiance it sends back; PG_VPL_* bits in w (include/rtpg/guiding_layout.h).
+      // normal there, the radiance it sends back and its PG_VPL_* bits, packed
+      // (include/rtpg/guiding_layout.h, include/rtpg/vpl_packing.h).
       const std::uint32_t strategy = s.strategy[i];
-      const float info =
-          static_cast<float>((t > 0.0f ? PG_VPL_VALID : 0u) | (strategy << PG_VPL_STRATEGY_SHIFT));
+      const std::uint32_t info =
+          (t > 0.0f ? PG_VPL_VALID : 0u) | (strategy << PG_VPL_STRATEGY_SHIFT);
       if (t > 0.0f) {
         const Vec3 y = p + d * t, ny = normalize(y - kLight);
         const float source_pdf = strategy == PG_STRATEGY_BSDF ? d.z / kPi : pdf;
         const float to_area = std::fabs(dot(ny, d)) / (t * t);
         v.position[i] = {y.x, y.y, y.z, source_pdf * to_area};
-        v.normal[i] = {ny.x, ny.y, ny.z, pdf * to_area};
-        v.radiance_info[i] = {kLe, kLe, kLe, info};
+        v.normal_radiance[i] = rtpg::pack_vpl_normal_radiance({ny.x, ny.y, ny.z}, pdf * to_area,
+                                                              {kLe, kLe, kLe}, info);
       } else {
         v.position[i] = {0.0f, 0.0f, 0.0f, 0.0f};
-        v.normal[i] = {0.0f, 0.0f, 0.0f, 0.0f};
-        v.radiance_info[i] = {0.0f, 0.0f, 0.0f, info};
+        v.normal_radiance[i] =
+            rtpg::pack_vpl_normal_radiance({0.0f, 0.0f, 0.0f}, 0.0f, {0.0f, 0.0f, 0.0f}, info);
       }
     }
     if (frame >= frames - 8) error_sum += error / static_cast<double>(n);

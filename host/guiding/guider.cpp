@@ -121,7 +121,7 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
     }
     if (local_tile_) {
       const std::size_t tile = static_cast<std::size_t>(group_x_ + 2 * settings.apron) *
-                               (group_y_ + 2 * settings.apron) * 3 * 16;
+                               (group_y_ + 2 * settings.apron) * 2 * 16;
       // Plus the work-group's count records (kernels/shared/work_group_sum.h).
       const std::size_t used = train_.getWorkGroupInfo<CL_KERNEL_LOCAL_MEM_SIZE>(runtime.device()) +
                                group * PG_COUNT_RECORD_BYTES;
@@ -266,7 +266,7 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
     args << current << vpls << state.state0 << state.state1 << train_counts_
          << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
          << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame) << kernel_settings_;
-    if (train_lanes_ == 1) args << cl::Local(tile) << cl::Local(tile) << cl::Local(tile);
+    if (train_lanes_ == 1) args << cl::Local(tile) << cl::Local(tile);
     args << cl::Local(train_launch_.group_items * PG_COUNT_RECORD_BYTES);
     times_.train_ms = run(train_, train_launch_);
   });

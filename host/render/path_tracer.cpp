@@ -16,6 +16,7 @@
 #include "render/surface.h"
 #include "shared/guiding_pixel.h"
 #include "shared/rng.h"
+#include "shared/vpl_packing.h"
 #include "rtpg/guiding_layout.h"
 
 namespace rtpg {
@@ -319,7 +320,8 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
           if (vpls) {
             const float strategy_pdf = vpls->strategy_pdf[i];
             vpls->position[i] = glm::vec4(dir, strategy_pdf);
-            vpls->normal[i] = glm::vec4(0.0f, 0.0f, 0.0f, vpl_paths_[i].sampler_pdf);
+            vpls->normal_radiance[i].x = shared::pg_pack_vpl_normal(glm::vec3(0.0f));
+            vpls->normal_radiance[i].y = shared::pg_pack_vpl_density(vpl_paths_[i].sampler_pdf);
             if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
           }
         }
@@ -341,7 +343,9 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         const float cos_y = std::fabs(glm::dot(sp.geometric_normal, dir));
         const float strategy_pdf = vpls->strategy_pdf[i] * cos_y / d2;
         vpls->position[i] = glm::vec4(sp.position, strategy_pdf);
-        vpls->normal[i] = glm::vec4(sp.geometric_normal, vpl_paths_[i].sampler_pdf * cos_y / d2);
+        vpls->normal_radiance[i].x = shared::pg_pack_vpl_normal(sp.geometric_normal);
+        vpls->normal_radiance[i].y =
+            shared::pg_pack_vpl_density(vpl_paths_[i].sampler_pdf * cos_y / d2);
         if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID;
       }
       if (depth == settings_.max_bounces) continue;
@@ -570,9 +574,10 @@ void PathTracer::gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls,
           if (vpls) {
             const glm::vec3 vpl_l = p.radiance;
             if (!is_finite(vpl_l)) vpls->info[i] &= ~PG_VPL_VALID;
-            // The kernels read the info bits from radiance_info.w (exact: small integers).
-            vpls->radiance_info[i] = glm::vec4(is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f),
-                                               static_cast<float>(vpls->info[i]));
+            // The kernels read the info bits from the packed channel's w.
+            const glm::vec3 l = is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f);
+            vpls->normal_radiance[i].z = shared::pg_pack_vpl_radiance_rg(l);
+            vpls->normal_radiance[i].w = shared::pg_pack_vpl_radiance_b_info(l, vpls->info[i]);
           }
         }
         return bad;

@@ -1,7 +1,7 @@
 // The VPLs of one frame on the host: the first-bounce hit of every pixel's path, written by
 // the path tracer, read by the guiding trainer. Its channels come from PG_VPL_CHANNELS (layout
-// and meaning: include/rtpg/guiding_layout.h); info is the host's integer copy of the info
-// word that radiance_info.w carries as a float for the kernels.
+// and meaning: include/rtpg/guiding_layout.h); info is the host's copy of the info word that
+// normal_radiance.w carries packed for the kernels.
 #pragma once
 
 #include <cstddef>
@@ -20,16 +20,17 @@ struct VplBuffer {
   std::vector<std::uint32_t> info;  // PG_VPL_* bits, the strategy in bits 8..15
   // Host only, from the first bounce to its hit: the density (solid angle at x0) of the
   // strategy that drew the direction, which becomes position.w in area measure at the hit.
-  // Kept apart so that the path tracer writes position and normal once, whole, at the hit,
-  // instead of their w at x0 and the rest at y (docs/guiding.md, "The VPLs written once").
+  // Kept apart so that the path tracer writes position, normal and mixture density once, at
+  // the hit, instead of some at x0 and the rest at y (docs/guiding.md, "The VPLs written once").
   std::vector<float> strategy_pdf;
 
   // Every VPL invalid: info 0. Each frame's path tracer calls it, so only a new size zeroes
   // every channel; otherwise the channels keep last frame's values, read by nobody before the
-  // path tracer writes them (strategy_pdf and a VPL's position and normal only where its path
-  // reaches the first bounce's hit) (it rewrites radiance_info, the kernels' copy of info, for
-  // every pixel: PathTracer::gather). Zeroing all 52 bytes a pixel every frame was a serial pass of
-  // 27 MB at 960x540 (docs/host-path-tracer.md, "Empty shadow rays skipped; per-frame fills").
+  // path tracer writes them (strategy_pdf, a VPL's position, normal and mixture density only
+  // where its path reaches the first bounce's hit; the radiance and the kernels' copy of info
+  // in normal_radiance for every pixel, PathTracer::gather). Zeroing every channel each frame
+  // (52 bytes a pixel when a VPL took 48) was a serial pass of 27 MB at 960x540
+  // (docs/host-path-tracer.md, "Empty shadow rays skipped; per-frame fills").
   void resize(std::size_t n);
 };
 

@@ -38,19 +38,19 @@
 
 /* ---- VPLs: the first-bounce hit y of every pixel's path, the trainer's input -------------
  * (paper, section 3.1: the texture Pi)
- * position       xyz hit point y (or the unit direction of an escaped ray); w the density of
- *                the strategy that generated y (the BSDF's for a BSDF sample, else D), in
- *                area measure at y (solid angle for an escaped ray), so that a neighbouring
- *                pixel can convert it to its own solid angle
- * normal         xyz geometric normal at y (facing the pixel's point), w the full mixture
- *                density D of the direction (whatever the strategy), in area measure at y
- *                (solid angle for an escaped ray)
- * radiance_info  rgb radiance leaving y towards the pixel's point; w the info word as a float
- *                (exact: small integers): PG_VPL_* bits, the strategy in bits 8..15 */
+ * position          xyz hit point y (or the unit direction of an escaped ray); w the density
+ *                   of the strategy that generated y (the BSDF's for a BSDF sample, else D), in
+ *                   area measure at y (solid angle for an escaped ray), so that a neighbouring
+ *                   pixel can convert it to its own solid angle
+ * normal_radiance   packed (kernels/shared/vpl_packing.h, which packs and unpacks it): the
+ *                   geometric normal at y (facing the pixel's point; octahedral), the full
+ *                   mixture density D of the direction whatever the strategy (area measure at
+ *                   y, solid angle for an escaped ray; exact), the rgb radiance leaving y
+ *                   towards the pixel's point (bfloat16) and the info word: PG_VPL_* bits, the
+ *                   strategy in bits 8..15 */
 #define PG_VPL_CHANNELS(X) \
   X(position, float4, 16)  \
-  X(normal, float4, 16)    \
-  X(radiance_info, float4, 16)
+  X(normal_radiance, uint4, 16)
 
 #define PG_VPL_VALID 1u
 #define PG_VPL_DISTANT 2u /* escaped ray: position holds a direction */

@@ -21,6 +21,7 @@
 #define pg_make_float2(x, y) ((float2)((x), (y)))
 #define pg_make_float3(x, y, z) ((float3)((x), (y), (z)))
 #define pg_make_float4(x, y, z, w) ((float4)((x), (y), (z), (w)))
+#define pg_make_uint4(x, y, z, w) ((uint4)((x), (y), (z), (w)))
 #define pg_float4_xyz(v) ((v).xyz)
 #define PG_PRIVATE __private
 
@@ -46,6 +47,7 @@ typedef glm::vec3 float3;
 typedef glm::vec4 float4;
 typedef std::uint32_t uint;
 typedef std::uint64_t ulong;
+typedef glm::uvec4 uint4;
 
 using glm::cross;
 using glm::dot;
@@ -70,8 +72,22 @@ PG_FN float3 pg_make_float3(float x, float y, float z) {
 PG_FN float4 pg_make_float4(float x, float y, float z, float w) {
   return float4(x, y, z, w);
 }
+PG_FN uint4 pg_make_uint4(uint x, uint y, uint z, uint w) {
+  return uint4(x, y, z, w);
+}
 PG_FN float3 pg_float4_xyz(float4 v) {
   return float3(v.x, v.y, v.z);
+}
+/* OpenCL C's reinterpretations of a float's bits. */
+PG_FN uint as_uint(float x) {
+  uint u;
+  std::memcpy(&u, &x, sizeof u);
+  return u;
+}
+PG_FN float as_float(uint u) {
+  float x;
+  std::memcpy(&x, &u, sizeof x);
+  return x;
 }
 /* fmax and fmin with the results of OpenCL C and glibc (the other operand where one is NaN, the
  * second where both compare equal, so signed zeros come out as glibc's, bit for bit), inline:

@@ -11,6 +11,7 @@
 #include "shared/guiding_pixel.h"
 #include "shared/pmm.h"
 #include "shared/rng.h"
+#include "shared/vpl_packing.h"
 
 PG_NAMESPACE_BEGIN
 
@@ -22,19 +23,19 @@ typedef struct {
   pg_lobes lobes;
 } pg_train_pixel;
 
-/* One VPL (position_pdf, normal, radiance with the info bits in w) as a training sample of
- * this pixel: x = weight a = lum(L f_r cos) / r, (y, z) = square point, w = BSDF density, and
+/* One VPL (its two channels, include/rtpg/guiding_layout.h) as a training sample of this
+ * pixel: x = weight a = lum(L f_r cos) / r, (y, z) = square point, w = BSDF density, and
  * *density = r, the density of its direction in this pixel's solid angle. Returns 0 when the VPL
  * says nothing about this pixel's hemisphere. With train_all_samples every VPL counts at the
- * density its pixel really sampled with (the whole mixture D, in normal.w); otherwise BSDF-strategy
- * VPLs only, at the BSDF's density (paper 3.2). */
-PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float4 normal,
-                                   float4 radiance_info, pg_kernel_settings p,
-                                   PG_PRIVATE float4* sample, PG_PRIVATE float* density_out) {
-  uint info = (uint)radiance_info.w;
+ * density its pixel really sampled with (the whole mixture D); otherwise BSDF-strategy VPLs only,
+ * at the BSDF's density (paper 3.2). */
+PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, uint4 normal_radiance,
+                                   pg_kernel_settings p, PG_PRIVATE float4* sample,
+                                   PG_PRIVATE float* density_out) {
+  uint info = pg_vpl_info(normal_radiance);
   if ((info & PG_VPL_VALID) == 0u) return 0;
   if (!p.train_all_samples && PG_VPL_STRATEGY(info) != PG_STRATEGY_BSDF) return 0;
-  float density = p.train_all_samples ? normal.w : position_pdf.w;
+  float density = p.train_all_samples ? pg_vpl_mixture_density(normal_radiance) : position_pdf.w;
   float3 w;
   float r; /* density of w as seen from this pixel */
   if ((info & PG_VPL_DISTANT) != 0u) {
@@ -46,14 +47,14 @@ PG_FN int pg_train_sample_from_vpl(pg_train_pixel px, float4 position_pdf, float
     if (!(d2 > 0.0f)) return 0;
     w = to * (1.0f / sqrt(d2));
     /* The VPL's density is in area measure at y: to this pixel's solid angle. */
-    float cos_y = -dot(pg_float4_xyz(normal), w);
+    float cos_y = -dot(pg_vpl_normal(normal_radiance), w);
     if (cos_y <= 1e-4f) return 0; /* y faces away from x */
     r = density * d2 / cos_y;
   }
   if (!(r > 0.0f) || !isfinite(r)) return 0;
   float3 wl = pg_to_local(px.frame, w);
   if (wl.z <= 0.0f) return 0;
-  float3 radiance = pg_float4_xyz(radiance_info);
+  float3 radiance = pg_vpl_radiance(normal_radiance);
   *density_out = r;
   if (pg_max3(radiance) <= 0.0f) { /* a dark VPL: weight 0, no need to map it */
     *sample = pg_make_float4(0.0f, 0.5f, 0.5f, 0.0f);

@@ -21,14 +21,14 @@ typedef struct {
   pg_lobes_w lobes;
 } pg_train_pixels_w;
 
-/* One VPL per lane (the three channels of include/rtpg/guiding_layout.h, split). */
+/* One VPL per lane (the channels of include/rtpg/guiding_layout.h, split and unpacked). */
 typedef struct {
   pg_float3w position; /* or a direction, for a distant VPL */
   pg_floatw position_pdf;
   pg_float3w normal;
   pg_floatw mixture_pdf;
   pg_float3w radiance;
-  pg_floatw info;
+  pg_uintw info;
 } pg_vpls_w;
 
 /* A training sample per lane (pg_train_sample_from_vpl's float4 and density, and whether it
@@ -42,7 +42,7 @@ typedef struct {
 static inline pg_train_samples_w pg_train_samples_from_vpls_w(pg_train_pixels_w px, pg_vpls_w v,
                                                               pg_intw asked, pg_kernel_settings p,
                                                               int any_specular) {
-  pg_uintw info = pg_convert_uintw(v.info);
+  pg_uintw info = v.info;
   pg_intw ok = asked & ((info & PG_VPL_VALID) != 0u);
   if (!p.train_all_samples) ok &= PG_VPL_STRATEGY(info) == PG_STRATEGY_BSDF;
   pg_floatw density = p.train_all_samples ? v.mixture_pdf : v.position_pdf;

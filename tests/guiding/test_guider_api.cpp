@@ -3,6 +3,7 @@
 // are the ones include/rtpg/guiding_layout.h documents.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -13,12 +14,12 @@
 #include "rtpg/cl_runtime.h"
 #include "rtpg/guider.h"
 #include "rtpg/guiding_distribution.h"
+#include "rtpg/vpl_packing.h"
 
 namespace {
 
 constexpr std::uint32_t kSky = PG_GBUF_SKY;
-constexpr float kValidBsdfVpl =
-    static_cast<float>(PG_VPL_VALID | (PG_STRATEGY_BSDF << PG_VPL_STRATEGY_SHIFT));
+constexpr std::uint32_t kValidBsdfVpl = PG_VPL_VALID | (PG_STRATEGY_BSDF << PG_VPL_STRATEGY_SHIFT);
 constexpr std::uint32_t kNone = PG_STRATEGY_NONE, kBsdf = PG_STRATEGY_BSDF,
                         kGuide = PG_STRATEGY_GUIDE;
 
@@ -162,18 +163,19 @@ TEST(GuiderApi, CreateResetReprojectSampleTrainAndStateRoundTrip) {
 
   // Training from bright VPLs 2 units above every pixel (valid, BSDF strategy): every surface
   // pixel takes an EM step (k: 5 -> 6); the sky does not.
-  std::vector<float> vp(4 * n), vn(4 * n), vr(4 * n);
+  std::vector<float> vp(4 * n);
+  std::vector<std::uint32_t> vnr(4 * n);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       const float pos[4] = {0.1f * x + 0.3f, 0.1f * y, 2.0f, 1.0f};  // w: area density
-      const float nrm[4] = {0.0f, 0.0f, -1.0f, 1.0f};  // w: the mixture's area density
-      const float rad[4] = {5.0f, 5.0f, 5.0f, y == 0 ? 0.0f : kValidBsdfVpl};
+      // Facing down, the mixture's area density 1, radiance 5, packed (rtpg/vpl_packing.h).
+      const std::array<std::uint32_t, 4> packed = rtpg::pack_vpl_normal_radiance(
+          {0.0f, 0.0f, -1.0f}, 1.0f, {5.0f, 5.0f, 5.0f}, y == 0 ? 0u : kValidBsdfVpl);
       std::memcpy(&vp[4 * i], pos, sizeof pos);
-      std::memcpy(&vn[4 * i], nrm, sizeof nrm);
-      std::memcpy(&vr[4 * i], rad, sizeof rad);
+      std::memcpy(&vnr[4 * i], packed.data(), sizeof packed);
     }
-  guider.train(g, {upload(rt, vp), upload(rt, vn), upload(rt, vr)}, 42u, 4u);
+  guider.train(g, {upload(rt, vp), upload(rt, vnr)}, 42u, 4u);
   EXPECT_EQ(guider.count_trained(), n - static_cast<std::size_t>(w));
   guider.read_state(state);
   for (std::size_t i = 0; i < n; ++i) {

@@ -176,11 +176,10 @@ HostVpls random_vpls(Random& r, std::size_t n) {
     const float mixture_pdf = strategy == PG_STRATEGY_GUIDE
                                   ? v.position.back().w
                                   : v.position.back().w * r.uniform(0.5f, 2.0f);
-    v.normal.push_back(float4(nrm.x, nrm.y, nrm.z, mixture_pdf));
     const float l = r.uniform();
     const float scale = l < 0.1f ? 0.0f : (l < 0.15f ? 1000.0f : 5.0f);
-    v.radiance_info.push_back(float4(scale * r.uniform(), scale * r.uniform(), scale * r.uniform(),
-                                     static_cast<float>(info)));
+    const float3 radiance(scale * r.uniform(), scale * r.uniform(), scale * r.uniform());
+    v.normal_radiance.push_back(sh::pg_pack_vpl_normal_radiance(nrm, mixture_pdf, radiance, info));
   }
   return v;
 }
@@ -458,7 +457,7 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
         const int sx = x + c % side - p.apron, sy = y + c / side - p.apron;
         if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
         const int j = sy * w + sx;
-        kept += sh::pg_train_sample_from_vpl(px, v.position[j], v.normal[j], v.radiance_info[j], p,
+        kept += sh::pg_train_sample_from_vpl(px, v.position[j], v.normal_radiance[j], p,
                                              &samples[kept], &densities[kept]);
       }
       if (conditioning) {
@@ -840,7 +839,10 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
     // give what the scalar code gives pixel by pixel.
     for (std::size_t i = 0; i < g.n(); ++i)
       if (static_cast<int>(i % static_cast<std::size_t>(kc.width)) < kc.width / 3)
-        v.radiance_info[i] = float4(0.0f, 0.0f, 0.0f, v.radiance_info[i].w);
+        v.normal_radiance[i] =
+            sh::pg_pack_vpl_normal_radiance(sh::pg_vpl_normal(v.normal_radiance[i]),
+                                            sh::pg_vpl_mixture_density(v.normal_radiance[i]),
+                                            float3(0.0f), sh::pg_vpl_info(v.normal_radiance[i]));
     const GuiderGBuffer dg = upload(rt, g);
     const GuiderVpls dv = upload(rt, v, g.width, g.height);
     GuidingSettings settings;
@@ -1229,19 +1231,14 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
   }
   expect_guider_error(
       [&] {
-        guider.train(good, {short16, vpls.normal, vpls.radiance_info}, 1, 0);
+        guider.train(good, {short16, vpls.normal_radiance}, 1, 0);
       },
       "vpls.position");
   expect_guider_error(
       [&] {
-        guider.train(good, {vpls.position, short16, vpls.radiance_info}, 1, 0);
+        guider.train(good, {vpls.position, short16}, 1, 0);
       },
-      "vpls.normal");
-  expect_guider_error(
-      [&] {
-        guider.train(good, {vpls.position, vpls.normal, short16}, 1, 0);
-      },
-      "vpls.radiance_info");
+      "vpls.normal_radiance");
   expect_guider_error([&] { guider.write_state(std::vector<float>(state.size() - 1)); },
                       "write_state");
   expect_guider_error([&] { guider.write_state(std::vector<float>(state.size() + 8)); },

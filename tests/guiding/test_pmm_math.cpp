@@ -993,15 +993,19 @@ TEST(PmmTrainSample, VplWeightByHand) {
   px.frame = pg_frame_from_normal(float3(0.0f, 0.0f, 1.0f));
   px.wo = float3(0.0f, 0.0f, 1.0f);
   px.lobes = pg_make_lobes(grey, px.wo);
-  const float bsdf_info = float(PG_VPL_VALID | (PG_STRATEGY_BSDF << PG_VPL_STRATEGY_SHIFT));
-  const float guide_info = float(PG_VPL_VALID | (PG_STRATEGY_GUIDE << PG_VPL_STRATEGY_SHIFT));
+  const uint bsdf_info = PG_VPL_VALID | (PG_STRATEGY_BSDF << PG_VPL_STRATEGY_SHIFT);
+  const uint guide_info = PG_VPL_VALID | (PG_STRATEGY_GUIDE << PG_VPL_STRATEGY_SHIFT);
   const float4 position_pdf(0.0f, 3.0f, 4.0f, 0.2f);
-  const float4 normal(0.0f, 0.0f, -1.0f, 0.3f);  // w: the whole mixture's area density
+  // The packed channel: facing straight down, the whole mixture's area density 0.3, radiance 2
+  // (both exact after packing: the octahedral map keeps the poles, bfloat16 keeps 2).
+  auto packed = [](float3 normal, uint info) {
+    return pg_pack_vpl_normal_radiance(normal, 0.3f, float3(2.0f), info);
+  };
+  const float3 down(0.0f, 0.0f, -1.0f), up(0.0f, 0.0f, 1.0f);
   float4 sample;
   float density = 0.0f;
-  ASSERT_EQ(pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, bsdf_info), p,
-                                     &sample, &density),
-            1);
+  ASSERT_EQ(
+      pg_train_sample_from_vpl(px, position_pdf, packed(down, bsdf_info), p, &sample, &density), 1);
   EXPECT_NEAR(sample.x, 0.8 / (6.25 * kPiD), 1e-6);
   EXPECT_NEAR(sample.w, 0.8 / kPiD, 1e-6);
   const float3 w = pg_square_to_hemisphere(float2(sample.y, sample.z));
@@ -1010,28 +1014,27 @@ TEST(PmmTrainSample, VplWeightByHand) {
   EXPECT_NEAR(w.z, 0.8f, 1e-5f);
   // A guide-strategy VPL trains only with train_all_samples (paper 3.2), and then every VPL
   // counts at the whole mixture's density: 0.3 * 25 / 0.8 = 9.375.
-  EXPECT_EQ(pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, guide_info), p,
-                                     &sample, &density),
-            0);
+  EXPECT_EQ(
+      pg_train_sample_from_vpl(px, position_pdf, packed(down, guide_info), p, &sample, &density),
+      0);
   p.train_all_samples = 1;
-  ASSERT_EQ(pg_train_sample_from_vpl(px, position_pdf, normal, float4(2, 2, 2, guide_info), p,
-                                     &sample, &density),
-            1);
+  ASSERT_EQ(
+      pg_train_sample_from_vpl(px, position_pdf, packed(down, guide_info), p, &sample, &density),
+      1);
   EXPECT_NEAR(sample.x, 0.8 / (9.375 * kPiD), 1e-6);
   p.train_all_samples = 0;
   // A distant VPL (an escaped ray) holds its direction and a solid-angle density already.
-  const float distant_info = bsdf_info + float(PG_VPL_DISTANT);
-  ASSERT_EQ(pg_train_sample_from_vpl(px, float4(0.0f, 0.6f, 0.8f, 0.2f), normal,
-                                     float4(2, 2, 2, distant_info), p, &sample, &density),
+  const uint distant_info = bsdf_info | PG_VPL_DISTANT;
+  ASSERT_EQ(pg_train_sample_from_vpl(px, float4(0.0f, 0.6f, 0.8f, 0.2f), packed(down, distant_info),
+                                     p, &sample, &density),
             1);
   EXPECT_NEAR(sample.x, 0.8 / (0.2 * kPiD), 1e-5);
   // A VPL whose surface faces away from the pixel, or one below the pixel's horizon, says
   // nothing about its hemisphere.
-  EXPECT_EQ(pg_train_sample_from_vpl(px, position_pdf, float4(0, 0, 1, 0.3f),
-                                     float4(2, 2, 2, bsdf_info), p, &sample, &density),
+  EXPECT_EQ(pg_train_sample_from_vpl(px, position_pdf, packed(up, bsdf_info), p, &sample, &density),
             0);
-  EXPECT_EQ(pg_train_sample_from_vpl(px, float4(0, 3, -4, 0.2f), float4(0, 0, 1, 0.3f),
-                                     float4(2, 2, 2, bsdf_info), p, &sample, &density),
+  EXPECT_EQ(pg_train_sample_from_vpl(px, float4(0, 3, -4, 0.2f), packed(up, bsdf_info), p, &sample,
+                                     &density),
             0);
 }
 

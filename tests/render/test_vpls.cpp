@@ -19,6 +19,7 @@
 #include "rtpg/cl_runtime.h"
 #include "scene/scene_loader.h"
 #include "shared/bsdf.h"
+#include "shared/vpl_packing.h"
 
 namespace rtpg {
 namespace {
@@ -69,8 +70,11 @@ VplCounts check_vpls(const std::string& scene_file, int frames) {
     ++counts.surfaces;
     const std::uint32_t info = v.info[i];
     const float d = kept.direction_pdf[i].w;
+    // The kernels' copy of the info word, packed beside the radiance.
+    EXPECT_EQ(shared::pg_vpl_info(v.normal_radiance[i]), info) << "pixel " << i;
     if (!(info & PG_VPL_VALID)) continue;
     SCOPED_TRACE("pixel " + std::to_string(i));
+    const float mixture_density = shared::pg_vpl_mixture_density(v.normal_radiance[i]);
     ++counts.valid;
     const std::uint32_t strategy = PG_VPL_STRATEGY(info);
     if (!(d > 0.0f) || strategy != kept.strategy[i]) {
@@ -91,17 +95,20 @@ VplCounts check_vpls(const std::string& scene_file, int frames) {
       ++counts.distant;
       EXPECT_NEAR(glm::length(glm::vec3(v.position[i]) - glm::normalize(wi_world)), 0.0f, 1e-6f);
       EXPECT_FLOAT_EQ(v.position[i].w, own);
-      EXPECT_FLOAT_EQ(v.normal[i].w, d);
+      EXPECT_FLOAT_EQ(mixture_density, d);
       continue;
     }
     const glm::vec3 to = glm::vec3(v.position[i]) - glm::vec3(g.position_depth[i]);
     const float d2 = glm::dot(to, to);
-    const glm::vec3 ng(v.normal[i]);
+    const glm::vec3 ng = shared::pg_vpl_normal(v.normal_radiance[i]);
     EXPECT_NEAR(glm::length(ng), 1.0f, 1e-5f);
     EXPECT_NEAR(glm::length(glm::normalize(to) - glm::normalize(wi_world)), 0.0f, 1e-3f);
+    // The packed normal is within PG_OCTAHEDRAL_MAX_ANGLE of the surface's, so its cosine
+    // within that much of the one the densities were converted with.
     const float to_area = std::fabs(glm::dot(ng, glm::normalize(wi_world))) / d2;
-    EXPECT_NEAR(v.position[i].w, own * to_area, 1e-4f * own * to_area);
-    EXPECT_NEAR(v.normal[i].w, d * to_area, 1e-4f * d * to_area);
+    const float cos_error = PG_OCTAHEDRAL_MAX_ANGLE / d2;
+    EXPECT_NEAR(v.position[i].w, own * to_area, 1e-4f * own * to_area + own * cos_error);
+    EXPECT_NEAR(mixture_density, d * to_area, 1e-4f * d * to_area + d * cos_error);
   }
   return counts;
 }
