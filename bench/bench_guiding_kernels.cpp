@@ -95,6 +95,10 @@ struct Inputs {
   GuiderSamples d_samples;
   double reproject_bytes = 0, sample_bytes = 0, train_bytes = 0;
   double reproject_flops = 0, sample_flops = 0, train_flops = 0;
+  // Of the neighbours a training pixel asks for (frame 1's walk), those that give it a sample,
+  // and those with light (count_kept): a Train case on VPLs that train nothing measures an idle
+  // kernel (docs/guiding.md, "The train benchmark trained on nothing").
+  double train_kept_fraction = 0, train_lit_fraction = 0;
 };
 
 float3 tilt(std::mt19937& g, float3 n, float max_deg) {
@@ -341,6 +345,51 @@ void count_flops(Inputs& in, const pg_kernel_settings& p) {
     }
 }
 
+// What pixel i knows about itself while training (as kernels/train.cl builds it).
+sh::pg_train_pixel train_pixel_of(const Inputs& in, std::size_t i) {
+  sh::pg_train_pixel px;
+  px.x = sh::pg_float4_xyz(in.cur.position_depth[i]);
+  px.frame = sh::pg_frame_from_normal(sh::pg_float4_xyz(in.cur.shading_normal[i]));
+  px.wo = sh::pg_to_local(px.frame, sh::pg_float4_xyz(in.cur.view_dir[i]));
+  px.lobes = sh::pg_make_lobes(
+      sh::pg_material_from_gbuffer(in.cur.base_color_roughness[i], in.cur.metallic_specular[i]),
+      px.wo);
+  return px;
+}
+
+// train_kept_fraction and train_lit_fraction over every pixel guiding applies to, its
+// neighbours of frame 1's walk (seed 1).
+void count_kept(Inputs& in, const pg_kernel_settings& p) {
+  const int w = in.w, h = in.h, side = 2 * p.apron + 1;
+  double asked = 0, kept = 0, lit = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (!sh::pg_guiding_applies(in.cur.flags[i], in.cur.base_color_roughness[i].w, p)) continue;
+      const sh::pg_train_pixel px = train_pixel_of(in, i);
+      const int n =
+          std::min(std::min(sh::pg_pmm_neighbour_count(in.state[8 * i + 7], p), side * side),
+                   PG_MAX_TRAIN_SAMPLES);
+      const sh::uint start = sh::pg_train_walk_start(1u, x, y, static_cast<sh::uint>(w), 1u, p);
+      for (int s = 0; s < n; ++s) {
+        const int wi = sh::pg_train_window_index(start, s, p);
+        const int sx = x + wi % side - p.apron, sy = y + wi / side - p.apron;
+        if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
+        const std::size_t j = static_cast<std::size_t>(sy) * w + sx;
+        float4 sample;
+        float density = 0.0f;
+        ++asked;
+        if (sh::pg_train_sample_from_vpl(px, in.vpls.position[j], in.vpls.normal_radiance[j], p,
+                                         &sample, &density)) {
+          ++kept;
+          lit += sample.x > 0.0f;
+        }
+      }
+    }
+  in.train_kept_fraction = asked > 0 ? kept / asked : 0.0;
+  in.train_lit_fraction = asked > 0 ? lit / asked : 0.0;
+}
+
 Inputs& inputs_for(int w, int h) {
   static std::map<std::pair<int, int>, std::unique_ptr<Inputs>> cache;
   auto& slot = cache[{w, h}];
@@ -357,6 +406,7 @@ Inputs& inputs_for(int w, int h) {
   make_states(in, g, static_cast<float>(settings.k_max));
   count_bytes(in, to_kernel_settings(settings));
   count_flops(in, to_kernel_settings(settings));
+  count_kept(in, to_kernel_settings(settings));
   in.d_cur = testing::upload(runtime(), in.cur);
   in.d_prev = testing::upload(runtime(), in.prev);
   in.d_vpls = testing::upload(runtime(), in.vpls, w, h);
@@ -484,6 +534,12 @@ void BM_GuidingKernel(benchmark::State& state, Kernel kernel, int w, int h, int 
   state.counters["vs_16x16_global"] = kernel_ms / ref_ms;
   state.counters["row_work_groups"] = g->row_work_groups() ? 1.0 : 0.0;
   if (kernel == Kernel::Train) {
+    state.counters["kept_fraction"] = in.train_kept_fraction;
+    state.counters["lit_fraction"] = in.train_lit_fraction;
+    if (!(in.train_lit_fraction > 0.0))
+      state.SkipWithError("the synthetic VPLs give the train kernel no lit sample");
+  }
+  if (kernel == Kernel::Train) {
     state.counters["local_tile"] = g->train_uses_local_memory() ? 1.0 : 0.0;
     state.counters["lanes"] = g->train_lanes();
   }
@@ -509,12 +565,7 @@ void tbb_train(const Inputs& in, const pg_kernel_settings& params, std::uint32_t
           sh::pg_pmm_state st;
           st.s0 = s0;
           st.s1 = s1;
-          sh::pg_train_pixel px;
-          px.x = sh::pg_float4_xyz(in.cur.position_depth[i]);
-          px.frame = sh::pg_frame_from_normal(sh::pg_float4_xyz(in.cur.shading_normal[i]));
-          px.wo = sh::pg_to_local(px.frame, sh::pg_float4_xyz(in.cur.view_dir[i]));
-          px.lobes = sh::pg_make_lobes(
-              sh::pg_material_from_gbuffer(bcr, in.cur.metallic_specular[i]), px.wo);
+          const sh::pg_train_pixel px = train_pixel_of(in, static_cast<std::size_t>(i));
           const int apron = params.apron, side = 2 * apron + 1;
           const int n = std::min(std::min(sh::pg_pmm_neighbour_count(s1.w, params), side * side),
                                  PG_MAX_TRAIN_SAMPLES);
