@@ -106,41 +106,55 @@ static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x0, i
     int row_inside = sy >= 0 && sy < (int)height;
     pg_intw sx = sx0 + lane;
     pg_intw asked_w = (s < counts) & (sx >= 0) & (sx < (int)width) & (pg_intw)(-row_inside);
-    /* The VPLs' two channels as eight rows: position and its density, then the packed
-     * channel's four words (loaded through a float pointer and reinterpreted: the bits are all
-     * that a load moves). */
-    pg_floatw row[8];
+    /* The VPLs' two channels as rows: position and its density as floats, the packed
+     * channel's four words as integers (kernels/wide/lanes.h, pg_load_uint4_rows). A lane not
+     * asked reads zeros: info 0, not a VPL. */
+    pg_floatw row[4];
+    pg_uintw packed[4];
     if (!row_inside) {
-      for (int f = 0; f < 8; ++f) row[f] = (pg_floatw)(0.0f);
+      for (int f = 0; f < 4; ++f) {
+        row[f] = (pg_floatw)(0.0f);
+        packed[f] = (pg_uintw)(0u);
+      }
     } else if (sx0 >= 0 && sx0 + PG_LANES <= (int)width) {
       int j = sy * (int)width + sx0;
       pg_load_float4_rows(vpl_position + j, &row[0], &row[1], &row[2], &row[3]);
-      pg_load_float4_rows((__global const float4*)(vpl_normal_radiance + j), &row[4], &row[5],
-                          &row[6], &row[7]);
-      for (int f = 0; f < 8; ++f) row[f] = select((pg_floatw)(0.0f), row[f], asked_w);
+      pg_load_uint4_rows(vpl_normal_radiance + j, &packed[0], &packed[1], &packed[2], &packed[3]);
+      for (int f = 0; f < 4; ++f) {
+        row[f] = select((pg_floatw)(0.0f), row[f], asked_w);
+        packed[f] = select((pg_uintw)(0u), packed[f], asked_w);
+      }
     } else {
       int asked[PG_LANES];
       pg_vstorew(asked_w, 0, asked);
-      float vpl[8][PG_LANES];
+      float vpl[4][PG_LANES];
+      uint words[4][PG_LANES];
       for (int l = 0; l < PG_LANES; ++l) {
-        float4 position_pdf = (float4)(0.0f), packed = (float4)(0.0f); /* info 0: not a VPL */
+        float4 position_pdf = (float4)(0.0f);
+        uint4 normal_radiance = (uint4)(0u);
         if (asked[l]) {
           int j = sy * (int)width + sx0 + l;
           position_pdf = vpl_position[j];
-          packed = as_float4(vpl_normal_radiance[j]);
+          normal_radiance = vpl_normal_radiance[j];
         }
         pg_put4_rows(vpl, 0, l, position_pdf);
-        pg_put4_rows(vpl, 4, l, packed);
+        words[0][l] = normal_radiance.x;
+        words[1][l] = normal_radiance.y;
+        words[2][l] = normal_radiance.z;
+        words[3][l] = normal_radiance.w;
       }
-      for (int f = 0; f < 8; ++f) row[f] = pg_vloadw(0, vpl[f]);
+      for (int f = 0; f < 4; ++f) {
+        row[f] = pg_vloadw(0, vpl[f]);
+        packed[f] = pg_vloadw(0, words[f]);
+      }
     }
     pg_vpls_w v;
     v.position = pg_make_float3w(row[0], row[1], row[2]);
     v.position_pdf = row[3];
-    v.normal = pg_unpack_unit_vector_w(pg_as_uintw(row[4]));
-    v.mixture_pdf = row[5];
-    v.radiance = pg_vpl_radiance_w(pg_as_uintw(row[6]), pg_as_uintw(row[7]));
-    v.info = pg_as_uintw(row[7]) >> 16;
+    v.normal = pg_unpack_unit_vector_w(packed[0]);
+    v.mixture_pdf = pg_as_floatw(packed[1]);
+    v.radiance = pg_vpl_radiance_w(packed[2], packed[3]);
+    v.info = packed[3] >> 16;
     samples[s] = pg_train_samples_from_vpls_w(px, v, asked_w, settings, any_specular);
   }
 

@@ -1,8 +1,8 @@
 /* The VPL's packed channel, normal_radiance (include/rtpg/guiding_layout.h, "VPLs"): the
  * writer (the host path tracer, or a library user) packs, the train kernels and the host
- * reference unpack. 32 bytes a VPL instead of 48: the trainer reads a VPL about 20 times a frame
- * from cache and its bytes were a third of the train kernel's time (docs/guiding.md, "VPLs in 32
- * bytes"), and every VPL crosses the bus once a frame where the device has its own memory.
+ * reference unpack. 32 bytes a VPL instead of 48: every VPL crosses the bus once a frame where
+ * the device has its own memory, and a GPU's VPL tile in local memory is a third smaller
+ * (docs/guiding.md, "The train benchmark trained on nothing; VPLs in 32 bytes").
  *   x  the geometric normal at y, octahedral (two 16-bit signed normalised integers, x in the
  *      low half): angular error under 1e-4
  *   y  the mixture density D, the float's bits (exact)

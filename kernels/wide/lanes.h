@@ -74,42 +74,56 @@ static inline void pg_put4_rows(__private float (*rows)[PG_LANES], int field, in
 }
 
 /* PG_LANES consecutive float4 (one per lane, as a channel of consecutive pixels) turned into
- * four rows: the x, y, z and w of every lane (a transposition by swizzles, no scalar code). */
-PG_ROW_LOAD void pg_load_float4_rows(__global const float4* p, pg_floatw* x, pg_floatw* y,
-                                     pg_floatw* z, pg_floatw* w) {
-  __global const float* f = (__global const float*)p;
+ * four rows: the x, y, z and w of every lane (a transposition by swizzles, no scalar code).
+ * pg_load_uint4_rows does the same for uint4: a channel of packed words is loaded as integers,
+ * never through float registers, where a device may flush a word that reads as a denormal. One
+ * body for both element types (OpenCL C has no templates). */
 #if PG_LANES == 16
-  float16 a = vload16(0, f), b = vload16(1, f), c = vload16(2, f), d = vload16(3, f);
-  *x = (float16)(a.s0, a.s4, a.s8, a.sc, b.s0, b.s4, b.s8, b.sc, c.s0, c.s4, c.s8, c.sc, d.s0, d.s4,
-                 d.s8, d.sc);
-  *y = (float16)(a.s1, a.s5, a.s9, a.sd, b.s1, b.s5, b.s9, b.sd, c.s1, c.s5, c.s9, c.sd, d.s1, d.s5,
-                 d.s9, d.sd);
-  *z = (float16)(a.s2, a.s6, a.sa, a.se, b.s2, b.s6, b.sa, b.se, c.s2, c.s6, c.sa, c.se, d.s2, d.s6,
-                 d.sa, d.se);
-  *w = (float16)(a.s3, a.s7, a.sb, a.sf, b.s3, b.s7, b.sb, b.sf, c.s3, c.s7, c.sb, c.sf, d.s3, d.s7,
-                 d.sb, d.sf);
+#define PG_LOAD_4_ROWS_BODY(T)                                                                   \
+  PG_PASTE(T, 16) a = vload16(0, f), b = vload16(1, f), c = vload16(2, f), d = vload16(3, f);    \
+  *x = (PG_PASTE(T, 16))(a.s0, a.s4, a.s8, a.sc, b.s0, b.s4, b.s8, b.sc, c.s0, c.s4, c.s8, c.sc, \
+                         d.s0, d.s4, d.s8, d.sc);                                                \
+  *y = (PG_PASTE(T, 16))(a.s1, a.s5, a.s9, a.sd, b.s1, b.s5, b.s9, b.sd, c.s1, c.s5, c.s9, c.sd, \
+                         d.s1, d.s5, d.s9, d.sd);                                                \
+  *z = (PG_PASTE(T, 16))(a.s2, a.s6, a.sa, a.se, b.s2, b.s6, b.sa, b.se, c.s2, c.s6, c.sa, c.se, \
+                         d.s2, d.s6, d.sa, d.se);                                                \
+  *w = (PG_PASTE(T, 16))(a.s3, a.s7, a.sb, a.sf, b.s3, b.s7, b.sb, b.sf, c.s3, c.s7, c.sb, c.sf, \
+                         d.s3, d.s7, d.sb, d.sf);
 #elif PG_LANES == 8
-  float16 a = vload16(0, f), b = vload16(1, f);
-  *x = (float8)(a.s0, a.s4, a.s8, a.sc, b.s0, b.s4, b.s8, b.sc);
-  *y = (float8)(a.s1, a.s5, a.s9, a.sd, b.s1, b.s5, b.s9, b.sd);
-  *z = (float8)(a.s2, a.s6, a.sa, a.se, b.s2, b.s6, b.sa, b.se);
-  *w = (float8)(a.s3, a.s7, a.sb, a.sf, b.s3, b.s7, b.sb, b.sf);
+#define PG_LOAD_4_ROWS_BODY(T)                                           \
+  PG_PASTE(T, 16) a = vload16(0, f), b = vload16(1, f);                  \
+  *x = (PG_PASTE(T, 8))(a.s0, a.s4, a.s8, a.sc, b.s0, b.s4, b.s8, b.sc); \
+  *y = (PG_PASTE(T, 8))(a.s1, a.s5, a.s9, a.sd, b.s1, b.s5, b.s9, b.sd); \
+  *z = (PG_PASTE(T, 8))(a.s2, a.s6, a.sa, a.se, b.s2, b.s6, b.sa, b.se); \
+  *w = (PG_PASTE(T, 8))(a.s3, a.s7, a.sb, a.sf, b.s3, b.s7, b.sb, b.sf);
 #elif PG_LANES == 4
-  float16 a = vload16(0, f);
-  *x = (float4)(a.s0, a.s4, a.s8, a.sc);
-  *y = (float4)(a.s1, a.s5, a.s9, a.sd);
-  *z = (float4)(a.s2, a.s6, a.sa, a.se);
-  *w = (float4)(a.s3, a.s7, a.sb, a.sf);
+#define PG_LOAD_4_ROWS_BODY(T)                   \
+  PG_PASTE(T, 16) a = vload16(0, f);             \
+  *x = (PG_PASTE(T, 4))(a.s0, a.s4, a.s8, a.sc); \
+  *y = (PG_PASTE(T, 4))(a.s1, a.s5, a.s9, a.sd); \
+  *z = (PG_PASTE(T, 4))(a.s2, a.s6, a.sa, a.se); \
+  *w = (PG_PASTE(T, 4))(a.s3, a.s7, a.sb, a.sf);
 #elif PG_LANES == 2
-  float8 a = vload8(0, f);
-  *x = (float2)(a.s0, a.s4);
-  *y = (float2)(a.s1, a.s5);
-  *z = (float2)(a.s2, a.s6);
-  *w = (float2)(a.s3, a.s7);
+#define PG_LOAD_4_ROWS_BODY(T)       \
+  PG_PASTE(T, 8) a = vload8(0, f);   \
+  *x = (PG_PASTE(T, 2))(a.s0, a.s4); \
+  *y = (PG_PASTE(T, 2))(a.s1, a.s5); \
+  *z = (PG_PASTE(T, 2))(a.s2, a.s6); \
+  *w = (PG_PASTE(T, 2))(a.s3, a.s7);
 #else
 #error "PG_LANES must be 2, 4, 8 or 16"
 #endif
+PG_ROW_LOAD void pg_load_float4_rows(__global const float4* p, pg_floatw* x, pg_floatw* y,
+                                     pg_floatw* z, pg_floatw* w) {
+  __global const float* f = (__global const float*)p;
+  PG_LOAD_4_ROWS_BODY(float)
 }
+PG_ROW_LOAD void pg_load_uint4_rows(__global const uint4* p, pg_uintw* x, pg_uintw* y, pg_uintw* z,
+                                    pg_uintw* w) {
+  __global const uint* f = (__global const uint*)p;
+  PG_LOAD_4_ROWS_BODY(uint)
+}
+#undef PG_LOAD_4_ROWS_BODY
 
 /* A float4 channel of the pixels x0 .. x0 + PG_LANES - 1 of one row (row: its first pixel) as
  * four rows: vector loads where every lane lies inside the row; at either end of the row lane

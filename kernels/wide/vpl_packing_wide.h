@@ -7,7 +7,6 @@
 #include "wide/lanes.h"
 
 #define pg_as_floatw PG_PASTE(as_float, PG_LANES)
-#define pg_as_uintw PG_PASTE(as_uint, PG_LANES)
 
 /* pg_snorm16_of per lane. */
 static inline pg_floatw pg_snorm16_of_w(pg_uintw bits) {
