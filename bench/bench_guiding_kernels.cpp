@@ -357,34 +357,48 @@ sh::pg_train_pixel train_pixel_of(const Inputs& in, std::size_t i) {
   return px;
 }
 
+// Pixel (x, y)'s training samples of this frame's walk through its window (kernels/train.cl's
+// loop): the kept ones in samples and densities, their number returned; the walk's length N in
+// *wanted, the neighbours of it inside the image in *asked.
+int neighbour_samples(const Inputs& in, const pg_kernel_settings& p, const sh::pg_train_pixel& px,
+                      int x, int y, float k, std::uint32_t seed, std::uint32_t frame,
+                      float4* samples, float* densities, int* wanted, int* asked) {
+  const int w = in.w, h = in.h, side = 2 * p.apron + 1;
+  const int n =
+      std::min(std::min(sh::pg_pmm_neighbour_count(k, p), side * side), PG_MAX_TRAIN_SAMPLES);
+  const sh::uint start = sh::pg_train_walk_start(seed, x, y, static_cast<sh::uint>(w), frame, p);
+  int kept = 0;
+  *wanted = n;
+  *asked = 0;
+  for (int s = 0; s < n; ++s) {
+    const int wi = sh::pg_train_window_index(start, s, p);
+    const int sx = x + wi % side - p.apron, sy = y + wi / side - p.apron;
+    if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
+    const std::size_t j = static_cast<std::size_t>(sy) * w + sx;
+    ++*asked;
+    kept += sh::pg_train_sample_from_vpl(px, in.vpls.position[j], in.vpls.normal_radiance[j], p,
+                                         &samples[kept], &densities[kept]);
+  }
+  return kept;
+}
+
 // train_kept_fraction and train_lit_fraction over every pixel guiding applies to, its
 // neighbours of frame 1's walk (seed 1).
 void count_kept(Inputs& in, const pg_kernel_settings& p) {
-  const int w = in.w, h = in.h, side = 2 * p.apron + 1;
   double asked = 0, kept = 0, lit = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+  for (int y = 0; y < in.h; ++y)
+    for (int x = 0; x < in.w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * in.w + x;
       if (!sh::pg_guiding_applies(in.cur.flags[i], in.cur.base_color_roughness[i].w, p)) continue;
-      const sh::pg_train_pixel px = train_pixel_of(in, i);
-      const int n =
-          std::min(std::min(sh::pg_pmm_neighbour_count(in.state[8 * i + 7], p), side * side),
-                   PG_MAX_TRAIN_SAMPLES);
-      const sh::uint start = sh::pg_train_walk_start(1u, x, y, static_cast<sh::uint>(w), 1u, p);
-      for (int s = 0; s < n; ++s) {
-        const int wi = sh::pg_train_window_index(start, s, p);
-        const int sx = x + wi % side - p.apron, sy = y + wi / side - p.apron;
-        if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
-        const std::size_t j = static_cast<std::size_t>(sy) * w + sx;
-        float4 sample;
-        float density = 0.0f;
-        ++asked;
-        if (sh::pg_train_sample_from_vpl(px, in.vpls.position[j], in.vpls.normal_radiance[j], p,
-                                         &sample, &density)) {
-          ++kept;
-          lit += sample.x > 0.0f;
-        }
-      }
+      float4 samples[PG_MAX_TRAIN_SAMPLES];
+      float densities[PG_MAX_TRAIN_SAMPLES];
+      int wanted = 0, pixel_asked = 0;
+      const int pixel_kept =
+          neighbour_samples(in, p, train_pixel_of(in, i), x, y, in.state[8 * i + 7], 1u, 1u,
+                            samples, densities, &wanted, &pixel_asked);
+      asked += pixel_asked;
+      kept += pixel_kept;
+      for (int s = 0; s < pixel_kept; ++s) lit += samples[s].x > 0.0f;
     }
   in.train_kept_fraction = asked > 0 ? kept / asked : 0.0;
   in.train_lit_fraction = asked > 0 ? lit / asked : 0.0;
@@ -566,23 +580,11 @@ void tbb_train(const Inputs& in, const pg_kernel_settings& params, std::uint32_t
           st.s0 = s0;
           st.s1 = s1;
           const sh::pg_train_pixel px = train_pixel_of(in, static_cast<std::size_t>(i));
-          const int apron = params.apron, side = 2 * apron + 1;
-          const int n = std::min(std::min(sh::pg_pmm_neighbour_count(s1.w, params), side * side),
-                                 PG_MAX_TRAIN_SAMPLES);
-          const sh::uint start =
-              sh::pg_train_walk_start(seed, x, y, static_cast<sh::uint>(w), frame, params);
           float4 samples[PG_MAX_TRAIN_SAMPLES];
           float densities[PG_MAX_TRAIN_SAMPLES];
-          int kept = 0;
-          for (int s = 0; s < n; ++s) {
-            const int wi = sh::pg_train_window_index(start, s, params);
-            const int sx = x + wi % side - apron, sy = y + wi / side - apron;
-            if (sx < 0 || sy < 0 || sx >= w || sy >= h) continue;
-            const int j = sy * w + sx;
-            kept +=
-                sh::pg_train_sample_from_vpl(px, in.vpls.position[j], in.vpls.normal_radiance[j],
-                                             params, &samples[kept], &densities[kept]);
-          }
+          int n = 0, asked = 0;
+          const int kept = neighbour_samples(in, params, px, x, y, s1.w, seed, frame, samples,
+                                             densities, &n, &asked);
           int updated = 0;
           st = sh::pg_pmm_train(st, samples, densities, kept, params, static_cast<float>(n),
                                 params.em_passes, &updated);
