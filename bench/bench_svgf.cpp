@@ -99,7 +99,10 @@ double power_flops(int n) {
 Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const SvgfSettings& s) {
   const int w = g.width, h = g.height;
   const double power = power_flops(s.phi_normal);
-  const double atrous_tap = 42 + power, variance_tap = 40 + power;
+  // A tap does not compute its phi_z: each pass takes 1 / phi_z once per pixel for each squared
+  // tap distance, 5 flops each (kernels/svgf_atrous.cl, svgf_variance.cl).
+  const double atrous_tap = 38 + power, atrous_inverse_phi_z = 6 * 5;
+  const double variance_tap = 36 + power, variance_inverse_phi_z = 19 * 5;
   auto taps_inside = [&](int x, int y, int radius, int step) {
     int nx = 0, ny = 0;
     for (int d = -radius; d <= radius; ++d) {
@@ -127,10 +130,11 @@ Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const Svgf
       c.temporal_flops += 41 + 4 * 8 + 19 + 15 + 30;
       const bool spatial = moments[i].z < static_cast<float>(s.min_history);
       c.variance_bytes += 16 + 16 + 16 + 16 + (spatial ? 4 : 0);
-      c.variance_flops += spatial ? 15 + variance_tap * taps_inside(x, y, 3, 1) : 5;
+      c.variance_flops +=
+          spatial ? 15 + variance_inverse_phi_z + variance_tap * taps_inside(x, y, 3, 1) : 5;
       for (int k = 0; k < s.iterations; ++k)
-        c.atrous_flops +=
-            11 + 3 * taps_inside(x, y, 1, 1) + atrous_tap * taps_inside(x, y, 2, 1 << k) + 5;
+        c.atrous_flops += 11 + 3 * taps_inside(x, y, 1, 1) + atrous_inverse_phi_z +
+                          atrous_tap * taps_inside(x, y, 2, 1 << k) + 5;
       c.atrous_bytes += s.iterations * 52.0;
       c.remodulate_bytes += 4 + 16 + 16 + 16 + 16;
       c.remodulate_flops += 9;

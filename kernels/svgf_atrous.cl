@@ -6,8 +6,9 @@
  * "Cost"), since its work-item loops are not vectorised either way (svgf_atrous_wide.cl runs
  * several pixels per work-item in vector lanes).
  * Per pixel and iteration (hand count, as svgf_temporal.cl): 11 + 3 per tap of the 3x3
- * prefilter + (42 + P) per tap of the 5x5 kernel inside the image + 5 flops, P the normal
- * weight's power (9 for phi_normal 128): 1318 inside the image; 52 bytes. No surface: 1 flop,
+ * prefilter + 6 x 5 for 1 / phi_z at the six tap distances (two multiplies, a multiply and an
+ * add, a division) + (38 + P) per tap of the 5x5 kernel inside the image + 5 flops, P the normal
+ * weight's power (9 for phi_normal 128): 1248 inside the image; 52 bytes. No surface: 1 flop,
  * 48 bytes. */
 #pragma OPENCL FP_CONTRACT OFF
 
@@ -43,6 +44,12 @@ __kernel void svgf_atrous(__global const float* in, __global float* out,
   }
   float inverse_phi_l = pg_svgf_inverse_phi_luminance(sqrt(fmax(sum_gv / sum_g, 0.0f)), settings);
   float slope = depth_slope[i];
+  float inverse_phi_z[PG_SVGF_ATROUS_SQUARED_DISTANCES];
+  for (int d2 = 0; d2 < PG_SVGF_ATROUS_SQUARED_DISTANCES; ++d2)
+    inverse_phi_z[d2] =
+        pg_svgf_is_atrous_squared_distance(d2)
+            ? pg_svgf_inverse_phi_depth(slope, sc.w, (float)step * sqrt((float)d2), settings)
+            : 0.0f;
   float lc = pg_luminance(c.xyz);
   float3 sum_c = (float3)(0.0f);
   float sum_v = 0.0f, sum_w = 0.0f;
@@ -54,10 +61,10 @@ __kernel void svgf_atrous(__global const float* in, __global float* out,
       if (qx < 0 || qx >= (int)width) continue;
       uint j = (uint)qy * width + (uint)qx;
       float4 q = pg_planar_get(in, n, j);
-      float distance = (float)step * sqrt((float)(dx * dx + dy * dy));
       float w = pg_svgf_b3(dx) * pg_svgf_b3(dy) *
-                pg_svgf_edge_weight(sc, slope, lc, pg_planar_get(surface, n, j),
-                                    pg_luminance(q.xyz), distance, inverse_phi_l, settings);
+                pg_svgf_edge_weight(sc, lc, pg_planar_get(surface, n, j), pg_luminance(q.xyz),
+                                    inverse_phi_z[pg_svgf_squared_distance(dx, dy)], inverse_phi_l,
+                                    settings);
       sum_c += w * q.xyz;
       sum_v += w * w * q.w;
       sum_w += w;

@@ -49,6 +49,12 @@ __kernel void svgf_atrous_wide(__global const float* in, __global float* out,
     pg_floatw inverse_phi_l = 1.0f / (settings.phi_luminance * sqrt(fmax(sum_gv / sum_g, 0.0f)) +
                                       PG_SVGF_LUMINANCE_EPSILON);
     pg_floatw slope = pg_load_row_floats(depth_slope + row_start, x0, w);
+    pg_floatw inverse_phi_z[PG_SVGF_ATROUS_SQUARED_DISTANCES];
+    for (int d2 = 0; d2 < PG_SVGF_ATROUS_SQUARED_DISTANCES; ++d2)
+      inverse_phi_z[d2] =
+          pg_svgf_is_atrous_squared_distance(d2)
+              ? pg_svgf_inverse_phi_depth_w(slope, z_c, (float)step * sqrt((float)d2), settings)
+              : (pg_floatw)(0.0f);
     pg_floatw luminance_c = pg_luminance3w(c);
     for (int dy = -2; dy <= 2; ++dy) {
       int qy = y + dy * step;
@@ -60,11 +66,10 @@ __kernel void svgf_atrous_wide(__global const float* in, __global float* out,
         pg_load_planar_row(in, n, qy * w, x0 + offset, w, &q, &variance_q);
         pg_load_planar_row(surface, n, qy * w, x0 + offset, w, &n_q, &z_q);
         pg_intw inside = (lane_x + offset >= 0) & (lane_x + offset < w);
-        float distance = (float)step * sqrt((float)(dx * dx + dy * dy));
-        pg_floatw weight =
-            pg_svgf_b3(dx) * pg_svgf_b3(dy) *
-            pg_svgf_edge_weight_w(n_c, z_c, slope, luminance_c, n_q, z_q, pg_luminance3w(q),
-                                  distance, inverse_phi_l, settings);
+        pg_floatw weight = pg_svgf_b3(dx) * pg_svgf_b3(dy) *
+                           pg_svgf_edge_weight_w(n_c, z_c, luminance_c, n_q, z_q, pg_luminance3w(q),
+                                                 inverse_phi_z[pg_svgf_squared_distance(dx, dy)],
+                                                 inverse_phi_l, settings);
         weight = select((pg_floatw)(0.0f), weight, inside);
         sum_c = pg_add3w(sum_c, pg_scale3w(q, weight));
         sum_v += weight * weight * variance_q;

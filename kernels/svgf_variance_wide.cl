@@ -39,6 +39,9 @@ __kernel void svgf_variance_wide(__global const float* integrated, __global cons
   pg_floatw result_v = pg_svgf_variance_w(m.x, m.y, m.z, settings.min_history);
   if (any(spatial)) {
     pg_floatw slope = pg_load_row_floats(depth_slope + row_start, x0, w);
+    pg_floatw inverse_phi_z[PG_SVGF_SPATIAL_SQUARED_DISTANCES];
+    for (int d2 = 0; d2 < PG_SVGF_SPATIAL_SQUARED_DISTANCES; ++d2)
+      inverse_phi_z[d2] = pg_svgf_inverse_phi_depth_w(slope, z_c, sqrt((float)d2), settings);
     pg_floatw luminance_c = pg_luminance3w(c);
     pg_float3w sum_c = pg_make_float3w(0.0f, 0.0f, 0.0f);
     pg_floatw sum_m1 = 0.0f, sum_m2 = 0.0f, sum_w = 0.0f;
@@ -52,10 +55,9 @@ __kernel void svgf_variance_wide(__global const float* integrated, __global cons
         pg_load_planar_row(surface, n, qy * w, x0 + dx, w, &n_q, &z_q);
         pg_load_planar_row(moments, n, qy * w, x0 + dx, w, &mq, &unused_q);
         pg_intw inside = (lane_x + dx >= 0) & (lane_x + dx < w);
-        float distance = sqrt((float)(dx * dx + dy * dy));
-        pg_floatw weight =
-            pg_svgf_edge_weight_w(n_c, z_c, slope, luminance_c, n_q, z_q, pg_luminance3w(iq),
-                                  distance, (pg_floatw)(0.0f), settings);
+        pg_floatw weight = pg_svgf_edge_weight_w(
+            n_c, z_c, luminance_c, n_q, z_q, pg_luminance3w(iq),
+            inverse_phi_z[pg_svgf_squared_distance(dx, dy)], (pg_floatw)(0.0f), settings);
         weight = select((pg_floatw)(0.0f), weight, inside);
         sum_c = pg_add3w(sum_c, pg_scale3w(iq, weight));
         sum_m1 += weight * mq.x;

@@ -188,8 +188,9 @@ void SvgfReference::variance() {
           const std::size_t j = static_cast<std::size_t>(qy) * width_ + qx;
           const glm::vec4 iq = integrated_[j];
           const float distance = std::sqrt(static_cast<float>(dx * dx + dy * dy));
-          const float w = sh::pg_svgf_edge_weight(sc, slope, lc, surface_[j],
-                                                  sh::pg_luminance(xyz(iq)), distance, 0.0f, s);
+          const float w = sh::pg_svgf_edge_weight(
+              sc, lc, surface_[j], sh::pg_luminance(xyz(iq)),
+              sh::pg_svgf_inverse_phi_depth(slope, sc.w, distance, s), 0.0f, s);
           const glm::vec4 mq = moments_[j];
           sum_c += w * xyz(iq);
           sum_m1 += w * mq.x;
@@ -244,8 +245,9 @@ void SvgfReference::atrous(const std::vector<glm::vec4>& in, std::vector<glm::ve
               static_cast<float>(step) * std::sqrt(static_cast<float>(dx * dx + dy * dy));
           const float w =
               sh::pg_svgf_b3(dx) * sh::pg_svgf_b3(dy) *
-              sh::pg_svgf_edge_weight(sc, slope, lc, surface_[j], sh::pg_luminance(xyz(q)),
-                                      distance, inverse_phi_l, s);
+              sh::pg_svgf_edge_weight(sc, lc, surface_[j], sh::pg_luminance(xyz(q)),
+                                      sh::pg_svgf_inverse_phi_depth(slope, sc.w, distance, s),
+                                      inverse_phi_l, s);
           sum_c += w * xyz(q);
           sum_v += w * w * q.w;
           sum_w += w;

@@ -185,20 +185,42 @@ PG_FN float pg_svgf_power(float x, uint n) {
   return r;
 }
 
+/* 1 / phi_z, the depth weight's scale between the centre pixel (depth depth_c, depth slope
+ * slope_c) and a tap `distance` pixels away (SVGF eq. 3): phi_z = sigma_z * slope_c * distance +
+ * eps * depth_c. The filters take it once per pixel for each squared tap distance
+ * (pg_svgf_squared_distance) instead of dividing at every tap: the division was a sixth of the
+ * a-trous pass's time (docs/denoising.md, "One division per tap distance"). */
+PG_FN float pg_svgf_inverse_phi_depth(float slope_c, float depth_c, float distance,
+                                      pg_svgf_settings s) {
+  return 1.0f / (s.phi_depth * slope_c * distance + PG_SVGF_DEPTH_EPSILON * depth_c);
+}
+
+/* A tap (dx, dy)'s squared distance from its centre, the index of its 1 / phi_z in a per-pixel
+ * table: 0..8 for the a-trous 5x5 kernel (PG_SVGF_ATROUS_SQUARED_DISTANCES entries, of which 3,
+ * 6 and 7 belong to no tap: pg_svgf_is_atrous_squared_distance), 0..18 for the variance pass's
+ * 7x7 neighbourhood (all of them filled: 19 divisions for 49 taps). */
+#define PG_SVGF_ATROUS_SQUARED_DISTANCES 9
+#define PG_SVGF_SPATIAL_SQUARED_DISTANCES 19
+PG_FN int pg_svgf_squared_distance(int dx, int dy) {
+  return dx * dx + dy * dy;
+}
+PG_FN int pg_svgf_is_atrous_squared_distance(int squared_distance) {
+  return squared_distance != 3 && squared_distance != 6 && squared_distance != 7;
+}
+
 /* The edge-stopping weight between the centre pixel c and a tap q (SVGF eq. 3-5):
- *   depth      exp(-|z_c - z_q| / phi_z), phi_z = sigma_z * slope_c * distance + eps * z_c;
+ *   depth      exp(-|z_c - z_q| * inverse_phi_z), from pg_svgf_inverse_phi_depth at the tap's
+ *              distance;
  *   normal     max(0, n_c . n_q)^sigma_n (sigma_n an integer, pg_svgf_power);
  *   luminance  exp(-|l_c - l_q| * inverse_phi_l), inverse_phi_l from
  *              pg_svgf_inverse_phi_luminance (0: no luminance term).
- * distance is the tap's offset in pixels. One exp for depth and luminance. A tap without a
- * surface (depth 0) gets 0. */
-PG_FN float pg_svgf_edge_weight(float4 surface_c, float slope_c, float luminance_c,
-                                float4 surface_q, float luminance_q, float distance,
-                                float inverse_phi_l, pg_svgf_settings s) {
+ * One exp for depth and luminance. A tap without a surface (depth 0) gets 0. */
+PG_FN float pg_svgf_edge_weight(float4 surface_c, float luminance_c, float4 surface_q,
+                                float luminance_q, float inverse_phi_z, float inverse_phi_l,
+                                pg_svgf_settings s) {
   float cos_n = fmin(fmax(dot(pg_float4_xyz(surface_c), pg_float4_xyz(surface_q)), 0.0f), 1.0f);
-  float phi_z = s.phi_depth * slope_c * distance + PG_SVGF_DEPTH_EPSILON * surface_c.w;
-  float e =
-      fabs(surface_c.w - surface_q.w) / phi_z + fabs(luminance_c - luminance_q) * inverse_phi_l;
+  float e = fabs(surface_c.w - surface_q.w) * inverse_phi_z +
+            fabs(luminance_c - luminance_q) * inverse_phi_l;
   float w = pg_svgf_power(cos_n, s.phi_normal) * exp(-e);
   return surface_q.w > 0.0f ? w : 0.0f;
 }

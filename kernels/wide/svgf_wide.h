@@ -37,16 +37,21 @@ static inline pg_floatw pg_svgf_power_w(pg_floatw x, uint n) {
   return r;
 }
 
-/* pg_svgf_edge_weight in the lanes: the centre's normal n_c and depth z_c, its depth slope and
- * luminance, a tap's normal n_q, depth z_q and luminance, the tap's distance in pixels (the same
- * for every lane) and the centre's inverse_phi_l. A tap without a surface gets 0. */
-static inline pg_floatw pg_svgf_edge_weight_w(pg_float3w n_c, pg_floatw z_c, pg_floatw slope_c,
-                                              pg_floatw luminance_c, pg_float3w n_q, pg_floatw z_q,
-                                              pg_floatw luminance_q, float distance,
-                                              pg_floatw inverse_phi_l, pg_svgf_settings s) {
+/* pg_svgf_inverse_phi_depth in the lanes. */
+static inline pg_floatw pg_svgf_inverse_phi_depth_w(pg_floatw slope_c, pg_floatw z_c,
+                                                    float distance, pg_svgf_settings s) {
+  return 1.0f / (s.phi_depth * slope_c * distance + PG_SVGF_DEPTH_EPSILON * z_c);
+}
+
+/* pg_svgf_edge_weight in the lanes: the centre's normal n_c, depth z_c and luminance, a tap's
+ * normal n_q, depth z_q and luminance, the centre's 1 / phi_z at the tap's distance and
+ * inverse_phi_l. A tap without a surface gets 0. */
+static inline pg_floatw pg_svgf_edge_weight_w(pg_float3w n_c, pg_floatw z_c, pg_floatw luminance_c,
+                                              pg_float3w n_q, pg_floatw z_q, pg_floatw luminance_q,
+                                              pg_floatw inverse_phi_z, pg_floatw inverse_phi_l,
+                                              pg_svgf_settings s) {
   pg_floatw cos_n = fmin(fmax(pg_dot3w(n_c, n_q), 0.0f), 1.0f);
-  pg_floatw phi_z = s.phi_depth * slope_c * distance + PG_SVGF_DEPTH_EPSILON * z_c;
-  pg_floatw e = fabs(z_c - z_q) / phi_z + fabs(luminance_c - luminance_q) * inverse_phi_l;
+  pg_floatw e = fabs(z_c - z_q) * inverse_phi_z + fabs(luminance_c - luminance_q) * inverse_phi_l;
   pg_floatw w = pg_svgf_power_w(cos_n, s.phi_normal) * exp(-e);
   return select((pg_floatw)(0.0f), w, z_q > 0.0f);
 }
