@@ -25,6 +25,11 @@
 //                        (bench_roofline.h's rules: docs/guiding.md, "The roofline")
 //   <kernel>_roofline    the kernel's roofline bound / its time (1: at the roof), the copy
 //                        and multiply-add yardsticks launched in the same iterations
+//   surface_fraction     the share of pixels with a surface: the filters skip the others, so
+//                        their times scale with it (0.53 on the Cornell box's 16:9 frame, 0.99
+//                        on Sponza; docs/denoising.md, "The three rooms")
+//   atrous_ms_per_surface_mpx  the a-trous time per million pixels with a surface: the figure
+//                        to compare across scenes
 //   lanes                pixels per work-item of the variance and a-trous kernels
 //   row_work_groups      1 where the temporal and remodulate kernels run in work-groups along
 //                        rows, 0 for tiles
@@ -84,6 +89,7 @@ Frames* frames_for(const std::string& scene_name, int w, int h, std::string* why
 struct Counts {
   double temporal_flops = 0, variance_flops = 0, atrous_flops = 0, remodulate_flops = 0;
   double temporal_bytes = 0, variance_bytes = 0, atrous_bytes = 0, remodulate_bytes = 0;
+  double surface_pixels = 0;
 };
 
 // x^n by repeated squaring (pg_svgf_power): one squaring per bit of n, one multiply per set bit.
@@ -124,6 +130,7 @@ Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const Svgf
         c.remodulate_bytes += 4 + 16 + 16;
         continue;
       }
+      c.surface_pixels += 1;
       // temporal, static camera: one bilinear tap of weight 1 (the others have weight 0),
       // tested and accepted.
       c.temporal_bytes += 96 + 68 + 88;
@@ -222,6 +229,9 @@ void BM_Svgf(benchmark::State& state, const std::string& scene_name, int w, int 
     state.counters[name + "_bytes_px"] = bytes[k] / n;
     state.counters[name + "_roofline"] = roofline_ms(bytes[k], flops[k], copy_ms, fma_ms, it) / ms;
   }
+  state.counters["surface_fraction"] = c.surface_pixels / n;
+  state.counters["atrous_ms_per_surface_mpx"] =
+      c.surface_pixels > 0 ? sum["atrous"] / it / (c.surface_pixels * 1e-6) : 0.0;
   state.counters["upload_ms"] = sum["upload"] / it;
   state.counters["download_ms"] = sum["download"] / it;
   state.counters["svgf_ms"] = sum["svgf"] / it;
