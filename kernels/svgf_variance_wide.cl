@@ -4,9 +4,12 @@
  * (the first frames of a run, disocclusions, a moving camera), loads each channel of its
  * PG_LANES tap pixels as one vector from the planar images. The same operations in the same
  * order as svgf_variance.cl: a tap outside the image adds a zero weight where the scalar kernel
- * skips it, which leaves every sum the same. Flops and bytes per pixel: svgf_variance.cl's count
- * (taps outside the image are computed and masked here, and not counted). */
-#pragma OPENCL FP_CONTRACT OFF
+ * skips it, which leaves every sum the same up to the multiply-adds the compiler forms in each.
+ * Flops and bytes per pixel: svgf_variance.cl's count (taps outside the image are computed and
+ * masked here, and not counted). */
+/* Multiply-adds allowed, as in the a-trous pass (docs/denoising.md, "Multiply-adds in the a-trous
+ * pass"): 8-9% of the spatial estimate on PoCL's CPU device. */
+#pragma OPENCL FP_CONTRACT ON
 
 #include "shared/planar.h"
 #include "shared/svgf.h"
