@@ -108,7 +108,7 @@ Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const Svgf
   // A tap does not compute its phi_z: each pass takes 1 / phi_z once per pixel for each squared
   // tap distance, 5 flops each (kernels/svgf_atrous.cl, svgf_variance.cl).
   const double atrous_tap = 38 + power, atrous_inverse_phi_z = 6 * 5;
-  const double variance_tap = 36 + power, variance_inverse_phi_z = 19 * 5;
+  const double variance_tap = 36 + power, variance_inverse_phi_z = 10 * 5;
   auto taps_inside = [&](int x, int y, int radius, int step) {
     int nx = 0, ny = 0;
     for (int d = -radius; d <= radius; ++d) {

@@ -47,12 +47,8 @@ __kernel void svgf_atrous(__global const float* in, __global float* out,
   }
   float inverse_phi_l = pg_svgf_inverse_phi_luminance(sqrt(fmax(sum_gv / sum_g, 0.0f)), settings);
   float slope = depth_slope[i];
-  float inverse_phi_z[PG_SVGF_ATROUS_SQUARED_DISTANCES];
-  for (int d2 = 0; d2 < PG_SVGF_ATROUS_SQUARED_DISTANCES; ++d2)
-    inverse_phi_z[d2] =
-        pg_svgf_is_atrous_squared_distance(d2)
-            ? pg_svgf_inverse_phi_depth(slope, sc.w, (float)step * sqrt((float)d2), settings)
-            : 0.0f;
+  float inverse_phi_z[PG_SVGF_SQUARED_DISTANCES(2)];
+  pg_svgf_inverse_phi_depth_table(slope, sc.w, (float)step, 2, settings, inverse_phi_z);
   float lc = pg_luminance(c.xyz);
   float3 sum_c = (float3)(0.0f);
   float sum_v = 0.0f, sum_w = 0.0f;

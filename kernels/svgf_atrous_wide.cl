@@ -53,12 +53,8 @@ __kernel void svgf_atrous_wide(__global const float* in, __global float* out,
     pg_floatw inverse_phi_l = 1.0f / (settings.phi_luminance * sqrt(fmax(sum_gv / sum_g, 0.0f)) +
                                       PG_SVGF_LUMINANCE_EPSILON);
     pg_floatw slope = pg_load_row_floats(depth_slope + row_start, x0, w);
-    pg_floatw inverse_phi_z[PG_SVGF_ATROUS_SQUARED_DISTANCES];
-    for (int d2 = 0; d2 < PG_SVGF_ATROUS_SQUARED_DISTANCES; ++d2)
-      inverse_phi_z[d2] =
-          pg_svgf_is_atrous_squared_distance(d2)
-              ? pg_svgf_inverse_phi_depth_w(slope, z_c, (float)step * sqrt((float)d2), settings)
-              : (pg_floatw)(0.0f);
+    pg_floatw inverse_phi_z[PG_SVGF_SQUARED_DISTANCES(2)];
+    pg_svgf_inverse_phi_depth_table_w(slope, z_c, (float)step, 2, settings, inverse_phi_z);
     pg_floatw luminance_c = pg_luminance3w(c);
     for (int dy = -2; dy <= 2; ++dy) {
       int qy = y + dy * step;

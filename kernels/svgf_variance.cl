@@ -4,7 +4,7 @@
  * same way there). Writes illumination (rgb) with its variance (w), the input of the first
  * a-trous iteration.
  * Per pixel (hand count, as svgf_temporal.cl): 5 flops and 64 bytes where the history is long
- * enough; else 15 + 19 x 5 (1 / phi_z at each squared tap distance: two multiplies, a multiply
+ * enough; else 15 + 10 x 5 (1 / phi_z at each squared tap distance: two multiplies, a multiply
  * and an add, a division) + (36 + P) per tap inside the image and 68 bytes, P = the normal weight's
  * power (one per bit of phi_normal and one per set bit: 9 for 128); no surface: 1 flop, 32 bytes.
  */
@@ -37,9 +37,8 @@ __kernel void svgf_variance(__global const float* integrated, __global const flo
     return;
   }
   float slope = depth_slope[i];
-  float inverse_phi_z[PG_SVGF_SPATIAL_SQUARED_DISTANCES];
-  for (int d2 = 0; d2 < PG_SVGF_SPATIAL_SQUARED_DISTANCES; ++d2)
-    inverse_phi_z[d2] = pg_svgf_inverse_phi_depth(slope, sc.w, sqrt((float)d2), settings);
+  float inverse_phi_z[PG_SVGF_SQUARED_DISTANCES(3)];
+  pg_svgf_inverse_phi_depth_table(slope, sc.w, 1.0f, 3, settings, inverse_phi_z);
   float lc = pg_luminance(ic.xyz);
   float3 sum_c = (float3)(0.0f);
   float sum_m1 = 0.0f, sum_m2 = 0.0f, sum_w = 0.0f;

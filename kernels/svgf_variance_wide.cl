@@ -42,9 +42,8 @@ __kernel void svgf_variance_wide(__global const float* integrated, __global cons
   pg_floatw result_v = pg_svgf_variance_w(m.x, m.y, m.z, settings.min_history);
   if (any(spatial)) {
     pg_floatw slope = pg_load_row_floats(depth_slope + row_start, x0, w);
-    pg_floatw inverse_phi_z[PG_SVGF_SPATIAL_SQUARED_DISTANCES];
-    for (int d2 = 0; d2 < PG_SVGF_SPATIAL_SQUARED_DISTANCES; ++d2)
-      inverse_phi_z[d2] = pg_svgf_inverse_phi_depth_w(slope, z_c, sqrt((float)d2), settings);
+    pg_floatw inverse_phi_z[PG_SVGF_SQUARED_DISTANCES(3)];
+    pg_svgf_inverse_phi_depth_table_w(slope, z_c, 1.0f, 3, settings, inverse_phi_z);
     pg_floatw luminance_c = pg_luminance3w(c);
     pg_float3w sum_c = pg_make_float3w(0.0f, 0.0f, 0.0f);
     pg_floatw sum_m1 = 0.0f, sum_m2 = 0.0f, sum_w = 0.0f;

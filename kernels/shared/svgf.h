@@ -195,17 +195,30 @@ PG_FN float pg_svgf_inverse_phi_depth(float slope_c, float depth_c, float distan
   return 1.0f / (s.phi_depth * slope_c * distance + PG_SVGF_DEPTH_EPSILON * depth_c);
 }
 
-/* A tap (dx, dy)'s squared distance from its centre, the index of its 1 / phi_z in a per-pixel
- * table: 0..8 for the a-trous 5x5 kernel (PG_SVGF_ATROUS_SQUARED_DISTANCES entries, of which 3,
- * 6 and 7 belong to no tap: pg_svgf_is_atrous_squared_distance), 0..18 for the variance pass's
- * 7x7 neighbourhood (all of them filled: 19 divisions for 49 taps). */
-#define PG_SVGF_ATROUS_SQUARED_DISTANCES 9
-#define PG_SVGF_SPATIAL_SQUARED_DISTANCES 19
+/* A tap (dx, dy)'s squared distance from its centre: the index of its 1 / phi_z in the per-pixel
+ * table of a filter of radius r (2 for the a-trous 5x5 kernel, 3 for the variance pass's 7x7
+ * neighbourhood), PG_SVGF_SQUARED_DISTANCES(r) entries, filled where some tap lies
+ * (pg_svgf_is_tap_squared_distance: 6 of 9 entries for the 5x5 kernel, 10 of 19 for the 7x7). */
+#define PG_SVGF_SQUARED_DISTANCES(radius) (2 * (radius) * (radius) + 1)
 PG_FN int pg_svgf_squared_distance(int dx, int dy) {
   return dx * dx + dy * dy;
 }
-PG_FN int pg_svgf_is_atrous_squared_distance(int squared_distance) {
-  return squared_distance != 3 && squared_distance != 6 && squared_distance != 7;
+PG_FN int pg_svgf_is_tap_squared_distance(int squared_distance, int radius) {
+  for (int a = 0; a <= radius; ++a)
+    for (int b = a; b <= radius; ++b)
+      if (a * a + b * b == squared_distance) return 1;
+  return 0;
+}
+
+/* table[d2] = 1 / phi_z at the distance step * sqrt(d2) for every squared tap distance d2 of a
+ * filter of that radius, 0 in the entries no tap reads; step is the filter's tap spacing in
+ * pixels (the a-trous iteration's step, 1 for the variance pass). */
+PG_FN void pg_svgf_inverse_phi_depth_table(float slope_c, float depth_c, float step, int radius,
+                                           pg_svgf_settings s, float* table) {
+  for (int d2 = 0; d2 < PG_SVGF_SQUARED_DISTANCES(radius); ++d2)
+    table[d2] = pg_svgf_is_tap_squared_distance(d2, radius)
+                    ? pg_svgf_inverse_phi_depth(slope_c, depth_c, step * sqrt((float)d2), s)
+                    : 0.0f;
 }
 
 /* The edge-stopping weight between the centre pixel c and a tap q (SVGF eq. 3-5):

@@ -43,6 +43,16 @@ static inline pg_floatw pg_svgf_inverse_phi_depth_w(pg_floatw slope_c, pg_floatw
   return 1.0f / (s.phi_depth * slope_c * distance + PG_SVGF_DEPTH_EPSILON * z_c);
 }
 
+/* pg_svgf_inverse_phi_depth_table in the lanes. */
+static inline void pg_svgf_inverse_phi_depth_table_w(pg_floatw slope_c, pg_floatw z_c, float step,
+                                                     int radius, pg_svgf_settings s,
+                                                     pg_floatw* table) {
+  for (int d2 = 0; d2 < PG_SVGF_SQUARED_DISTANCES(radius); ++d2)
+    table[d2] = pg_svgf_is_tap_squared_distance(d2, radius)
+                    ? pg_svgf_inverse_phi_depth_w(slope_c, z_c, step * sqrt((float)d2), s)
+                    : (pg_floatw)(0.0f);
+}
+
 /* pg_svgf_edge_weight in the lanes: the centre's normal n_c, depth z_c and luminance, a tap's
  * normal n_q, depth z_q and luminance, the centre's 1 / phi_z at the tap's distance and
  * inverse_phi_l. A tap without a surface gets 0. */
