@@ -117,6 +117,7 @@ inline const Scene* scene_by_name(const std::string& name, std::string* why) {
 //   shadow    : from every primary hit, towards a light sample (NEE), as the path tracer makes
 //               them (finite length to area lights, unbounded towards the sun and the sky).
 struct RaySets {
+  int width = 0, height = 0;  // primary[y * width + x] is pixel (x, y)'s ray
   std::vector<Ray> primary, secondary, shadow;
   std::vector<Hit> hits;          // scratch for intersect()
   std::vector<std::uint8_t> occ;  // scratch for occluded()
@@ -125,6 +126,8 @@ struct RaySets {
 inline RaySets make_ray_sets(const Scene& scene, const EmbreeScene& tracer, int width, int height,
                              std::uint32_t seed = 7) {
   RaySets s;
+  s.width = width;
+  s.height = height;
   const std::size_t n = static_cast<std::size_t>(width) * height;
   const CameraFrame camera =
       make_camera_frame(scene.camera.view, static_cast<float>(width) / static_cast<float>(height));
@@ -138,7 +141,7 @@ inline RaySets make_ray_sets(const Scene& scene, const EmbreeScene& tracer, int 
     s.primary[i] = r;
   }
   std::vector<Hit> hits(n);
-  tracer.intersect(s.primary.data(), hits.data(), n, RayMode::Packet8);
+  tracer.intersect_image(s.primary.data(), hits.data(), width, height);
 
   const Lights lights(scene);
   std::vector<Ray> bounce(n), shadow(n);
@@ -187,6 +190,16 @@ inline const char* kind_name(RayKind k) {
 
 inline const std::vector<Ray>& rays_of(const RaySets& s, RayKind k) {
   return k == RayKind::Primary ? s.primary : (k == RayKind::Secondary ? s.secondary : s.shadow);
+}
+
+// The camera rays as the renderer traces them (EmbreeScene::intersect_image, packets of pixel
+// tiles); wall seconds.
+inline double trace_primary_image(const EmbreeScene& tracer, RaySets& s) {
+  const auto start = std::chrono::steady_clock::now();
+  tracer.intersect_image(s.primary.data(), s.hits.data(), s.width, s.height);
+  const auto stop = std::chrono::steady_clock::now();
+  benchmark::DoNotOptimize(s.hits.data());
+  return std::chrono::duration<double>(stop - start).count();
 }
 
 // Traces one set (closest hit for primary and secondary, any hit for shadow); wall seconds.

@@ -1,6 +1,7 @@
 // Embree alone: primary, secondary (incoherent first bounce) and shadow rays per second on the
 // Cornell box and Crytek Sponza, one ray at a time, in 8-wide packets or in streams of 256
-// (rtcIntersect1M / rtcOccluded1M) (RayMode). The rays
+// (rtcIntersect1M / rtcOccluded1M) (RayMode), and camera rays also as the renderer traces
+// them, in packets of pixel tiles (`tiles`: EmbreeScene::intersect_image). The rays
 // come from the scene's camera and its real first hits and are built once, outside the timed
 // loop (bench_common.h: make_ray_sets). Time is wall time of the whole batch (Embree over all
 // cores with TBB), set as manual time.
@@ -43,8 +44,10 @@ Setup* setup_for(const std::string& scene_name, int w, int h, std::string* why) 
   return (cache[key] = std::move(s)).get();
 }
 
+// image_tiles: camera rays by EmbreeScene::intersect_image (mode is then Packet8, the
+// comparison's name for packets).
 void BM_EmbreeRays(benchmark::State& state, const std::string& scene_name, int w, int h,
-                   RayKind kind, RayMode mode) {
+                   RayKind kind, RayMode mode, bool image_tiles) {
   std::string why;
   Setup* s = setup_for(scene_name, w, h, &why);
   if (!s) {
@@ -54,7 +57,8 @@ void BM_EmbreeRays(benchmark::State& state, const std::string& scene_name, int w
   const double count = static_cast<double>(rays_of(s->rays, kind).size());
   double mode_s = 0.0, single_s = 0.0;
   for (auto _ : state) {
-    const double t = trace_set(*s->tracer, s->rays, kind, mode);
+    const double t = image_tiles ? trace_primary_image(*s->tracer, s->rays)
+                                 : trace_set(*s->tracer, s->rays, kind, mode);
     state.SetIterationTime(t);
     if (mode != RayMode::Single) {
       mode_s += t;
@@ -85,15 +89,21 @@ void register_all(bool full) {
   for (const char* scene : {"cornell", "sponza"})
     for (auto [w, h] : sizes)
       for (RayKind kind : {RayKind::Primary, RayKind::Secondary, RayKind::Shadow})
-        for (RayMode mode : {RayMode::Single, RayMode::Packet8, RayMode::Stream}) {
-          const char* mode_name = mode == RayMode::Single    ? "single"
-                                  : mode == RayMode::Packet8 ? "packet8"
-                                                             : "stream";
+        for (int m = 0; m < 4; ++m) {
+          // Modes 0-2: RayMode; 3: pixel tiles, for camera rays only.
+          if (m == 3 && kind != RayKind::Primary) continue;
+          const RayMode mode = m == 0   ? RayMode::Single
+                               : m == 2 ? RayMode::Stream
+                                        : RayMode::Packet8;
+          const char* mode_name = m == 0   ? "single"
+                                  : m == 1 ? "packet8"
+                                  : m == 2 ? "stream"
+                                           : "tiles";
           const std::string name = std::string("EmbreeRays/") + scene + "/" + kind_name(kind) +
                                    "/" + mode_name + "/" + std::to_string(w) + "x" +
                                    std::to_string(h);
           benchmark::RegisterBenchmark(name.c_str(), BM_EmbreeRays, std::string(scene), w, h, kind,
-                                       mode)
+                                       mode, m == 3)
               ->UseManualTime()
               ->Unit(benchmark::kMillisecond)
               ->MinTime(0.3);

@@ -17,7 +17,8 @@
 //                         FrameStats) x (Embree's time per ray on a representative set of that
 //                         kind: camera rays, cosine bounces and NEE shadow rays from the real
 //                         first hits, each in the RayMode the renderer uses for it:
-//                         kCameraRayMode and the others in host/render/path_tracer.h),
+//                         camera rays by EmbreeScene::intersect_image, the others by
+//                         kBounceRayMode and kShadowRayMode in host/render/path_tracer.h),
 //                         timed in the same iteration as the frame
 //   ratio                 frame_ms / embree_only_ms
 //   guiding_overhead      pmm only: (pmm frame - off frame) / off frame, with an off frame
@@ -77,7 +78,8 @@ double embree_only_ms(FrameSetup& s, const FrameStats& stats) {
     const std::size_t n = rays_of(s.rays, k).size();
     return n ? trace_set(tracer, s.rays, k, mode) / static_cast<double>(n) : 0.0;
   };
-  const double p = per_ray(RayKind::Primary, kCameraRayMode);
+  const double p = trace_primary_image(tracer, s.rays) /
+                   static_cast<double>(std::max<std::size_t>(s.rays.primary.size(), 1));
   const double b = per_ray(RayKind::Secondary, kBounceRayMode);
   const double sh = per_ray(RayKind::Shadow, kShadowRayMode);
   return 1e3 * (static_cast<double>(stats.primary_rays) * p +

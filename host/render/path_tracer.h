@@ -71,10 +71,11 @@ inline SampleCoordinates first_bounce_coordinates(const SampleCoordinates& at, S
   return first;
 }
 
-// How a frame's rays go to Embree (host/trace/ray.h): camera rays in packets of 8; bounce and
-// shadow rays in streams, 1.1-1.2x and 1.7-1.8x as fast as one by one (2026-11-26, AVX-512)
-// (docs/host-path-tracer.md, "Embree's stream API"). bench_frame times Embree alone the same way.
-inline constexpr RayMode kCameraRayMode = RayMode::Packet8;
+// How a frame's rays go to Embree (host/trace/ray.h): camera rays in packets of 4x4 or 4x2
+// pixels (EmbreeScene::intersect_image; docs/host-path-tracer.md, "Camera rays in vector
+// lanes"); bounce and shadow rays in streams, 1.1-1.2x and 1.7-1.8x as fast as one by one
+// (2026-11-26, AVX-512) (docs/host-path-tracer.md, "Embree's stream API"). bench_frame times
+// Embree alone the same way.
 inline constexpr RayMode kBounceRayMode = RayMode::Stream;
 inline constexpr RayMode kShadowRayMode = RayMode::Stream;
 

@@ -1,5 +1,6 @@
 #include "render/renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <new>
@@ -7,6 +8,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "render/camera_rays.h"
 #include "render/surface.h"
 #include "rtpg/guiding_layout.h"
 #include "shared/rng.h"
@@ -87,34 +89,16 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
   camera_hits_.resize(n);
 
   auto start = Clock::now();
-  // By rows: a pixel's coordinates without a division per pixel (docs/host-path-tracer.md,
-  // "Camera rays by rows").
-  const int rows_per_task = std::max(1, 4096 / std::max(w, 1));
-  tbb::parallel_for(tbb::blocked_range<int>(0, h, rows_per_task), [&](const auto& rows) {
-    for (int y = rows.begin(); y != rows.end(); ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i =
-            static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-        float jx = 0.5f, jy = 0.5f;
-        if (settings_.jitter) {
-          shared::pg_rng rng =
-              shared::pg_rng_make(settings_.seed, static_cast<shared::uint>(i),
-                                  static_cast<shared::uint>(frame), 0u, PG_RNG_STREAM_CAMERA);
-          jx = shared::pg_rng_next(&rng);
-          jy = shared::pg_rng_next(&rng);
-        }
-        Ray ray;
-        ray.origin = camera.position;
-        ray.direction = camera.ray_direction((static_cast<float>(x) + jx) / static_cast<float>(w),
-                                             (static_cast<float>(y) + jy) / static_cast<float>(h));
-        camera_rays_[i] = ray;
-      }
-  });
-  tracer_->intersect(camera_rays_.data(), camera_hits_.data(), n, kCameraRayMode);
+  make_camera_rays(
+      camera, w, h,
+      CameraJitter{settings_.jitter, settings_.seed, static_cast<std::uint32_t>(frame)},
+      camera_rays_.data());
+  tracer_->intersect_image(camera_rays_.data(), camera_hits_.data(), w, h);
   stats.time_ms["primary"] += ms_since(start);
   stats.primary_rays += n;
 
   start = Clock::now();
+  const int rows_per_task = std::max(1, 4096 / std::max(w, 1));
   // A static camera (no path, or a path held at one frame) has exactly zero motion, whatever the
   // jitter.
   const bool static_camera =

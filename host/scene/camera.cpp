@@ -79,13 +79,6 @@ CameraFrame make_camera_frame(const CameraView& view, float aspect) {
   return frame;
 }
 
-glm::vec3 CameraFrame::ray_direction(float sx, float sy) const {
-  // Film x grows to the right, film y grows downwards (image rows).
-  const float x = (2.0f * sx - 1.0f) * tan_half_fov_y * aspect;
-  const float y = (1.0f - 2.0f * sy) * tan_half_fov_y;
-  return glm::normalize(forward + x * right + y * up);
-}
-
 bool CameraFrame::project(const glm::vec3& p, float& sx, float& sy) const {
   const glm::vec3 d = p - position;
   const float z = glm::dot(d, forward);

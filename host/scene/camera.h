@@ -36,8 +36,14 @@ struct CameraFrame {
   glm::vec3 right, up, forward;  // orthonormal, right-handed, forward = view direction
   float tan_half_fov_y = 0.0f;
   float aspect = 1.0f;  // width / height
-  // Ray direction through film point (sx, sy) in [0,1]^2, (0,0) = top-left corner.
-  glm::vec3 ray_direction(float sx, float sy) const;
+  // Ray direction through film point (sx, sy) in [0,1]^2, (0,0) = top-left corner. Inline:
+  // the camera-ray loop (render/camera_rays.cpp) computes it in vector lanes.
+  glm::vec3 ray_direction(float sx, float sy) const {
+    // Film x grows to the right, film y grows downwards (image rows).
+    const float x = (2.0f * sx - 1.0f) * tan_half_fov_y * aspect;
+    const float y = (1.0f - 2.0f * sy) * tan_half_fov_y;
+    return glm::normalize(forward + x * right + y * up);
+  }
   // Film position in [0,1]^2 of a world point (for motion vectors); false if behind.
   bool project(const glm::vec3& p, float& sx, float& sy) const;
 };

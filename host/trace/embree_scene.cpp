@@ -147,7 +147,9 @@ void to_embree(const Ray& r, RTCRay& out) {
   out.flags = 0;
 }
 
-void set_ray8(RTCRay8& packet, int lane, const Ray& r) {
+// Lane `lane` of an Embree packet of N rays (RTCRay8, RTCRay16).
+template <class RTCRayN>
+void set_ray_n(RTCRayN& packet, int lane, const Ray& r) {
   packet.org_x[lane] = r.origin.x;
   packet.org_y[lane] = r.origin.y;
   packet.org_z[lane] = r.origin.z;
@@ -223,7 +225,7 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
           for (int lane = 0; lane < 8; ++lane) {
             const std::size_t i = p * 8 + lane;
             valid[lane] = i < count ? -1 : 0;
-            set_ray8(rh.ray, lane, rays[i < count ? i : count - 1]);
+            set_ray_n(rh.ray, lane, rays[i < count ? i : count - 1]);
             rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
             rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
           }
@@ -239,6 +241,78 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
             h.v = rh.hit.v[lane];
           }
         }
+      });
+}
+
+namespace {
+
+// Hits of an image's rays in tiles of tile_w x tile_h pixels, one packet of N = tile_w * tile_h
+// rays each (lanes row by row inside the tile; lanes past the image's edge invalid). Rows of
+// tiles in parallel.
+template <int kTileW, int kTileH, class RTCRayHitN, class IntersectN>
+void intersect_tiles(RTCScene scene, const Ray* rays, Hit* hits, int width, int height,
+                     IntersectN intersect_n) {
+  constexpr int kN = kTileW * kTileH;
+  const int tiles_x = (width + kTileW - 1) / kTileW, tiles_y = (height + kTileH - 1) / kTileH;
+  tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const auto& tile_rows) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    for (int ty = tile_rows.begin(); ty != tile_rows.end(); ++ty)
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        alignas(64) RTCRayHitN rh;
+        alignas(64) int valid[kN];
+        std::size_t pixel[kN];
+        for (int lane = 0; lane < kN; ++lane) {
+          const int x = tx * kTileW + lane % kTileW, y = ty * kTileH + lane / kTileW;
+          const bool inside = x < width && y < height;
+          valid[lane] = inside ? -1 : 0;
+          pixel[lane] = inside ? static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                                     static_cast<std::size_t>(x)
+                               : 0;
+          set_ray_n(rh.ray, lane, rays[pixel[lane]]);
+          rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
+          rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
+        }
+        intersect_n(valid, scene, &context, &rh);
+        for (int lane = 0; lane < kN; ++lane) {
+          if (!valid[lane]) continue;
+          Hit& h = hits[pixel[lane]];
+          h.mesh = rh.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID[lane];
+          h.triangle = rh.hit.primID[lane];
+          h.t = rh.ray.tfar[lane];
+          h.u = rh.hit.u[lane];
+          h.v = rh.hit.v[lane];
+        }
+      }
+  });
+}
+
+}  // namespace
+
+bool EmbreeScene::native_packets_of_16() const {
+  return rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0;
+}
+
+void EmbreeScene::intersect_image(const Ray* rays, Hit* hits, int width, int height,
+                                  ImageTiles tiles) const {
+  if (width <= 0 || height <= 0) return;
+  if (tiles == ImageTiles::automatic)
+    tiles = native_packets_of_16() ? ImageTiles::tiles_4x4 : ImageTiles::tiles_4x2;
+  if (tiles == ImageTiles::tiles_4x4) {
+    if (!native_packets_of_16())
+      throw EmbreeError("intersect_image: Embree does not trace 16-wide packets on this CPU");
+    intersect_tiles<4, 4, RTCRayHit16>(
+        impl_->scene, rays, hits, width, height,
+        [](const int* valid, RTCScene scene, RTCIntersectContext* context, RTCRayHit16* rh) {
+          rtcIntersect16(valid, scene, context, rh);
+        });
+    return;
+  }
+  intersect_tiles<4, 2, RTCRayHit8>(
+      impl_->scene, rays, hits, width, height,
+      [](const int* valid, RTCScene scene, RTCIntersectContext* context, RTCRayHit8* rh) {
+        rtcIntersect8(valid, scene, context, rh);
       });
 }
 
@@ -311,7 +385,7 @@ std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::
             const std::size_t i = p * 8 + lane;
             valid[lane] = i < count && has_segment(i) ? -1 : 0;
             lanes += valid[lane] != 0;
-            set_ray8(ray, lane, rays[i < count ? i : count - 1]);
+            set_ray_n(ray, lane, rays[i < count ? i : count - 1]);
           }
           if (lanes > 0) rtcOccluded8(valid, scene, &context, &ray);
           queried += static_cast<std::size_t>(lanes);

@@ -34,6 +34,16 @@ class EmbreeScene {
   std::size_t occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
                        RayMode mode = RayMode::Single) const;
 
+  // Closest hits of an image's camera rays, rays[y * width + x] into hits[y * width + x],
+  // traced in packets of neighbouring pixels: tiles of 4x4 (16 rays) where this CPU and Embree
+  // trace 16-wide packets natively, else of 4x2 (8 rays) (docs/host-path-tracer.md, "Camera
+  // rays in vector lanes"). `tiles` names one shape instead; 4x4 throws EmbreeError where
+  // 16-wide packets are not native.
+  enum class ImageTiles { automatic, tiles_4x2, tiles_4x4 };
+  void intersect_image(const Ray* rays, Hit* hits, int width, int height,
+                       ImageTiles tiles = ImageTiles::automatic) const;
+  bool native_packets_of_16() const;
+
   double build_seconds() const { return build_seconds_; }
 
  private:

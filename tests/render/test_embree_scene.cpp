@@ -1,5 +1,6 @@
 // The batched ray queries of host/trace/embree_scene.h: the same hits and occlusion answers in
-// every ray mode (one by one, packets of 8, streams), and the empty segments the path tracer
+// every ray mode (one by one, packets of 8, streams) and for an image's rays traced in tiles of
+// pixels, and the empty segments the path tracer
 // leaves in its shadow slots (inactive rays, tmin > tmax) answered 0 without a query and left
 // out of the count of rays queried.
 #include <gtest/gtest.h>
@@ -136,6 +137,50 @@ TEST(EmbreeScene, EveryRayModeGivesTheSameAnswers) {
       EXPECT_EQ(std::memcmp(&a.t, &b.t, sizeof a.t), 0) << "ray " << i << ", " << mode_name(mode);
       EXPECT_EQ(std::memcmp(&a.u, &b.u, sizeof a.u), 0) << "ray " << i << ", " << mode_name(mode);
       EXPECT_EQ(std::memcmp(&a.v, &b.v, sizeof a.v), 0) << "ray " << i << ", " << mode_name(mode);
+    }
+  }
+}
+
+// An image's rays from a point above the quad, spread so that the quad's edge crosses tiles, at
+// sizes whose last tiles are partial: intersect_image in each tile shape this CPU runs gives every
+// pixel the hit of its own one-by-one query, to the bit, and writes no pixel twice or not at all
+// (misses keep kNoHit; hits match).
+TEST(EmbreeScene, ImageTilesGiveEveryPixelItsOwnHit) {
+  const Scene scene = quad_scene();
+  const EmbreeScene tracer(scene);
+  std::vector<EmbreeScene::ImageTiles> shapes = {EmbreeScene::ImageTiles::automatic,
+                                                 EmbreeScene::ImageTiles::tiles_4x2};
+  if (tracer.native_packets_of_16()) shapes.push_back(EmbreeScene::ImageTiles::tiles_4x4);
+  const int sizes[][2] = {{1, 1}, {3, 5}, {13, 7}, {16, 16}, {37, 23}};
+  for (const auto& size : sizes) {
+    const int w = size[0], h = size[1];
+    std::vector<Ray> rays;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const float sx = (static_cast<float>(x) + 0.5f) / static_cast<float>(w) * 3.0f - 1.5f;
+        const float sz = (static_cast<float>(y) + 0.5f) / static_cast<float>(h) * 3.0f - 1.5f;
+        rays.push_back(segment({0.1f, 1.0f, -0.2f}, {sx, -1.0f, sz}, 0.0f, 1e30f));
+      }
+    std::vector<Hit> single(rays.size());
+    tracer.intersect(rays.data(), single.data(), rays.size(), RayMode::Single);
+    for (const EmbreeScene::ImageTiles shape : shapes) {
+      std::vector<Hit> got(rays.size());
+      tracer.intersect_image(rays.data(), got.data(), w, h, shape);
+      int differing = 0;
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        const Hit &a = single[i], &b = got[i];
+        differing += a.mesh != b.mesh || (a.valid() && (a.triangle != b.triangle ||
+                                                        std::memcmp(&a.t, &b.t, sizeof a.t) != 0 ||
+                                                        std::memcmp(&a.u, &b.u, sizeof a.u) != 0 ||
+                                                        std::memcmp(&a.v, &b.v, sizeof a.v) != 0));
+      }
+      EXPECT_EQ(differing, 0) << w << "x" << h << ", shape " << static_cast<int>(shape);
+    }
+    if (w == 37) {  // the case spans hits and misses
+      std::size_t hits = 0;
+      for (const Hit& hit : single) hits += hit.valid();
+      EXPECT_GT(hits, rays.size() / 4);
+      EXPECT_LT(hits, rays.size());
     }
   }
 }
