@@ -1,19 +1,12 @@
 #include "render/camera_rays.h"
 
 #include <algorithm>
-#include <stdexcept>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "rtpg/guiding_layout.h"
 #include "shared/rng.h"
-
-#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
-#define RTPG_CAMERA_RAYS_AVX2 1
-#else
-#define RTPG_CAMERA_RAYS_AVX2 0
-#endif
 
 namespace rtpg {
 namespace {
@@ -70,11 +63,9 @@ void camera_rows_baseline(const CameraFrame& camera, int y0, int y1, int width, 
                rays + static_cast<std::size_t>(y) * static_cast<std::size_t>(width));
 }
 
-#if RTPG_CAMERA_RAYS_AVX2
-// The same rows built for AVX2 only (no FMA: a fused multiply-add would round differently).
-__attribute__((target("avx2"))) void camera_rows_avx2(const CameraFrame& camera, int y0, int y1,
-                                                      int width, int height,
-                                                      const CameraJitter& jitter, Ray* rays) {
+#if RTPG_HAS_AVX2_VARIANT
+RTPG_AVX2_VARIANT void camera_rows_avx2(const CameraFrame& camera, int y0, int y1, int width,
+                                        int height, const CameraJitter& jitter, Ray* rays) {
   for (int y = y0; y < y1; ++y)
     camera_row(camera, y, width, height, jitter,
                rays + static_cast<std::size_t>(y) * static_cast<std::size_t>(width));
@@ -83,24 +74,13 @@ __attribute__((target("avx2"))) void camera_rows_avx2(const CameraFrame& camera,
 
 }  // namespace
 
-bool camera_rays_avx2_available() {
-#if RTPG_CAMERA_RAYS_AVX2
-  return __builtin_cpu_supports("avx2");
-#else
-  return false;
-#endif
-}
-
 void make_camera_rays(const CameraFrame& camera, int width, int height, const CameraJitter& jitter,
-                      Ray* rays, CameraRayCode code) {
-  if (code == CameraRayCode::automatic)
-    code = camera_rays_avx2_available() ? CameraRayCode::avx2 : CameraRayCode::baseline;
-  if (code == CameraRayCode::avx2 && !camera_rays_avx2_available())
-    throw std::invalid_argument("make_camera_rays: this CPU does not run AVX2 code");
+                      Ray* rays, CpuCode code) {
+  code = resolve_cpu_code(code);
   const int rows_per_task = std::max(1, 4096 / std::max(width, 1));
   tbb::parallel_for(tbb::blocked_range<int>(0, height, rows_per_task), [&](const auto& rows) {
-#if RTPG_CAMERA_RAYS_AVX2
-    if (code == CameraRayCode::avx2) {
+#if RTPG_HAS_AVX2_VARIANT
+    if (code == CpuCode::avx2) {
       camera_rows_avx2(camera, rows.begin(), rows.end(), width, height, jitter, rays);
       return;
     }

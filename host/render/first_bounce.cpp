@@ -11,8 +11,18 @@ namespace rtpg {
 FirstBounceSample bsdf_first_bounce_sample(const shared::pg_frame& frame, const glm::vec3& wo,
                                            const shared::pg_lobes& lobes,
                                            const SampleCoordinates& at, std::size_t i) {
-  shared::pg_rng rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
-                                           at.sample, PG_RNG_STREAM_FIRST_BOUNCE);
+  return bsdf_first_bounce_sample(
+      frame, wo, lobes,
+      shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame, at.sample,
+                          PG_RNG_STREAM_FIRST_BOUNCE)
+          .state);
+}
+
+FirstBounceSample bsdf_first_bounce_sample(const shared::pg_frame& frame, const glm::vec3& wo,
+                                           const shared::pg_lobes& lobes,
+                                           std::uint32_t stream_start) {
+  shared::pg_rng rng;
+  rng.state = stream_start;
   const float u_lobe = shared::pg_rng_next(&rng);
   const float u1 = shared::pg_rng_next(&rng);
   const float u2 = shared::pg_rng_next(&rng);

@@ -107,6 +107,11 @@ class FirstBounceSampler {
 FirstBounceSample bsdf_first_bounce_sample(const shared::pg_frame& frame, const glm::vec3& wo,
                                            const shared::pg_lobes& lobes,
                                            const SampleCoordinates& at, std::size_t i);
+// The same from the start state of that stream, pg_rng_make(at.seed, i, at.frame, at.sample,
+// PG_RNG_STREAM_FIRST_BOUNCE).state, made by the caller (render/stream_starts.h).
+FirstBounceSample bsdf_first_bounce_sample(const shared::pg_frame& frame, const glm::vec3& wo,
+                                           const shared::pg_lobes& lobes,
+                                           std::uint32_t stream_start);
 
 // BSDF importance sampling, on the host.
 class BsdfFirstBounce final : public FirstBounceSampler {

@@ -13,6 +13,7 @@
 #include <tbb/parallel_scan.h>
 
 #include "render/mis.h"
+#include "render/stream_starts.h"
 #include "render/surface.h"
 #include "shared/guiding_pixel.h"
 #include "shared/rng.h"
@@ -172,108 +173,120 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
   // A sampler of the BSDF has the BSDF's density already (its samples' own).
   const bool mis_with_bsdf =
       settings_.first_bounce_mis == FirstBounceMis::bsdf && !sampler.samples_the_bsdf();
+  const SampleCoordinates first_at = first_bounce_coordinates(at, settings_.shared_randoms);
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, g.pixel_count(), kGrain), [&](const auto& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-          PathState& p = paths_[i];
-          p.throughput = glm::vec3(0.0f);
-          if (vpls) {
-            // Measured from y (VplPath): x0's emission is the pixel's own.
-            p.radiance = glm::vec3(0.0f);
-            vpl_paths_[i] = VplPath{glm::vec3(0.0f), glm::vec3(g.emission[i]), 0.0f};
-          } else {
-            p.radiance = glm::vec3(g.emission[i]);
-          }
-          shadow_rays_[i] = inactive_ray();
-          has_shadow_[i] = 0;
-          rays_[i] = inactive_ray();
-          alive_[i] = 0;
-          if (!g.has_surface(i)) continue;
-          shared::pg_rng rng = shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
-                                                   at.sample, PG_RNG_STREAM_PATH);
-          const glm::vec3 x0(g.position_depth[i]);
-          const glm::vec3 ng(g.geometric_normal[i]);
-          const shared::pg_frame frame = gbuffer_frame(g, i);
-          const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
-          const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
-          const glm::vec3 origin = offset_ray_origin(x0, ng, g.geometric_normal[i].w);
-
-          // Next-event estimation draws three numbers: the sample's own, or sample 0's where the
-          // frame's samples share the primary vertex (SharedRandoms); either way the sample's
-          // own stream moves past them, so that sample 0 draws as the renderer does.
-          const bool shared_nee = settings_.shared_randoms == SharedRandoms::primary_vertex ||
-                                  settings_.shared_randoms == SharedRandoms::second_vertex;
-          shared::pg_rng nee_rng = shared_nee
-                                       ? shared::pg_rng_make(at.seed, static_cast<shared::uint>(i),
-                                                             at.frame, 0u, PG_RNG_STREAM_PATH)
-                                       : rng;
-          const float u_sel = shared::pg_rng_next(&nee_rng), u1 = shared::pg_rng_next(&nee_rng),
-                      u2 = shared::pg_rng_next(&nee_rng);
-          if (shared_nee) {
-            for (int k = 0; k < kNextEventDraws; ++k) shared::pg_rng_next(&rng);
-          } else {
-            rng = nee_rng;
-          }
-          // The first bounce's own sampler competes with the light here: the MIS weights use
-          // its density (the guided mixture), or the BSDF's where first_bounce_mis says so.
-          const auto first_bounce_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
-            return mis_with_bsdf ? bsdf_mis_density(shared::pg_bsdf_pdf(lobes, wo, wi))
-                                 : sampler.pdf(g, i, lobes, wo, wi);
-          };
-          glm::vec3 c;
-          Ray shadow;
-          if (next_event_on_ && next_event(x0, ng, frame, wo, lobes, origin, u_sel, u1, u2,
-                                           first_bounce_pdf, c, shadow)) {
-            shadow_contribution_[i] = c;
-            shadow_rays_[i] = shadow;
-            has_shadow_[i] = 1;
-          }
-
-          FirstBounceSample fs;
-          if (first) {
-            const glm::vec4 d = first->direction_pdf[i];
-            fs.direction = glm::vec3(d);
-            fs.pdf = std::isfinite(d.w) ? d.w : 0.0f;
-            fs.strategy = first->strategy[i];
-          } else {
-            fs = bsdf_first_bounce_sample(
-                frame, wo, lobes, first_bounce_coordinates(at, settings_.shared_randoms), i);
-          }
-          if (fs.pdf > 0.0f && glm::dot(fs.direction, ng) > 0.0f) {
-            const glm::vec3 wi = shared::pg_to_local(frame, fs.direction);
-            const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
-            const glm::vec3 throughput = f / fs.pdf;
-            const bool bsdf_strategy = fs.strategy == kStrategyBsdf;
-            const float bsdf_pdf = (vpls && bsdf_strategy) || mis_with_bsdf
-                                       ? shared::pg_bsdf_pdf(lobes, wo, wi)
-                                       : 0.0f;
+        // The pixels' path streams (and first-bounce streams where the BSDF's first bounce is
+        // drawn here) started in vector lanes, a chunk at a time (render/stream_starts.h).
+        std::uint32_t path_starts[kGrain], first_starts[kGrain];
+        for (std::size_t chunk = range.begin(); chunk < range.end(); chunk += kGrain) {
+          const std::size_t chunk_end = std::min(range.end(), chunk + kGrain);
+          make_stream_starts({at.seed, at.frame, at.sample, PG_RNG_STREAM_PATH}, chunk,
+                             chunk_end - chunk, path_starts);
+          if (!first)
+            make_stream_starts(
+                {first_at.seed, first_at.frame, first_at.sample, PG_RNG_STREAM_FIRST_BOUNCE}, chunk,
+                chunk_end - chunk, first_starts);
+          for (std::size_t i = chunk; i != chunk_end; ++i) {
+            PathState& p = paths_[i];
+            p.throughput = glm::vec3(0.0f);
             if (vpls) {
-              // The VPL keeps the density of the strategy that made it (BSDF samples are
-              // distributed by the BSDF alone: paper 3.2) and the whole sampler's density D
-              // (include/rtpg/guiding_layout.h). Area measure comes at y.
-              vpls->strategy_pdf[i] = bsdf_strategy ? bsdf_pdf : fs.pdf;
-              vpls->info[i] = fs.strategy << PG_VPL_STRATEGY_SHIFT;
-              vpl_paths_[i].sampler_pdf = fs.pdf;
+              // Measured from y (VplPath): x0's emission is the pixel's own.
+              p.radiance = glm::vec3(0.0f);
+              vpl_paths_[i] = VplPath{glm::vec3(0.0f), glm::vec3(g.emission[i]), 0.0f};
+            } else {
+              p.radiance = glm::vec3(g.emission[i]);
             }
-            if (!is_black(throughput) && is_finite(throughput)) {
+            shadow_rays_[i] = inactive_ray();
+            has_shadow_[i] = 0;
+            rays_[i] = inactive_ray();
+            alive_[i] = 0;
+            if (!g.has_surface(i)) continue;
+            shared::pg_rng rng;
+            rng.state = path_starts[i - chunk];
+            const glm::vec3 x0(g.position_depth[i]);
+            const glm::vec3 ng(g.geometric_normal[i]);
+            const shared::pg_frame frame = gbuffer_frame(g, i);
+            const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
+            const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
+            const glm::vec3 origin = offset_ray_origin(x0, ng, g.geometric_normal[i].w);
+
+            // Next-event estimation draws three numbers: the sample's own, or sample 0's where the
+            // frame's samples share the primary vertex (SharedRandoms); either way the sample's
+            // own stream moves past them, so that sample 0 draws as the renderer does.
+            const bool shared_nee = settings_.shared_randoms == SharedRandoms::primary_vertex ||
+                                    settings_.shared_randoms == SharedRandoms::second_vertex;
+            shared::pg_rng nee_rng =
+                shared_nee ? shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
+                                                 0u, PG_RNG_STREAM_PATH)
+                           : rng;
+            const float u_sel = shared::pg_rng_next(&nee_rng), u1 = shared::pg_rng_next(&nee_rng),
+                        u2 = shared::pg_rng_next(&nee_rng);
+            if (shared_nee) {
+              for (int k = 0; k < kNextEventDraws; ++k) shared::pg_rng_next(&rng);
+            } else {
+              rng = nee_rng;
+            }
+            // The first bounce's own sampler competes with the light here: the MIS weights use
+            // its density (the guided mixture), or the BSDF's where first_bounce_mis says so.
+            const auto first_bounce_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
+              return mis_with_bsdf ? bsdf_mis_density(shared::pg_bsdf_pdf(lobes, wo, wi))
+                                   : sampler.pdf(g, i, lobes, wo, wi);
+            };
+            glm::vec3 c;
+            Ray shadow;
+            if (next_event_on_ && next_event(x0, ng, frame, wo, lobes, origin, u_sel, u1, u2,
+                                             first_bounce_pdf, c, shadow)) {
+              shadow_contribution_[i] = c;
+              shadow_rays_[i] = shadow;
+              has_shadow_[i] = 1;
+            }
+
+            FirstBounceSample fs;
+            if (first) {
+              const glm::vec4 d = first->direction_pdf[i];
+              fs.direction = glm::vec3(d);
+              fs.pdf = std::isfinite(d.w) ? d.w : 0.0f;
+              fs.strategy = first->strategy[i];
+            } else {
+              fs = bsdf_first_bounce_sample(frame, wo, lobes, first_starts[i - chunk]);
+            }
+            if (fs.pdf > 0.0f && glm::dot(fs.direction, ng) > 0.0f) {
+              const glm::vec3 wi = shared::pg_to_local(frame, fs.direction);
+              const glm::vec3 f = shared::pg_bsdf_eval(lobes, wo, wi) * std::max(wi.z, 0.0f);
+              const glm::vec3 throughput = f / fs.pdf;
+              const bool bsdf_strategy = fs.strategy == kStrategyBsdf;
+              const float bsdf_pdf = (vpls && bsdf_strategy) || mis_with_bsdf
+                                         ? shared::pg_bsdf_pdf(lobes, wo, wi)
+                                         : 0.0f;
               if (vpls) {
-                vpl_paths_[i].first_throughput = throughput;
-                p.throughput = glm::vec3(1.0f);  // measured from y on (VplPath)
-              } else {
-                p.throughput = throughput;
+                // The VPL keeps the density of the strategy that made it (BSDF samples are
+                // distributed by the BSDF alone: paper 3.2) and the whole sampler's density D
+                // (include/rtpg/guiding_layout.h). Area measure comes at y.
+                vpls->strategy_pdf[i] = bsdf_strategy ? bsdf_pdf : fs.pdf;
+                vpls->info[i] = fs.strategy << PG_VPL_STRATEGY_SHIFT;
+                vpl_paths_[i].sampler_pdf = fs.pdf;
               }
-              Ray r;
-              r.origin = origin;
-              r.direction = fs.direction;
-              rays_[i] = r;
-              // The density the hit's MIS weight uses: the same function of the direction
-              // as next-event estimation's above.
-              p.prev_pdf = mis_with_bsdf ? bsdf_mis_density(bsdf_pdf) : fs.pdf;
-              p.prev_position = x0;
-              alive_[i] = 1;
+              if (!is_black(throughput) && is_finite(throughput)) {
+                if (vpls) {
+                  vpl_paths_[i].first_throughput = throughput;
+                  p.throughput = glm::vec3(1.0f);  // measured from y on (VplPath)
+                } else {
+                  p.throughput = throughput;
+                }
+                Ray r;
+                r.origin = origin;
+                r.direction = fs.direction;
+                rays_[i] = r;
+                // The density the hit's MIS weight uses: the same function of the direction
+                // as next-event estimation's above.
+                p.prev_pdf = mis_with_bsdf ? bsdf_mis_density(bsdf_pdf) : fs.pdf;
+                p.prev_position = x0;
+                alive_[i] = 1;
+              }
             }
+            p.rng = rng.state;
           }
-          p.rng = rng.state;
         }
       });
 }

@@ -41,9 +41,9 @@ Ray expected_ray(const CameraFrame& camera, int x, int y, int width, int height,
   return r;
 }
 
-std::vector<CameraRayCode> codes_this_cpu_runs() {
-  std::vector<CameraRayCode> codes = {CameraRayCode::automatic, CameraRayCode::baseline};
-  if (camera_rays_avx2_available()) codes.push_back(CameraRayCode::avx2);
+std::vector<CpuCode> codes_this_cpu_runs() {
+  std::vector<CpuCode> codes = {CpuCode::automatic, CpuCode::baseline};
+  if (cpu_runs_avx2()) codes.push_back(CpuCode::avx2);
   return codes;
 }
 
@@ -55,7 +55,7 @@ TEST(CameraRays, EveryVariantGivesTheScalarRaysToTheBit) {
   // 1x1, widths below, at and past one step of 16 lanes, a tall thin frame, a 960-wide row.
   const int sizes[][2] = {{1, 1}, {15, 3}, {16, 2}, {17, 5}, {37, 23}, {3, 41}, {960, 4}};
   const CameraJitter jitters[] = {{true, 7u, 0u}, {true, 1u, 31u}, {false, 7u, 3u}};
-  for (const CameraRayCode code : codes_this_cpu_runs())
+  for (const CpuCode code : codes_this_cpu_runs())
     for (const auto& size : sizes)
       for (const CameraJitter& jitter : jitters) {
         const int w = size[0], h = size[1];
