@@ -84,9 +84,10 @@ Ray inactive_ray() {
 
 }  // namespace
 
-PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer, const Lights& lights,
+PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer,
+                       const TriangleTable& triangles, const Lights& lights,
                        PathTracerSettings settings)
-    : scene_(scene), tracer_(tracer), lights_(lights), settings_(settings) {}
+    : scene_(scene), tracer_(tracer), triangles_(triangles), lights_(lights), settings_(settings) {}
 
 void PathTracer::trace(const GBuffer& g, const FirstBounceSamples* first,
                        const FirstBounceSampler& sampler, const SampleCoordinates& at,
@@ -340,7 +341,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         }
         continue;
       }
-      const SurfacePoint sp = make_surface_point(scene_, ray, hit);
+      const SurfacePoint sp = make_surface_point(scene_, triangles_, ray, hit);
       if (!is_black(sp.emission)) {
         const float w =
             nee ? power_heuristic(p.prev_pdf,

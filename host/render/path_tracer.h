@@ -12,6 +12,7 @@
 #include "render/first_bounce.h"
 #include "render/gbuffer.h"
 #include "render/lights.h"
+#include "render/surface.h"
 #include "render/vpl_buffer.h"
 #include "scene/scene.h"
 #include "shared/rng.h"
@@ -93,8 +94,8 @@ struct PassTimes {
 
 class PathTracer {
  public:
-  PathTracer(const Scene& scene, const EmbreeScene& tracer, const Lights& lights,
-             PathTracerSettings settings);
+  PathTracer(const Scene& scene, const EmbreeScene& tracer, const TriangleTable& triangles,
+             const Lights& lights, PathTracerSettings settings);
 
   // One path per surface pixel of the G-buffer, starting with `first` (from `sampler`), or
   // with bsdf_first_bounce_sample() drawn at the primary hit where first is null (a sampler
@@ -188,6 +189,7 @@ class PathTracer {
 
   const Scene& scene_;
   const EmbreeScene& tracer_;
+  const TriangleTable& triangles_;
   const Lights& lights_;
   PathTracerSettings settings_;
 

@@ -47,8 +47,10 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
                              "not enough memory for " + std::to_string(pixels) + " pixels");
   }
   tracer_ = std::make_unique<EmbreeScene>(scene);
+  triangles_ = std::make_unique<TriangleTable>(scene);
   lights_ = std::make_unique<Lights>(scene);
-  path_tracer_ = std::make_unique<PathTracer>(scene, *tracer_, *lights_, settings.path_tracer);
+  path_tracer_ =
+      std::make_unique<PathTracer>(scene, *tracer_, *triangles_, *lights_, settings.path_tracer);
   sampler_ = std::make_unique<BsdfFirstBounce>();
 }
 
@@ -126,7 +128,7 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
           g.view_dir[i] = glm::vec4(-dir, 0.0f);
           continue;
         }
-        const SurfacePoint sp = make_surface_point(scene_, ray, hit);
+        const SurfacePoint sp = make_surface_point(scene_, *triangles_, ray, hit);
         const float depth = glm::dot(sp.position - camera.position, camera.forward);
         g.position_depth[i] = glm::vec4(sp.position, depth);
         g.shading_normal[i] = glm::vec4(sp.shading_normal, 0.0f);

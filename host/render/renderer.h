@@ -15,6 +15,7 @@
 #include "render/gbuffer.h"
 #include "render/lights.h"
 #include "render/path_tracer.h"
+#include "render/surface.h"
 #include "rtpg/errors.h"
 #include "scene/scene.h"
 #include "trace/embree_scene.h"
@@ -83,6 +84,7 @@ class Renderer {
   const Scene& scene_;
   RenderSettings settings_;
   std::unique_ptr<EmbreeScene> tracer_;
+  std::unique_ptr<TriangleTable> triangles_;  // built with the BVH, from the same positions
   std::unique_ptr<Lights> lights_;
   std::unique_ptr<PathTracer> path_tracer_;
   std::unique_ptr<FirstBounceSampler> sampler_;

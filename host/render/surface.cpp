@@ -65,30 +65,58 @@ glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n, float offset
   return out;
 }
 
-SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
+TriangleFacts triangle_facts(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2) {
+  // The bound gamma(7) * max|p_i| per coordinate covers a hit's interpolation from its
+  // barycentrics and their own rounding (b0 = 1 - u - v); the offset distance is its projection
+  // on the normal (docs/robustness.md, "Scale invariance").
+  constexpr float kEps = std::numeric_limits<float>::epsilon() * 0.5f;
+  constexpr float kGamma7 = 7.0f * kEps / (1.0f - 7.0f * kEps);
+  const glm::vec3 error = kGamma7 * glm::max(glm::max(glm::abs(p0), glm::abs(p1)), glm::abs(p2));
+  TriangleFacts f;
+  f.normal = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+  f.offset_distance = glm::dot(glm::abs(f.normal), error);
+  f.flat_shading_normal = glm::normalize(f.normal);
+  return f;
+}
+
+TriangleTable::TriangleTable(const Scene& scene) {
+  facts_.resize(scene.meshes.size());
+  for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    facts_[m].resize(mesh.triangles.size());
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::uvec3 tri = mesh.triangles[t];
+      facts_[m][t] =
+          triangle_facts(mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z]);
+    }
+  }
+}
+
+namespace {
+
+SurfacePoint surface_point(const Scene& scene, const TriangleFacts& facts, const Ray& ray,
+                           const Hit& hit) {
   const Mesh& mesh = scene.meshes[hit.mesh];
   const glm::uvec3 tri = mesh.triangles[hit.triangle];
   const Material& mat = scene.materials[mesh.material];
   SurfacePoint sp;
   sp.material_id = mesh.material;
-  const glm::vec3 p0 = mesh.positions[tri.x], p1 = mesh.positions[tri.y],
-                  p2 = mesh.positions[tri.z];
   // The hit from its barycentrics, not from origin + t * direction: its rounding error then
-  // depends on the triangle's coordinates only, not on how far the ray came.
-  // The bound gamma(7) * max|p_i| per coordinate covers the sum and the barycentrics'
-  // own rounding (b0 = 1 - u - v); the offset distance is its projection on the normal
-  // (docs/robustness.md, "Scale invariance").
-  sp.position = (1.0f - hit.u - hit.v) * p0 + hit.u * p1 + hit.v * p2;
-  constexpr float kEps = std::numeric_limits<float>::epsilon() * 0.5f;
-  constexpr float kGamma7 = 7.0f * kEps / (1.0f - 7.0f * kEps);
-  const glm::vec3 error = kGamma7 * glm::max(glm::max(glm::abs(p0), glm::abs(p1)), glm::abs(p2));
-  glm::vec3 ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-  const bool front = glm::dot(ng, ray.direction) < 0.0f;
-  if (!front) ng = -ng;
-  glm::vec3 ns = mesh.normals.empty() ? ng : interpolate(mesh.normals, tri, hit.u, hit.v);
-  if (glm::dot(ns, ns) < 1e-12f) ns = ng;
-  ns = glm::normalize(ns);
-  if (glm::dot(ns, ng) < 0.0f) ns = -ns;
+  // depends on the triangle's coordinates only, not on how far the ray came (TriangleFacts).
+  sp.position = (1.0f - hit.u - hit.v) * mesh.positions[tri.x] + hit.u * mesh.positions[tri.y] +
+                hit.v * mesh.positions[tri.z];
+  const bool front = glm::dot(facts.normal, ray.direction) < 0.0f;
+  const glm::vec3 ng = front ? facts.normal : -facts.normal;
+  glm::vec3 ns;
+  if (mesh.normals.empty()) {
+    // normalize(ng), as below; negation commutes with it exactly.
+    ns = front ? facts.flat_shading_normal : -facts.flat_shading_normal;
+  } else {
+    ns = interpolate(mesh.normals, tri, hit.u, hit.v);
+    if (glm::dot(ns, ns) < 1e-12f) ns = ng;
+    ns = glm::normalize(ns);
+    if (glm::dot(ns, ng) < 0.0f) ns = -ns;
+  }
 
   glm::vec2 uv(0.0f);
   if (!mesh.uvs.empty())
@@ -126,7 +154,7 @@ SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& h
     }
   }
   sp.geometric_normal = ng;
-  sp.offset_distance = glm::dot(glm::abs(ng), error);
+  sp.offset_distance = facts.offset_distance;
   sp.shading_normal = ns;
   sp.material.base_color = shared::float3(base.x, base.y, base.z);
   sp.material.roughness = roughness;
@@ -135,6 +163,21 @@ SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& h
   sp.transmissive = mat.transmissive;
   if (front) sp.emission = mat.emission;
   return sp;
+}
+
+}  // namespace
+
+SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
+  const Mesh& mesh = scene.meshes[hit.mesh];
+  const glm::uvec3 tri = mesh.triangles[hit.triangle];
+  return surface_point(
+      scene, triangle_facts(mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z]),
+      ray, hit);
+}
+
+SurfacePoint make_surface_point(const Scene& scene, const TriangleTable& triangles, const Ray& ray,
+                                const Hit& hit) {
+  return surface_point(scene, triangles.at(hit.mesh, hit.triangle), ray, hit);
 }
 
 }  // namespace rtpg

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -25,8 +26,36 @@ struct SurfacePoint {
   bool transmissive = false;
 };
 
-// Interpolates and textures the hit of `ray`; `hit` must be valid.
+// What a surface point needs of its triangle and not of the hit: the same for every hit on the
+// triangle, so the renderer computes it once per scene (TriangleTable) instead of per hit.
+struct alignas(16) TriangleFacts {
+  glm::vec3 normal{0.0f, 0.0f, 1.0f};  // normalize(cross(p1 - p0, p2 - p0)), facing no ray yet
+  // dot(|normal|, gamma(7) * max|p_i|): SurfacePoint::offset_distance of every point on it
+  float offset_distance = 0.0f;
+  // normalize(normal): the shading normal of a mesh without vertex normals, as make_surface_point
+  // normalises it once more (so that the table gives the same bits as the per-hit code)
+  glm::vec3 flat_shading_normal{0.0f, 0.0f, 1.0f};
+};
+TriangleFacts triangle_facts(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2);
+
+// The facts of every triangle of a scene, from its positions as they are when the table is built
+// (the renderer builds it with its BVH; a scene changed afterwards needs both rebuilt).
+class TriangleTable {
+ public:
+  explicit TriangleTable(const Scene& scene);
+  const TriangleFacts& at(std::uint32_t mesh, std::uint32_t triangle) const {
+    return facts_[mesh][triangle];
+  }
+
+ private:
+  std::vector<std::vector<TriangleFacts>> facts_;
+};
+
+// Interpolates and textures the hit of `ray`; `hit` must be valid. The first form computes the
+// triangle's facts for this hit, the second reads them from `triangles`: the same bits.
 SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& hit);
+SurfacePoint make_surface_point(const Scene& scene, const TriangleTable& triangles, const Ray& ray,
+                                const Hit& hit);
 
 // Origin for rays leaving p on the side of the unit normal n: p moved offset_distance along n
 // (SurfacePoint::offset_distance, an error bound of p), then one float further from p in each

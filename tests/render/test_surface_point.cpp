@@ -1,0 +1,94 @@
+// Surface points from the renderer's triangle table (host/render/surface.h, TriangleTable) equal,
+// to the bit, those computed from the hit alone, and both keep SurfacePoint's promises (normals
+// facing the ray, emission only from the front): for hits on flat meshes and on meshes with
+// vertex normals, from the front and from behind, at ordinary and at extreme coordinate
+// magnitudes (the offset distance scales with them; docs/robustness.md).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "render/surface.h"
+#include "scene/shapes.h"
+#include "trace/embree_scene.h"
+
+namespace rtpg {
+namespace {
+
+bool same_bits(const glm::vec3& a, const glm::vec3& b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+Scene scene_at_scale(float scale) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  Material light;
+  light.emission = glm::vec3(2.0f);
+  scene.materials.push_back(light);
+  // The box and the quad flat (no vertex normals), the sphere with them.
+  Mesh box = make_box(glm::vec3(-1.0f) * scale, glm::vec3(1.0f) * scale);
+  box.normals.clear();
+  box.material = 1;
+  scene.meshes.push_back(box);
+  scene.meshes.push_back(make_sphere(glm::vec3(0.2f) * scale, 0.5f * scale, 3, false));
+  // Through the middle, tilted: the origins lie on both of its sides.
+  Mesh quad = make_quad(glm::vec3(-0.9f, -0.05f, -0.9f) * scale,
+                        glm::vec3(1.8f, 0.1f, 0.0f) * scale, glm::vec3(0.0f, 0.0f, 1.8f) * scale);
+  quad.normals.clear();
+  scene.meshes.push_back(quad);
+  return scene;
+}
+
+TEST(SurfacePoint, TheTriangleTableGivesThePerHitBits) {
+  for (const float scale : {1.0f, 1e-4f, 3e4f}) {
+    const Scene scene = scene_at_scale(scale);
+    const EmbreeScene tracer(scene);
+    const TriangleTable table(scene);
+    std::mt19937 gen(11);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    int hits = 0, differing = 0, wrong_side = 0;
+    int flat_front = 0, flat_back = 0, smooth_front = 0, smooth_back = 0;
+    for (int k = 0; k < 4000; ++k) {
+      Ray ray;
+      // Inside the box: rays hit the sphere (vertex normals), the quad (either side) or the box
+      // from within (its back faces).
+      ray.origin = glm::vec3(0.8f * u(gen), 0.8f * u(gen), 0.8f * u(gen)) * scale;
+      ray.direction = glm::vec3(u(gen), u(gen), u(gen));
+      Hit hit;
+      tracer.intersect(&ray, &hit, 1);
+      if (!hit.valid()) continue;
+      ++hits;
+      const SurfacePoint a = make_surface_point(scene, ray, hit);
+      const SurfacePoint b = make_surface_point(scene, table, ray, hit);
+      // What SurfacePoint promises on either side: the geometric normal faces the ray, the
+      // shading normal lies on its side, the emission leaves only the front.
+      const bool facing = glm::dot(table.at(hit.mesh, hit.triangle).normal, ray.direction) < 0.0f;
+      wrong_side += !(glm::dot(b.geometric_normal, ray.direction) < 0.0f) ||
+                    !(glm::dot(b.shading_normal, b.geometric_normal) > 0.0f) ||
+                    (!facing && b.emission != glm::vec3(0.0f));
+      const bool flat = scene.meshes[hit.mesh].normals.empty();
+      flat_front += flat && facing;
+      flat_back += flat && !facing;
+      smooth_front += !flat && facing;
+      smooth_back += !flat && !facing;
+      differing += !same_bits(a.position, b.position) ||
+                   !same_bits(a.geometric_normal, b.geometric_normal) ||
+                   !same_bits(a.shading_normal, b.shading_normal) ||
+                   !same_bits(a.emission, b.emission) ||
+                   std::memcmp(&a.offset_distance, &b.offset_distance, sizeof(float)) != 0 ||
+                   a.material_id != b.material_id;
+    }
+    EXPECT_GT(hits, 3000) << "scale " << scale;
+    // Both sides of the triangles' winding, on flat and on smooth meshes.
+    EXPECT_GT(flat_front, 50) << "scale " << scale;
+    EXPECT_GT(flat_back, 50) << "scale " << scale;
+    EXPECT_GT(smooth_front, 50) << "scale " << scale;
+    EXPECT_GT(smooth_back, 50) << "scale " << scale;
+    EXPECT_EQ(differing, 0) << "scale " << scale;
+    EXPECT_EQ(wrong_side, 0) << "scale " << scale;
+  }
+}
+
+}  // namespace
+}  // namespace rtpg
