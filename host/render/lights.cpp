@@ -18,12 +18,14 @@ float luminance(const glm::vec3& c) {
 
 }  // namespace
 
+void set_shadow_ray(Ray& r, const glm::vec3& origin, const LightSample& sample) {
+  set_ray(r, origin, sample.direction, 0.0f,
+          std::isinf(sample.distance) ? kInfinity : sample.distance * (1.0f - 1e-4f));
+}
+
 Ray shadow_ray(const glm::vec3& origin, const LightSample& sample) {
   Ray r;
-  r.origin = origin;
-  r.direction = sample.direction;
-  r.tmin = 0.0f;
-  r.tmax = std::isinf(sample.distance) ? kInfinity : sample.distance * (1.0f - 1e-4f);
+  set_shadow_ray(r, origin, sample);
   return r;
 }
 

@@ -26,6 +26,8 @@ struct LightSample {
 // Shadow ray from origin towards a light sample, stopping just short of the light (infinite
 // for the sun and the environment).
 Ray shadow_ray(const glm::vec3& origin, const LightSample& sample);
+// The same written into r in place (set_ray, host/trace/ray.h).
+void set_shadow_ray(Ray& r, const glm::vec3& origin, const LightSample& sample);
 
 class Lights {
  public:

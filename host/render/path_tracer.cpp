@@ -157,7 +157,7 @@ bool PathTracer::next_event(const glm::vec3& position, const glm::vec3& ng,
   if (is_black(f)) return false;
   const float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, competing_pdf(ls.direction, wi));
   contribution = f * ls.radiance * (w / ls.pdf);
-  shadow = shadow_ray(origin, ls);
+  set_shadow_ray(shadow, origin, ls);
   return true;
 }
 
@@ -234,12 +234,11 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
               return mis_with_bsdf ? bsdf_mis_density(shared::pg_bsdf_pdf(lobes, wo, wi))
                                    : sampler.pdf(g, i, lobes, wo, wi);
             };
+            // next_event writes the shadow ray in place only where it returns true.
             glm::vec3 c;
-            Ray shadow;
             if (next_event_on_ && next_event(x0, ng, frame, wo, lobes, origin, u_sel, u1, u2,
-                                             first_bounce_pdf, c, shadow)) {
+                                             first_bounce_pdf, c, shadow_rays_[i])) {
               shadow_contribution_[i] = c;
-              shadow_rays_[i] = shadow;
               has_shadow_[i] = 1;
             }
 
@@ -275,10 +274,7 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                 } else {
                   p.throughput = throughput;
                 }
-                Ray r;
-                r.origin = origin;
-                r.direction = fs.direction;
-                rays_[i] = r;
+                set_ray(rays_[i], origin, fs.direction, 0.0f, 1e30f);
                 // The density the hit's MIS weight uses: the same function of the direction
                 // as next-event estimation's above.
                 p.prev_pdf = mis_with_bsdf ? bsdf_mis_density(bsdf_pdf) : fs.pdf;
@@ -392,11 +388,9 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         return guided ? guide_density(guide, w, bsdf) : bsdf;
       };
       glm::vec3 c;
-      Ray shadow;
       if (nee && next_event(sp.position, sp.geometric_normal, frame, wo, lobes, origin, u_sel, u1,
-                            u2, vertex_pdf, c, shadow)) {
+                            u2, vertex_pdf, c, shadow_rays_[j])) {
         shadow_contribution_[j] = p.throughput * c;
-        shadow_rays_[j] = shadow;
         has_shadow_[j] = 1;
       }
 
@@ -446,10 +440,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       if (is_black(from_camera) || !is_finite(from_camera)) continue;
       p.prev_pdf = bs.pdf;
       p.prev_position = sp.position;
-      Ray next;
-      next.origin = origin;
-      next.direction = wi_world;
-      rays_[j] = next;
+      set_ray(rays_[j], origin, wi_world, 0.0f, 1e30f);
       alive_[j] = 1;
     }
     guided_vertices += guided_here;

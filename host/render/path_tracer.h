@@ -146,7 +146,8 @@ class PathTracer {
   // Next-event estimation at a surface point, once for every vertex: samples a light and,
   // where the BSDF sees it, returns true with the contribution an unoccluded shadow ray adds
   // (BSDF x cosine x radiance x MIS weight / pdf; competing_pdf(world_dir, local_dir) is the
-  // density of the strategy that could have found the same light) and the shadow ray.
+  // density of the strategy that could have found the same light) and the shadow ray, written
+  // into `shadow` in place (set_ray) and only where it returns true.
   template <class CompetingPdf>
   bool next_event(const glm::vec3& position, const glm::vec3& geometric_normal,
                   const shared::pg_frame& frame, const glm::vec3& wo, const shared::pg_lobes& lobes,

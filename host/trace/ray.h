@@ -15,6 +15,17 @@ struct Ray {
   float tmax = 1e30f;
 };
 
+// Writes a ray's fields in place. Building a Ray on the stack and copying it into a batch makes
+// the compiler store its fields one by one and reload them as 16-byte vectors, a store-forwarding
+// stall per copy in the path tracer's loops (docs/host-path-tracer.md, "Rays written in place").
+inline void set_ray(Ray& r, const glm::vec3& origin, const glm::vec3& direction, float tmin,
+                    float tmax) {
+  r.origin = origin;
+  r.tmin = tmin;
+  r.direction = direction;
+  r.tmax = tmax;
+}
+
 constexpr std::uint32_t kNoHit = 0xffffffffu;
 
 struct Hit {
