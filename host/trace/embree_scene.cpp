@@ -335,11 +335,14 @@ std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::
           std::size_t i = range.begin();
           while (i < range.end()) {
             unsigned int n = 0;
+            // Without a branch: every slot is written at chunk[n], and n moves on only past a
+            // segment (whether a slot has one is a coin toss on most scenes, which a branch
+            // mispredicts; docs/host-path-tracer.md, "Rays written in place").
             for (; i < range.end() && n < kStreamChunk; ++i) {
               occluded[i] = 0;
-              if (!has_segment(i)) continue;
               to_embree(rays[i], chunk[n]);
-              slot[n++] = static_cast<std::uint32_t>(i);
+              slot[n] = static_cast<std::uint32_t>(i);
+              n += has_segment(i) ? 1u : 0u;
             }
             if (n == 0) continue;
             rtcOccluded1M(scene, &context, chunk, n, sizeof(RTCRay));
