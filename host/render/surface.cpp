@@ -58,9 +58,9 @@ glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n, float offset
   glm::vec3 out = p + offset;
   for (int i = 0; i < 3; ++i) {
     if (offset[i] > 0.0f)
-      out[i] = std::nextafter(out[i], std::numeric_limits<float>::infinity());
+      out[i] = next_float_up(out[i]);
     else if (offset[i] < 0.0f)
-      out[i] = std::nextafter(out[i], -std::numeric_limits<float>::infinity());
+      out[i] = next_float_down(out[i]);
   }
   return out;
 }

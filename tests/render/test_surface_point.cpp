@@ -5,7 +5,9 @@
 // magnitudes (the offset distance scales with them; docs/robustness.md).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -88,6 +90,44 @@ TEST(SurfacePoint, TheTriangleTableGivesThePerHitBits) {
     EXPECT_EQ(differing, 0) << "scale " << scale;
     EXPECT_EQ(wrong_side, 0) << "scale " << scale;
   }
+}
+
+// next_float_up and next_float_down against std::nextafter: zeros, subnormals, the extremes,
+// infinities, NaN (compared as NaN) and a million random bit patterns.
+TEST(SurfacePoint, NextFloatIsStdNextafter) {
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<float> values = {0.0f,
+                               -0.0f,
+                               std::numeric_limits<float>::denorm_min(),
+                               -std::numeric_limits<float>::denorm_min(),
+                               std::numeric_limits<float>::min(),
+                               -std::numeric_limits<float>::min(),
+                               std::numeric_limits<float>::max(),
+                               -std::numeric_limits<float>::max(),
+                               inf,
+                               -inf,
+                               std::numeric_limits<float>::quiet_NaN(),
+                               1.0f,
+                               -1.0f};
+  std::mt19937 gen(3);
+  for (int k = 0; k < 1000000; ++k) {
+    const std::uint32_t bits = static_cast<std::uint32_t>(gen());
+    float x;
+    std::memcpy(&x, &bits, sizeof x);
+    values.push_back(x);
+  }
+  int differing = 0;
+  for (const float x : values) {
+    const float up = next_float_up(x), down = next_float_down(x);
+    const float want_up = std::nextafter(x, inf), want_down = std::nextafter(x, -inf);
+    if (std::isnan(x)) {
+      differing += !std::isnan(up) || !std::isnan(down);
+      continue;
+    }
+    differing += std::memcmp(&up, &want_up, sizeof up) != 0;
+    differing += std::memcmp(&down, &want_down, sizeof down) != 0;
+  }
+  EXPECT_EQ(differing, 0);
 }
 
 }  // namespace
