@@ -25,6 +25,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "render/camera_rays.h"
 #include "render/lights.h"
 #include "render/surface.h"
 #include "scene/camera.h"
@@ -132,14 +133,7 @@ inline RaySets make_ray_sets(const Scene& scene, const EmbreeScene& tracer, int 
   const CameraFrame camera =
       make_camera_frame(scene.camera.view, static_cast<float>(width) / static_cast<float>(height));
   s.primary.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
-    Ray r;
-    r.origin = camera.position;
-    r.direction = camera.ray_direction((static_cast<float>(x) + 0.5f) / static_cast<float>(width),
-                                       (static_cast<float>(y) + 0.5f) / static_cast<float>(height));
-    s.primary[i] = r;
-  }
+  make_camera_rays(camera, width, height, CameraJitter{false, 0u, 0u}, s.primary.data());
   std::vector<Hit> hits(n);
   tracer.intersect_image(s.primary.data(), hits.data(), width, height);
 

@@ -164,6 +164,18 @@ void set_ray_n(RTCRayN& packet, int lane, const Ray& r) {
   packet.flags[lane] = 0;
 }
 
+// Lane `lane` of an Embree packet's answer (RTCRayHit8, RTCRayHit16) as a Hit.
+template <class RTCRayHitN>
+Hit hit_of_lane(const RTCRayHitN& rh, int lane) {
+  Hit h;
+  h.mesh = rh.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID[lane];
+  h.triangle = rh.hit.primID[lane];
+  h.t = rh.ray.tfar[lane];
+  h.u = rh.hit.u[lane];
+  h.v = rh.hit.v[lane];
+  return h;
+}
+
 // A closest-hit query of one ray, and its answer as a Hit.
 void start_query(const Ray& r, RTCRayHit& rh) {
   to_embree(r, rh.ray);
@@ -214,34 +226,29 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
     return;
   }
   const std::size_t packets = (count + 7) / 8;
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), [&](const auto& range) {
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
-        context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        for (std::size_t p = range.begin(); p != range.end(); ++p) {
-          alignas(32) RTCRayHit8 rh;
-          alignas(32) int valid[8];
-          for (int lane = 0; lane < 8; ++lane) {
-            const std::size_t i = p * 8 + lane;
-            valid[lane] = i < count ? -1 : 0;
-            set_ray_n(rh.ray, lane, rays[i < count ? i : count - 1]);
-            rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
-          }
-          rtcIntersect8(valid, scene, &context, &rh);
-          for (int lane = 0; lane < 8; ++lane) {
-            const std::size_t i = p * 8 + lane;
-            if (i >= count) break;
-            Hit& h = hits[i];
-            h.mesh = rh.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID[lane];
-            h.triangle = rh.hit.primID[lane];
-            h.t = rh.ray.tfar[lane];
-            h.u = rh.hit.u[lane];
-            h.v = rh.hit.v[lane];
-          }
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets, kGrain / 8),
+                    [&](const auto& range) {
+                      RTCIntersectContext context;
+                      rtcInitIntersectContext(&context);
+                      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+                      for (std::size_t p = range.begin(); p != range.end(); ++p) {
+                        alignas(32) RTCRayHit8 rh;
+                        alignas(32) int valid[8];
+                        for (int lane = 0; lane < 8; ++lane) {
+                          const std::size_t i = p * 8 + lane;
+                          valid[lane] = i < count ? -1 : 0;
+                          set_ray_n(rh.ray, lane, rays[i < count ? i : count - 1]);
+                          rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
+                          rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
+                        }
+                        rtcIntersect8(valid, scene, &context, &rh);
+                        for (int lane = 0; lane < 8; ++lane) {
+                          const std::size_t i = p * 8 + lane;
+                          if (i >= count) break;
+                          hits[i] = hit_of_lane(rh, lane);
+                        }
+                      }
+                    });
 }
 
 namespace {
@@ -277,12 +284,7 @@ void intersect_tiles(RTCScene scene, const Ray* rays, Hit* hits, int width, int 
         intersect_n(valid, scene, &context, &rh);
         for (int lane = 0; lane < kN; ++lane) {
           if (!valid[lane]) continue;
-          Hit& h = hits[pixel[lane]];
-          h.mesh = rh.hit.geomID[lane] == RTC_INVALID_GEOMETRY_ID ? kNoHit : rh.hit.geomID[lane];
-          h.triangle = rh.hit.primID[lane];
-          h.t = rh.ray.tfar[lane];
-          h.u = rh.hit.u[lane];
-          h.v = rh.hit.v[lane];
+          hits[pixel[lane]] = hit_of_lane(rh, lane);
         }
       }
   });
