@@ -46,13 +46,8 @@ constexpr int kLanes = 16;
       dz[k] = d.z;
     }
     const int lanes = std::min(kLanes, width - x0);
-    for (int k = 0; k < lanes; ++k) {
-      Ray& r = row[x0 + k];
-      r.origin = camera.position;
-      r.tmin = 0.0f;
-      r.direction = glm::vec3(dx[k], dy[k], dz[k]);
-      r.tmax = 1e30f;
-    }
+    for (int k = 0; k < lanes; ++k)
+      set_ray(row[x0 + k], camera.position, glm::vec3(dx[k], dy[k], dz[k]), 0.0f, 1e30f);
   }
 }
 
