@@ -164,6 +164,14 @@ void set_ray_n(RTCRayN& packet, int lane, const Ray& r) {
   packet.flags[lane] = 0;
 }
 
+// A query context with the given coherence hint (rtcInitIntersectContext sets INCOHERENT).
+RTCIntersectContext intersect_context(RTCIntersectContextFlags flags) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = flags;
+  return context;
+}
+
 // Lane `lane` of an Embree packet's answer (RTCRayHit8, RTCRayHit16) as a Hit.
 template <class RTCRayHitN>
 Hit hit_of_lane(const RTCRayHitN& rh, int lane) {
@@ -199,9 +207,7 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
   RTCScene scene = impl_->scene;
   if (mode == RayMode::Stream) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
-      RTCIntersectContext context;
-      rtcInitIntersectContext(&context);
-      context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+      RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
       alignas(64) RTCRayHit chunk[kStreamChunk];
       for (std::size_t first = range.begin(); first < range.end(); first += kStreamChunk) {
         const std::size_t n = std::min(kStreamChunk, range.end() - first);
@@ -214,8 +220,7 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
   }
   if (mode == RayMode::Single) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
-      RTCIntersectContext context;
-      rtcInitIntersectContext(&context);
+      RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
       for (std::size_t i = range.begin(); i != range.end(); ++i) {
         RTCRayHit rh;
         start_query(rays[i], rh);
@@ -226,29 +231,27 @@ void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMo
     return;
   }
   const std::size_t packets = (count + 7) / 8;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, packets, kGrain / 8),
-                    [&](const auto& range) {
-                      RTCIntersectContext context;
-                      rtcInitIntersectContext(&context);
-                      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-                      for (std::size_t p = range.begin(); p != range.end(); ++p) {
-                        alignas(32) RTCRayHit8 rh;
-                        alignas(32) int valid[8];
-                        for (int lane = 0; lane < 8; ++lane) {
-                          const std::size_t i = p * 8 + lane;
-                          valid[lane] = i < count ? -1 : 0;
-                          set_ray_n(rh.ray, lane, rays[i < count ? i : count - 1]);
-                          rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
-                          rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
-                        }
-                        rtcIntersect8(valid, scene, &context, &rh);
-                        for (int lane = 0; lane < 8; ++lane) {
-                          const std::size_t i = p * 8 + lane;
-                          if (i >= count) break;
-                          hits[i] = hit_of_lane(rh, lane);
-                        }
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), [&](const auto& range) {
+        RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
+        for (std::size_t p = range.begin(); p != range.end(); ++p) {
+          alignas(32) RTCRayHit8 rh;
+          alignas(32) int valid[8];
+          for (int lane = 0; lane < 8; ++lane) {
+            const std::size_t i = p * 8 + lane;
+            valid[lane] = i < count ? -1 : 0;
+            set_ray_n(rh.ray, lane, rays[i < count ? i : count - 1]);
+            rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
+          }
+          rtcIntersect8(valid, scene, &context, &rh);
+          for (int lane = 0; lane < 8; ++lane) {
+            const std::size_t i = p * 8 + lane;
+            if (i >= count) break;
+            hits[i] = hit_of_lane(rh, lane);
+          }
+        }
+      });
 }
 
 namespace {
@@ -262,9 +265,7 @@ void intersect_tiles(RTCScene scene, const Ray* rays, Hit* hits, int width, int 
   constexpr int kN = kTileW * kTileH;
   const int tiles_x = (width + kTileW - 1) / kTileW, tiles_y = (height + kTileH - 1) / kTileH;
   tbb::parallel_for(tbb::blocked_range<int>(0, tiles_y), [&](const auto& tile_rows) {
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
     for (int ty = tile_rows.begin(); ty != tile_rows.end(); ++ty)
       for (int tx = 0; tx < tiles_x; ++tx) {
         alignas(64) RTCRayHitN rh;
@@ -329,9 +330,7 @@ std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::
     return tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
         [&](const auto& range, std::size_t queried) {
-          RTCIntersectContext context;
-          rtcInitIntersectContext(&context);
-          context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+          RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
           alignas(64) RTCRay chunk[kStreamChunk];
           std::uint32_t slot[kStreamChunk];
           std::size_t i = range.begin();
@@ -360,8 +359,7 @@ std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::
     return tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
         [&](const auto& range, std::size_t queried) {
-          RTCIntersectContext context;
-          rtcInitIntersectContext(&context);
+          RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
           for (std::size_t i = range.begin(); i != range.end(); ++i) {
             occluded[i] = 0;
             if (!has_segment(i)) continue;
@@ -379,9 +377,7 @@ std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::
   return tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), std::size_t{0},
       [&](const auto& range, std::size_t queried) {
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
-        context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
         for (std::size_t p = range.begin(); p != range.end(); ++p) {
           alignas(32) RTCRay8 ray;
           alignas(32) int valid[8];
