@@ -35,10 +35,22 @@ std::size_t Distribution1D::sample_discrete(float u, float* probability, float* 
     return only_cell_;
   }
   const double target = static_cast<double>(u) * cdf_.back();
-  auto it = std::upper_bound(cdf_.begin() + 1, cdf_.end(), target);
-  std::size_t i =
-      std::min<std::size_t>(static_cast<std::size_t>(it - cdf_.begin()) - 1, weights_.size() - 1);
-  while (i > 0 && weights_[i] == 0.0f) --i;  // u at the very top of a run of empty cells
+  std::size_t i = 0;
+  if (weights_.size() <= kCountedCells) {
+    // The index upper_bound finds, counted without a branch: the cells whose upper end is at or
+    // below the target. A search's branch goes either way at random (u is uniform), and a
+    // scene's few emissive triangles (two for a quad light) made it a fifth of next-event
+    // estimation's light sampling (docs/host-path-tracer.md, "Light selection by counting").
+    for (std::size_t k = 1; k <= weights_.size(); ++k) i += cdf_[k] <= target;
+  } else {
+    i = static_cast<std::size_t>(std::upper_bound(cdf_.begin() + 1, cdf_.end(), target) -
+                                 cdf_.begin()) -
+        1;
+  }
+  i = std::min(i, weights_.size() - 1);
+  // u at the very top of a run of empty cells; the weight tested first, as i > 0 alone is as
+  // random as u
+  while (weights_[i] == 0.0f && i > 0) --i;
   if (probability) *probability = this->probability(i);
   if (remapped) {
     const double width = cdf_[i + 1] - cdf_[i];

@@ -32,6 +32,8 @@ class Distribution1D {
   std::vector<float>
       probabilities_;  // weight / total, once (next-event estimation asks per vertex)
   float total_ = 0.0f;
+  // Up to this many cells sample_discrete counts instead of searching.
+  static constexpr std::size_t kCountedCells = 16;
   // The only cell with weight (a scene with one kind of light), else size(): sampling it needs
   // no search and no division.
   std::size_t only_cell_ = 0;

@@ -34,6 +34,10 @@ constexpr int kBounceDraws = 4;
 // How many vertices ahead the shading loop starts loading the pixel a later vertex borrows
 // from (prefetch_borrowable).
 constexpr std::size_t kPrefetchAhead = 4;
+// How many vertices ahead the shading loop starts loading a path's state: after compaction
+// the live paths' pixels are sparse, and a state read cold stalled the loop on its first field
+// (prefetch_path).
+constexpr std::size_t kPathPrefetchAhead = 8;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -87,7 +91,9 @@ Ray inactive_ray() {
 PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer,
                        const TriangleTable& triangles, const Lights& lights,
                        PathTracerSettings settings)
-    : scene_(scene), tracer_(tracer), triangles_(triangles), lights_(lights), settings_(settings) {}
+    : scene_(scene), tracer_(tracer), triangles_(triangles), lights_(lights), settings_(settings) {
+  prefetch_surfaces_ = loads_surfaces_ahead(settings_.surface_prefetch, scene);
+}
 
 void PathTracer::trace(const GBuffer& g, const FirstBounceSamples* first,
                        const FirstBounceSampler& sampler, const SampleCoordinates& at,
@@ -314,6 +320,9 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
       if (settings_.guide_secondary && j + kPrefetchAhead < range.end())
         prefetch_borrowable(j + kPrefetchAhead);
+      if (j + kPathPrefetchAhead < range.end()) prefetch_path(active_[j + kPathPrefetchAhead]);
+      if (prefetch_surfaces_)
+        prefetch_surfaces_ahead(scene_, triangles_, hits_.data(), j, range.end());
       const std::uint32_t i = active_[j];
       PathState& p = paths_[i];
       const Ray ray = rays_[j];
@@ -478,6 +487,14 @@ std::size_t PathTracer::borrowable_index(const glm::vec3& position) const {
     return kNotOnScreen;
   return static_cast<std::size_t>(fy) * static_cast<std::size_t>(g.width) +
          static_cast<std::size_t>(fx);
+}
+
+void PathTracer::prefetch_path(std::uint32_t i) const {
+  // A PathState may straddle two cache lines (44 bytes at any offset).
+  const char* p = reinterpret_cast<const char*>(&paths_[i]);
+  __builtin_prefetch(p);
+  __builtin_prefetch(p + sizeof(PathState) - 1);
+  if (keep_vpls_) __builtin_prefetch(&vpl_paths_[i]);
 }
 
 void PathTracer::prefetch_borrowable(std::size_t j) const {

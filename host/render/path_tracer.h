@@ -62,6 +62,9 @@ struct PathTracerSettings {
   float guide_position = 0.05f;  // relative distance to the pixel's depth
   float guide_normal = 0.9f;     // normal cosine
   SharedRandoms shared_randoms = SharedRandoms::none;
+  // Whether the shading loop and the G-buffer load each hit's triangle, vertices and texels a
+  // few hits ahead (render/surface.h, loads_surfaces_ahead). Images are the same either way.
+  SurfacePrefetch surface_prefetch = SurfacePrefetch::automatic;
 };
 
 // The coordinates a sample's first bounce draws with: sample 0's where the first bounce is
@@ -183,6 +186,9 @@ class PathTracer {
   // read cold stalls the shading loop for a whole cache miss (docs/guiding.md, "Later
   // vertices, revisited").
   void prefetch_borrowable(std::size_t j) const;
+  // Starts loading path i's PathState (and VplPath where VPLs are kept) a few vertices before
+  // the shading loop reads it.
+  void prefetch_path(std::uint32_t i) const;
   // The guide of the pixel that shows surface point sp, if any (guide_secondary).
   bool borrow_guide(const SurfacePoint& sp, PixelGuide& guide) const;
   // Pixel estimates (non-finite ones dropped and counted) and the VPLs' radiance.
@@ -193,6 +199,7 @@ class PathTracer {
   const TriangleTable& triangles_;
   const Lights& lights_;
   PathTracerSettings settings_;
+  bool prefetch_surfaces_ = false;  // settings_.surface_prefetch, resolved for the scene
 
   // This frame's G-buffer and first-bounce sampler (set by trace()).
   const GBuffer* gbuffer_ = nullptr;

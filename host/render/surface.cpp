@@ -1,5 +1,7 @@
 #include "render/surface.h"
 
+#include "render/cpu_code.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -166,6 +168,51 @@ SurfacePoint surface_point(const Scene& scene, const TriangleFacts& facts, const
 }
 
 }  // namespace
+
+std::size_t scene_surface_bytes(const Scene& scene) {
+  const auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+  std::size_t sum = 0;
+  for (const Mesh& mesh : scene.meshes)
+    sum += bytes(mesh.positions) + bytes(mesh.normals) + bytes(mesh.uvs) + bytes(mesh.tangents) +
+           bytes(mesh.triangles) + mesh.triangles.size() * sizeof(TriangleFacts);
+  for (const Texture& t : scene.textures)
+    sum += bytes(t.texels8) + bytes(t.texels) + bytes(t.slopes);
+  return sum;
+}
+
+bool loads_surfaces_ahead(SurfacePrefetch setting, const Scene& scene) {
+  return setting == SurfacePrefetch::always ||
+         (setting == SurfacePrefetch::automatic && scene_surface_bytes(scene) > core_cache_bytes());
+}
+
+void prefetch_surface_triangle(const Scene& scene, const TriangleTable& triangles, const Hit& hit) {
+  __builtin_prefetch(scene.meshes[hit.mesh].triangles.data() + hit.triangle);
+  __builtin_prefetch(&triangles.at(hit.mesh, hit.triangle));
+}
+
+void prefetch_surface_vertices(const Scene& scene, const Hit& hit) {
+  const Mesh& mesh = scene.meshes[hit.mesh];
+  const glm::uvec3 tri = mesh.triangles[hit.triangle];
+  for (std::uint32_t v : {tri.x, tri.y, tri.z}) {
+    __builtin_prefetch(mesh.positions.data() + v);
+    if (!mesh.normals.empty()) __builtin_prefetch(mesh.normals.data() + v);
+    if (!mesh.uvs.empty()) __builtin_prefetch(mesh.uvs.data() + v);
+    if (!mesh.tangents.empty()) __builtin_prefetch(mesh.tangents.data() + v);
+  }
+}
+
+void prefetch_surface_texels(const Scene& scene, const Hit& hit) {
+  const Mesh& mesh = scene.meshes[hit.mesh];
+  const Material& mat = scene.materials[mesh.material];
+  if (mesh.uvs.empty() || !mat.has_textures()) return;
+  const glm::uvec3 tri = mesh.triangles[hit.triangle];
+  // surface_point's uv.
+  const glm::vec2 uv =
+      (1.0f - hit.u - hit.v) * mesh.uvs[tri.x] + hit.u * mesh.uvs[tri.y] + hit.v * mesh.uvs[tri.z];
+  for (int texture : {mat.base_color_texture, mat.roughness_texture, mat.metallic_texture,
+                      mat.normal_texture, mat.bump_texture})
+    if (texture >= 0) scene.textures[texture].prefetch(uv);
+}
 
 SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
   const Mesh& mesh = scene.meshes[hit.mesh];

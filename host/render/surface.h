@@ -59,6 +59,42 @@ SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& h
 SurfacePoint make_surface_point(const Scene& scene, const TriangleTable& triangles, const Ray& ray,
                                 const Hit& hit);
 
+// make_surface_point's reads for a valid hit, started a few vertices before the shading loop
+// gets there, in three stages that each need the one before to have arrived: a bounce lands
+// anywhere in a scene's meshes and textures, and on Sponza those reads, cold, were a quarter of
+// a path-traced frame (docs/host-path-tracer.md, "Surfaces loaded ahead"). None changes anything.
+// The stages pay only where that data does not stay in a core's cache (on the Cornell box and
+// the sunlit room they cost 4-6% of the shading): scene_surface_bytes says how much there is.
+// 1. the triangle's vertex indices and its facts;
+void prefetch_surface_triangle(const Scene& scene, const TriangleTable& triangles, const Hit& hit);
+// 2. its vertices' positions, normals, uvs and tangents (reads the indices);
+void prefetch_surface_vertices(const Scene& scene, const Hit& hit);
+// 3. the texels of every texture of its material at the hit's uv (reads the indices and uvs).
+void prefetch_surface_texels(const Scene& scene, const Hit& hit);
+// The bytes make_surface_point can read over a scene: its meshes' vertex and index arrays, the
+// triangle table's facts, and its textures' texels and slopes.
+std::size_t scene_surface_bytes(const Scene& scene);
+
+// Whether a pass over hits loads their surfaces ahead (the stages above): automatic where the
+// scene's surface data is larger than a core's cache (core_cache_bytes, render/cpu_code.h).
+// Images are the same either way.
+enum class SurfacePrefetch { automatic, always, never };
+bool loads_surfaces_ahead(SurfacePrefetch setting, const Scene& scene);
+// The three stages for the hits a pass over hits[0, end) will shade after hits[j]: each stage at
+// its own distance ahead of j, so that its loads have arrived when the next stage, or the
+// shading, reads them. Invalid hits are skipped.
+inline void prefetch_surfaces_ahead(const Scene& scene, const TriangleTable& triangles,
+                                    const Hit* hits, std::size_t j, std::size_t end) {
+  // Distances in hits; each stage's loads take a memory latency, a few hits' shading.
+  constexpr std::size_t kTriangleAhead = 12, kVertexAhead = 8, kTexelAhead = 4;
+  if (j + kTriangleAhead < end && hits[j + kTriangleAhead].valid())
+    prefetch_surface_triangle(scene, triangles, hits[j + kTriangleAhead]);
+  if (j + kVertexAhead < end && hits[j + kVertexAhead].valid())
+    prefetch_surface_vertices(scene, hits[j + kVertexAhead]);
+  if (j + kTexelAhead < end && hits[j + kTexelAhead].valid())
+    prefetch_surface_texels(scene, hits[j + kTexelAhead]);
+}
+
 // std::nextafter(x, +infinity) and std::nextafter(x, -infinity), to the bit for every float
 // (zeros, subnormals, infinities and NaN included), inline: offset_ray_origin takes up to three a
 // vertex, and the library calls were 1.5% of a path-traced frame (docs/host-path-tracer.md,

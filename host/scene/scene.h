@@ -37,6 +37,11 @@ struct Material {
   glm::vec3 emission{0.0f};   // emitted radiance (one-sided, along the geometric normal)
   bool transmissive = false;  // guiding and NEE skip it; rendered as the BSDF allows
   bool is_emissive() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
+  // Whether shading a hit reads a texture (the alpha mask is the ray queries' own).
+  bool has_textures() const {
+    return base_color_texture >= 0 || roughness_texture >= 0 || metallic_texture >= 0 ||
+           normal_texture >= 0 || bump_texture >= 0;
+  }
 };
 
 // One triangle mesh in world space (instances and transforms are flattened at load time).

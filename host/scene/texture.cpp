@@ -110,6 +110,21 @@ glm::vec4 Texture::sample(glm::vec2 uv) const {
   return glm::mix(top, bottom, b.ty);
 }
 
+void Texture::prefetch(glm::vec2 uv) const {
+  if (width <= 0 || height <= 0) return;
+  const Bilinear b = bilinear_at(uv, width, height);
+  const std::size_t w = static_cast<std::size_t>(width), n = w * static_cast<std::size_t>(height);
+  const std::size_t taps[4] = {static_cast<std::size_t>(b.y0) * w + static_cast<std::size_t>(b.x0),
+                               static_cast<std::size_t>(b.y0) * w + static_cast<std::size_t>(b.x1),
+                               static_cast<std::size_t>(b.y1) * w + static_cast<std::size_t>(b.x0),
+                               static_cast<std::size_t>(b.y1) * w + static_cast<std::size_t>(b.x1)};
+  for (std::size_t t : taps) {
+    if (texels8.size() == n) __builtin_prefetch(texels8.data() + t);
+    if (texels.size() == n) __builtin_prefetch(texels.data() + t);
+    if (slopes.size() == n) __builtin_prefetch(slopes.data() + t);
+  }
+}
+
 glm::vec2 Texture::sample_gradient(glm::vec2 uv) const {
   const float w = static_cast<float>(std::max(width, 1)),
               h = static_cast<float>(std::max(height, 1));

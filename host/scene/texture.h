@@ -37,6 +37,9 @@ struct Texture {
   // d(channel 0)/du and d/dv at uv per unit of uv, as one-texel forward differences of the
   // bilinear sample: from `slopes` when prepared, else from three samples.
   glm::vec2 sample_gradient(glm::vec2 uv) const;
+  // Starts loading the cache lines of the texels (and slopes) that sample and sample_gradient
+  // read at uv; changes nothing.
+  void prefetch(glm::vec2 uv) const;
 };
 
 // Fills t.slopes (8 bytes a texel) for a texture used as a bump map.

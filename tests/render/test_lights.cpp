@@ -268,6 +268,43 @@ TEST(Distribution1D, PicksCellsInProportionAndNeverAnEmptyOne) {
   }
 }
 
+// Small distributions count the cells below u instead of searching (sample_discrete); either
+// way the cell is the one the cumulative search gives (the first whose upper end exceeds u's
+// target, stepped back over empty cells), for every size on both sides of the switch, with
+// empty cells, for u on a grid, at every cell edge and next to it.
+TEST(Distribution1D, CountingPicksTheCellTheSearchPicks) {
+  std::mt19937 gen(23);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  for (std::size_t size = 1; size <= 40; ++size) {
+    std::vector<float> weights(size);
+    for (float& x : weights) x = u01(gen) < 0.3f ? 0.0f : u01(gen);
+    weights[size / 3] = 0.5f;
+    const Distribution1D dist(weights);
+    std::vector<double> cdf(size + 1, 0.0);
+    for (std::size_t i = 0; i < size; ++i) cdf[i + 1] = cdf[i] + weights[i];
+    const auto searched = [&](float u) {
+      const double target = static_cast<double>(u) * cdf.back();
+      std::size_t i = std::min<std::size_t>(
+          static_cast<std::size_t>(std::upper_bound(cdf.begin() + 1, cdf.end(), target) -
+                                   cdf.begin()) -
+              1,
+          size - 1);
+      while (i > 0 && weights[i] == 0.0f) --i;
+      return i;
+    };
+    std::vector<float> us;
+    for (int k = 0; k <= 1000; ++k) us.push_back(std::min(k / 1000.0f, 0.99999994f));
+    for (std::size_t i = 0; i <= size; ++i) {
+      const float edge = std::min(static_cast<float>(cdf[i] / cdf.back()), 0.99999994f);
+      us.insert(us.end(), {edge, std::nextafter(edge, 0.0f), std::nextafter(edge, 1.0f)});
+    }
+    for (float u : us) {
+      if (!(u >= 0.0f && u < 1.0f)) continue;
+      EXPECT_EQ(dist.sample_discrete(u), searched(u)) << "size " << size << " u " << u;
+    }
+  }
+}
+
 // One cell with weight among empty ones (a scene with one kind of light, which takes a path of
 // its own in sample_discrete): that cell with probability 1, and the remapped number is u itself
 // (below the clamp at 1 - 1e-7 that every cell's remapping has), as the cumulative search gives.

@@ -11,7 +11,9 @@
 #include <random>
 #include <vector>
 
+#include "render/renderer.h"
 #include "render/surface.h"
+#include "scene/scene_loader.h"
 #include "scene/shapes.h"
 #include "trace/embree_scene.h"
 
@@ -128,6 +130,83 @@ TEST(SurfacePoint, NextFloatIsStdNextafter) {
     differing += std::memcmp(&down, &want_down, sizeof down) != 0;
   }
   EXPECT_EQ(differing, 0);
+}
+
+// The surface data make_surface_point can read, counted array by array: a flat box (positions,
+// uvs, indices), a sphere with normals, the triangle table's 32 bytes a triangle, an 8-bit
+// texture with bump slopes and a float texture.
+TEST(SurfacePoint, SceneSurfaceBytesCountsEveryArrayShadingReads) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  Mesh box = make_box(glm::vec3(-1.0f), glm::vec3(1.0f));
+  box.normals.clear();
+  Mesh sphere = make_sphere(glm::vec3(0.0f), 0.5f, 2, false);
+  sphere.uvs.clear();
+  sphere.tangents.assign(sphere.positions.size(), glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+  scene.meshes = {box, sphere};
+  Texture bytes8;
+  bytes8.width = 5;
+  bytes8.height = 3;
+  bytes8.texels8.resize(15);
+  bytes8.slopes.resize(15);
+  Texture floats;
+  floats.width = 2;
+  floats.height = 7;
+  floats.texels.resize(14);
+  scene.textures = {bytes8, floats};
+  std::size_t expected = 15 * 4 + 15 * 8 + 14 * 16;
+  for (const Mesh& m : scene.meshes)
+    expected += m.positions.size() * 12 + m.normals.size() * 12 + m.uvs.size() * 8 +
+                m.tangents.size() * 16 + m.triangles.size() * (12 + sizeof(TriangleFacts));
+  EXPECT_EQ(sizeof(TriangleFacts), 32u);
+  EXPECT_GT(box.uvs.size(), 0u);
+  EXPECT_GT(sphere.normals.size(), 0u);
+  EXPECT_EQ(scene_surface_bytes(scene), expected);
+}
+
+// The shading loop's loads ahead (PathTracerSettings::surface_prefetch) change nothing: the
+// Cornell box with a texture on every material (base colour and bump, so that every stage has
+// texels to load) over the uvs of its walls, two samples a pixel, a moving camera, an odd size:
+// every frame the same to the bit with the loads ahead always and never.
+TEST(SurfacePoint, LoadingSurfacesAheadLeavesTheImageAsItIs) {
+  Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
+  Texture checker;
+  checker.width = 64;
+  checker.height = 48;
+  for (int y = 0; y < checker.height; ++y)
+    for (int x = 0; x < checker.width; ++x) {
+      const std::uint8_t v = ((x / 4 + y / 4) % 2) ? 230 : 40;
+      checker.texels8.push_back({v, static_cast<std::uint8_t>(255 - v), 128, 255});
+    }
+  checker.srgb = true;
+  prepare_bump_slopes(checker);
+  scene.textures.push_back(checker);
+  for (Material& m : scene.materials) {
+    m.base_color_texture = 0;
+    m.bump_texture = 0;
+  }
+  for (const Mesh& m : scene.meshes) ASSERT_FALSE(m.uvs.empty()) << m.name;
+  RenderSettings always;
+  always.width = 23;
+  always.height = 17;
+  always.spp = 2;
+  always.camera_path = "pan";
+  RenderSettings never = always;
+  always.path_tracer.surface_prefetch = SurfacePrefetch::always;
+  never.path_tracer.surface_prefetch = SurfacePrefetch::never;
+  Renderer a(scene, always), b(scene, never);
+  for (int frame = 0; frame < 3; ++frame) {
+    a.render_frame(frame);
+    b.render_frame(frame);
+    ASSERT_EQ(a.image().size(), b.image().size());
+    std::size_t differ = 0, lit = 0;
+    for (std::size_t i = 0; i < a.image().size(); ++i) {
+      differ += !same_bits(a.image()[i], b.image()[i]);
+      lit += a.image()[i] != glm::vec3(0.0f);
+    }
+    EXPECT_EQ(differ, 0u) << "frame " << frame;
+    EXPECT_GT(lit, a.image().size() / 2) << "frame " << frame;
+  }
 }
 
 }  // namespace
