@@ -30,8 +30,7 @@ std::size_t Distribution1D::sample_discrete(float u, float* probability, float* 
     // What the search below gives for one cell with weight w: cdf = w exactly (a float in a
     // double), so target = u * w is exact and (target - 0) / w = u, before the same clamp.
     if (probability) *probability = probabilities_[only_cell_];
-    if (remapped)
-      *remapped = static_cast<float>(std::clamp(static_cast<double>(u), 0.0, 1.0 - 1e-7));
+    if (remapped) *remapped = remap(u, only_cell_);
     return only_cell_;
   }
   const double target = static_cast<double>(u) * cdf_.back();
@@ -52,12 +51,17 @@ std::size_t Distribution1D::sample_discrete(float u, float* probability, float* 
   // random as u
   while (weights_[i] == 0.0f && i > 0) --i;
   if (probability) *probability = this->probability(i);
-  if (remapped) {
-    const double width = cdf_[i + 1] - cdf_[i];
-    const double r = width > 0.0 ? (target - cdf_[i]) / width : 0.5;
-    *remapped = static_cast<float>(std::clamp(r, 0.0, 1.0 - 1e-7));
-  }
+  if (remapped) *remapped = remap(u, i);
   return i;
+}
+
+float Distribution1D::remap(float u, std::size_t i) const {
+  if (only_cell_ < weights_.size())
+    return static_cast<float>(std::clamp(static_cast<double>(u), 0.0, 1.0 - 1e-7));
+  const double target = static_cast<double>(u) * cdf_.back();
+  const double width = cdf_[i + 1] - cdf_[i];
+  const double r = width > 0.0 ? (target - cdf_[i]) / width : 0.5;
+  return static_cast<float>(std::clamp(r, 0.0, 1.0 - 1e-7));
 }
 
 float Distribution1D::sample_continuous(float u, float* pdf, std::size_t* cell) const {

@@ -18,6 +18,9 @@ class Distribution1D {
   // uniform number for the next decision.
   std::size_t sample_discrete(float u, float* probability = nullptr,
                               float* remapped = nullptr) const;
+  // The remapped number sample_discrete gives for u, which picked cell i: for a caller that
+  // needs it for some cells only (its double division is a fifth of a light sample).
+  float remap(float u, std::size_t i) const;
   // 0 for an index outside the distribution (an empty one has no cells).
   float probability(std::size_t i) const {
     return i < probabilities_.size() ? probabilities_[i] : 0.0f;

@@ -60,6 +60,7 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
   const glm::vec3 extent = scene.bounds_max() - scene.bounds_min();
   const float radius = 0.5f * glm::length(extent);
   const float disc = kPi * radius * radius;
+  sun_axis_ = glm::normalize(scene.sun.direction);
   std::vector<float> kinds(3, 0.0f);
   kinds[kTriangles] = kPi * triangle_selection_.total();
   if (scene.sun.enabled && luminance(scene.sun.irradiance) > 0.0f) {
@@ -138,11 +139,13 @@ float Lights::environment_pdf(const glm::vec3& d) const {
 bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2,
                     LightSample& out) const {
   if (empty()) return false;
-  float p_kind = 0.0f, u_next = 0.0f;
-  const std::size_t kind = selection_.sample_discrete(u_select, &p_kind, &u_next);
+  float p_kind = 0.0f;
+  const std::size_t kind = selection_.sample_discrete(u_select, &p_kind);
   if (kind == kTriangles) {
+    // u_select's place inside the kind's cell chooses the triangle (only this kind needs it).
     float p_tri = 0.0f;
-    const std::size_t i = triangle_selection_.sample_discrete(u_next, &p_tri);
+    const std::size_t i =
+        triangle_selection_.sample_discrete(selection_.remap(u_select, kind), &p_tri);
     const EmissiveTriangle& e = triangles_[i];
     // Uniform point on the triangle (pbrt's square-root parameterisation).
     const float su = std::sqrt(u1);
@@ -162,7 +165,7 @@ bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2,
     return true;
   }
   if (kind == kSun) {
-    const glm::vec3 axis = glm::normalize(scene_.sun.direction);
+    const glm::vec3 axis = sun_axis_;
     out.distance = kInfinity;
     if (sun_solid_angle_ <= 0.0f) {
       out.direction = axis;
@@ -215,14 +218,13 @@ float Lights::pdf_triangle(std::uint32_t mesh, std::uint32_t triangle, const glm
 
 glm::vec3 Lights::escaped_radiance(const glm::vec3& d) const {
   glm::vec3 l = environment_radiance(d);
-  if (sun_solid_angle_ > 0.0f && glm::dot(d, glm::normalize(scene_.sun.direction)) >= sun_cos_max_)
-    l += sun_radiance_;
+  if (sun_solid_angle_ > 0.0f && glm::dot(d, sun_axis_) >= sun_cos_max_) l += sun_radiance_;
   return l;
 }
 
 float Lights::pdf_escaped(const glm::vec3& d) const {
   float pdf = selection_.probability(kEnvironment) * environment_pdf(d);
-  if (sun_solid_angle_ > 0.0f && glm::dot(d, glm::normalize(scene_.sun.direction)) >= sun_cos_max_)
+  if (sun_solid_angle_ > 0.0f && glm::dot(d, sun_axis_) >= sun_cos_max_)
     pdf += selection_.probability(kSun) / sun_solid_angle_;
   return pdf;
 }

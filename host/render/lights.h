@@ -66,7 +66,8 @@ class Lights {
   std::vector<EmissiveTriangle> triangles_;
   std::vector<std::vector<std::int32_t>> triangle_index_;  // [mesh][triangle] -> light or -1
   Distribution1D triangle_selection_;
-  Distribution1D selection_;  // over Kind
+  Distribution1D selection_;     // over Kind
+  glm::vec3 sun_axis_{0, 1, 0};  // normalize(scene.sun.direction), once: every escaped ray asks
   glm::vec3 sun_frame_t_{1, 0, 0}, sun_frame_b_{0, 1, 0};
   float sun_cos_max_ = 1.0f;
   float sun_solid_angle_ = 0.0f;

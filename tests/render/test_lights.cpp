@@ -271,7 +271,8 @@ TEST(Distribution1D, PicksCellsInProportionAndNeverAnEmptyOne) {
 // Small distributions count the cells below u instead of searching (sample_discrete); either
 // way the cell is the one the cumulative search gives (the first whose upper end exceeds u's
 // target, stepped back over empty cells), for every size on both sides of the switch, with
-// empty cells, for u on a grid, at every cell edge and next to it.
+// empty cells, for u on a grid, at every cell edge and next to it; and the remapped number,
+// from sample_discrete or from remap alone, is u's place inside that cell.
 TEST(Distribution1D, CountingPicksTheCellTheSearchPicks) {
   std::mt19937 gen(23);
   std::uniform_real_distribution<float> u01(0.0f, 1.0f);
@@ -300,7 +301,16 @@ TEST(Distribution1D, CountingPicksTheCellTheSearchPicks) {
     }
     for (float u : us) {
       if (!(u >= 0.0f && u < 1.0f)) continue;
-      EXPECT_EQ(dist.sample_discrete(u), searched(u)) << "size " << size << " u " << u;
+      float remapped = -1.0f;
+      const std::size_t cell = dist.sample_discrete(u, nullptr, &remapped);
+      EXPECT_EQ(cell, searched(u)) << "size " << size << " u " << u;
+      // u's place in its cell, as the search's caller would compute it, and remap's the same.
+      const double target = static_cast<double>(u) * cdf.back();
+      const double width = cdf[cell + 1] - cdf[cell];
+      const float place = static_cast<float>(
+          std::clamp(width > 0.0 ? (target - cdf[cell]) / width : 0.5, 0.0, 1.0 - 1e-7));
+      EXPECT_EQ(remapped, place) << "size " << size << " u " << u;
+      EXPECT_EQ(dist.remap(u, cell), remapped) << "size " << size << " u " << u;
     }
   }
 }
