@@ -80,19 +80,19 @@ std::size_t scene_surface_bytes(const Scene& scene);
 // Images are the same either way.
 enum class SurfacePrefetch { automatic, always, never };
 bool loads_surfaces_ahead(SurfacePrefetch setting, const Scene& scene);
-// The three stages for the hits a pass over hits[0, end) will shade after hits[j]: each stage at
-// its own distance ahead of j, so that its loads have arrived when the next stage, or the
-// shading, reads them. Invalid hits are skipped.
+// The three stages for the hits a pass over hits[0, end) will shade after hits[j]: the texels
+// `spacing` hits ahead of j, the vertices twice and the triangle three times as far, so that each
+// stage's loads have arrived when the next stage, or the shading, reads them. Invalid hits are
+// skipped. 4 measured best in both the bounce loop (texels 2, 4, 8 ahead alike) and the G-buffer
+// pass (spacings 4, 8, 16, 32: 14.4, 14.7, 15.2, 15.3 ms on Sponza at 640x360).
 inline void prefetch_surfaces_ahead(const Scene& scene, const TriangleTable& triangles,
-                                    const Hit* hits, std::size_t j, std::size_t end) {
-  // Distances in hits; each stage's loads take a memory latency, a few hits' shading.
-  constexpr std::size_t kTriangleAhead = 12, kVertexAhead = 8, kTexelAhead = 4;
-  if (j + kTriangleAhead < end && hits[j + kTriangleAhead].valid())
-    prefetch_surface_triangle(scene, triangles, hits[j + kTriangleAhead]);
-  if (j + kVertexAhead < end && hits[j + kVertexAhead].valid())
-    prefetch_surface_vertices(scene, hits[j + kVertexAhead]);
-  if (j + kTexelAhead < end && hits[j + kTexelAhead].valid())
-    prefetch_surface_texels(scene, hits[j + kTexelAhead]);
+                                    const Hit* hits, std::size_t j, std::size_t end,
+                                    std::size_t spacing = 4) {
+  const std::size_t texel = j + spacing, vertex = j + 2 * spacing, triangle = j + 3 * spacing;
+  if (triangle < end && hits[triangle].valid())
+    prefetch_surface_triangle(scene, triangles, hits[triangle]);
+  if (vertex < end && hits[vertex].valid()) prefetch_surface_vertices(scene, hits[vertex]);
+  if (texel < end && hits[texel].valid()) prefetch_surface_texels(scene, hits[texel]);
 }
 
 // std::nextafter(x, +infinity) and std::nextafter(x, -infinity), to the bit for every float
