@@ -8,8 +8,13 @@ namespace rtpg {
 
 namespace {
 
-// Texel index modulo n, also for negative x (repeat wrapping).
+// Texel index modulo n, also for negative x (repeat wrapping). A bilinear lookup's taps lie at
+// most one texel outside the image, where a comparison gives the same index as the division,
+// which cost four integer divisions a lookup (docs/host-path-tracer.md, "Surfaces loaded ahead").
 int wrap(int x, int n) {
+  if (x >= 0 && x < n) return x;
+  if (x < 0 && x >= -n) return x + n;
+  if (x >= n && x - n < n) return x - n;
   const int r = x % n;
   return r < 0 ? r + n : r;
 }

@@ -210,6 +210,47 @@ TEST(Texture, UvOriginIsBottomLeftAndWrapsWithRepeat) {
   expect_vec3_near(glm::vec3(t.fetch(-3, 7)), {0, 0, 1});                 // fetch clamps
 }
 
+// The bilinear lookup's four taps wrap as repeat wrapping's modulo does, for every image size
+// from one texel up (where the taps fall off either edge), at uv on a grid across several
+// periods, at 0, just below 1 and at huge and non-finite values: sample() equals the same mix of
+// the texels at the taps' indices taken modulo the size.
+TEST(Texture, BilinearTapsWrapAsTheModulo) {
+  const auto unit = [](float t) {
+    if (!std::isfinite(t)) return 0.0f;
+    const float f = t - std::floor(t);
+    return f < 1.0f ? f : 0.0f;
+  };
+  const auto modulo = [](int x, int n) { return ((x % n) + n) % n; };
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int w : {1, 2, 3, 7})
+    for (int h : {1, 2, 5}) {
+      Texture t;
+      t.width = w;
+      t.height = h;
+      for (int i = 0; i < w * h; ++i) t.texels.push_back(glm::vec4(u(gen), u(gen), u(gen), 1.0f));
+      std::vector<float> coords = {0.0f,
+                                   0.99999994f,
+                                   -0.99999994f,
+                                   1e9f,
+                                   -1e9f,
+                                   std::numeric_limits<float>::infinity(),
+                                   std::numeric_limits<float>::quiet_NaN()};
+      for (int k = -40; k <= 40; ++k) coords.push_back(k / 16.0f + 1.0f / 64.0f);
+      for (float a : coords)
+        for (float b : coords) {
+          const float x = unit(a) * static_cast<float>(w) - 0.5f;
+          const float y = (1.0f - unit(b)) * static_cast<float>(h) - 0.5f;
+          const int fx = static_cast<int>(std::floor(x)), fy = static_cast<int>(std::floor(y));
+          const float tx = x - std::floor(x), ty = y - std::floor(y);
+          const auto at = [&](int i, int j) { return t.fetch(modulo(i, w), modulo(j, h)); };
+          const glm::vec4 want = glm::mix(glm::mix(at(fx, fy), at(fx + 1, fy), tx),
+                                          glm::mix(at(fx, fy + 1), at(fx + 1, fy + 1), tx), ty);
+          ASSERT_EQ(t.sample({a, b}), want) << w << "x" << h << " at " << a << ", " << b;
+        }
+    }
+}
+
 // A bump map's gradient from its precomputed per-texel slopes equals the one-texel forward
 // differences of the bilinear sample it replaces (three lookups), up to float rounding, at
 // random points, across the wrapping edges too.
