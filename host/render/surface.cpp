@@ -1,15 +1,16 @@
 #include "render/surface.h"
 
-#include "render/cpu_code.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "render/cpu_code.h"
+
 namespace rtpg {
 namespace {
 
-glm::vec3 interpolate(const std::vector<glm::vec3>& a, const glm::uvec3& t, float u, float v) {
+template <class T>
+T interpolate(const std::vector<T>& a, const glm::uvec3& t, float u, float v) {
   return (1.0f - u - v) * a[t.x] + u * a[t.y] + v * a[t.z];
 }
 
@@ -121,9 +122,7 @@ SurfacePoint surface_point(const Scene& scene, const TriangleFacts& facts, const
   }
 
   glm::vec2 uv(0.0f);
-  if (!mesh.uvs.empty())
-    uv = (1.0f - hit.u - hit.v) * mesh.uvs[tri.x] + hit.u * mesh.uvs[tri.y] +
-         hit.v * mesh.uvs[tri.z];
+  if (!mesh.uvs.empty()) uv = interpolate(mesh.uvs, tri, hit.u, hit.v);
 
   glm::vec3 base = mat.base_color;
   float roughness = mat.roughness, metallic = mat.metallic;
@@ -206,9 +205,7 @@ void prefetch_surface_texels(const Scene& scene, const Hit& hit) {
   const Material& mat = scene.materials[mesh.material];
   if (mesh.uvs.empty() || !mat.has_textures()) return;
   const glm::uvec3 tri = mesh.triangles[hit.triangle];
-  // surface_point's uv.
-  const glm::vec2 uv =
-      (1.0f - hit.u - hit.v) * mesh.uvs[tri.x] + hit.u * mesh.uvs[tri.y] + hit.v * mesh.uvs[tri.z];
+  const glm::vec2 uv = interpolate(mesh.uvs, tri, hit.u, hit.v);  // surface_point's
   for (int texture : {mat.base_color_texture, mat.roughness_texture, mat.metallic_texture,
                       mat.normal_texture, mat.bump_texture})
     if (texture >= 0) scene.textures[texture].prefetch(uv);
