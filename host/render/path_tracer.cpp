@@ -92,7 +92,7 @@ PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer,
                        const TriangleTable& triangles, const Lights& lights,
                        PathTracerSettings settings)
     : scene_(scene), tracer_(tracer), triangles_(triangles), lights_(lights), settings_(settings) {
-  prefetch_surfaces_ = loads_surfaces_ahead(settings_.surface_prefetch, scene);
+  prefetch_surfaces_ = rtpg::loads_surfaces_ahead(settings_.surface_prefetch, scene);
 }
 
 void PathTracer::trace(const GBuffer& g, const FirstBounceSamples* first,

@@ -111,6 +111,9 @@ class PathTracer {
              RayCounts& rays, PassTimes& times);
 
   const PathTracerSettings& settings() const { return settings_; }
+  // settings().surface_prefetch resolved for the scene (render/surface.h, loads_surfaces_ahead):
+  // the G-buffer pass follows the same decision.
+  bool loads_surfaces_ahead() const { return prefetch_surfaces_; }
 
  private:
   // What every path carries from vertex to vertex (44 bytes: a path touches one cache line).

@@ -48,7 +48,6 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
   }
   tracer_ = std::make_unique<EmbreeScene>(scene);
   triangles_ = std::make_unique<TriangleTable>(scene);
-  load_surfaces_ahead_ = loads_surfaces_ahead(settings.path_tracer.surface_prefetch, scene);
   lights_ = std::make_unique<Lights>(scene);
   path_tracer_ =
       std::make_unique<PathTracer>(scene, *tracer_, *triangles_, *lights_, settings.path_tracer);
@@ -106,13 +105,14 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
   // jitter.
   const bool static_camera =
       frame == 0 || settings_.camera_path.empty() || settings_.camera_frame >= 0;
+  const bool load_surfaces_ahead = path_tracer_->loads_surfaces_ahead();
   tbb::parallel_for(tbb::blocked_range<int>(0, h, rows_per_task), [&](const auto& rows) {
     const std::size_t rows_end = static_cast<std::size_t>(rows.end()) * static_cast<std::size_t>(w);
     for (int y = rows.begin(); y != rows.end(); ++y)
       for (int x = 0; x < w; ++x) {
         const std::size_t i =
             static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-        if (load_surfaces_ahead_)
+        if (load_surfaces_ahead)
           prefetch_surfaces_ahead(scene_, *triangles_, camera_hits_.data(), i, rows_end);
         const Ray& ray = camera_rays_[i];
         const Hit& hit = camera_hits_[i];

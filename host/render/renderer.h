@@ -85,8 +85,6 @@ class Renderer {
   RenderSettings settings_;
   std::unique_ptr<EmbreeScene> tracer_;
   std::unique_ptr<TriangleTable> triangles_;  // built with the BVH, from the same positions
-  // Whether the G-buffer pass loads surfaces ahead (render/surface.h, loads_surfaces_ahead).
-  bool load_surfaces_ahead_ = false;
   std::unique_ptr<Lights> lights_;
   std::unique_ptr<PathTracer> path_tracer_;
   std::unique_ptr<FirstBounceSampler> sampler_;
