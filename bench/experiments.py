@@ -38,13 +38,16 @@ LABEL = {"off": "PT", "pmm": "PG"}
 # T: training frames of the equal-frame comparison; sweep: other T (all from one static run of
 # max(sweep) frames per method, saved with --save-frames). path_*: convergence along the scene's
 # camera path, per-frame references of path_ref_spp. trade_res: trade-offs, against the main
-# reference box-filtered down (metrics.downsample_box).
+# reference box-filtered down (metrics.downsample_box). equal_time_order: the equal-time runs'
+# order, recorded so that the report says it ("alternating": PT and PG run by run).
 MODES = {
     "quick": dict(res="48x32", ref_spp=64, T=8, sweep=[2, 8], time_frames=6, repeats=2, flicker_frames=4,
+                  equal_time_order="alternating",
                   path_res="24x16", path_frames=[1, 4], path_ref_spp=64, trade_res="24x16", trade_frames=8,
                   svgf_large_res="96x64",
                   scenes=["cornell-box", "cornell-indirect"], tradeoff_scenes=["cornell-indirect"]),
     "full": dict(res="960x540", ref_spp=1024, T=32, sweep=[1, 4, 8, 16, 32, 64], time_frames=32, repeats=3,
+                 equal_time_order="alternating",
                  flicker_frames=24, path_res="480x270", path_frames=[7, 15, 31, 59], path_ref_spp=256,
                  trade_res="480x270", trade_frames=32, svgf_large_res="1920x1080",
                  scenes=["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza"],
@@ -169,19 +172,19 @@ def equal_time(ctx, scene):
     m = ctx.mode
     ref_path = ctx.reference(scene, m["res"])
     out = ctx.out / "equal_time" / scene
-    curves = {}
-    for method in METHODS:
-        runs = []
-        for r in range(m["repeats"]):
+    curves = {method: {"runs": []} for method in METHODS}
+    # The methods alternate run by run (PT, PG, PT, PG, ...), so that a machine whose speed
+    # drifts during the experiment slows both alike rather than one method's block of runs.
+    for r in range(m["repeats"]):
+        for method in METHODS:
             stats, _ = runner.render(scene, m["res"], m["time_frames"], method, out, f"{method}-r{r}",
                                      reference=ref_path, extra=["--accumulate", "--seed", 100 + r])
             ms = [f["time_ms"]["total"] for f in stats["frames"]]
             # Frame 0 also builds the OpenCL programs (from the disk cache) and compiles
             # work-group functions: a one-time start-up cost, replaced by a typical frame.
             ms[0] = statistics.median(ms[1:]) if len(ms) > 1 else ms[0]
-            runs.append({"time_ms": np.cumsum(ms).tolist(),
-                         "relmse": [f["relmse_accumulated"] for f in stats["frames"]]})
-        curves[method] = {"runs": runs}
+            curves[method]["runs"].append({"time_ms": np.cumsum(ms).tolist(),
+                                           "relmse": [f["relmse_accumulated"] for f in stats["frames"]]})
     fig, ax = plt.subplots(figsize=(5, 4))
     for i, (method, c) in enumerate(curves.items()):
         for j, run in enumerate(c["runs"]):

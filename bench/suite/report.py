@@ -102,10 +102,13 @@ def _equal_time(ex, report_dir, settings):
     else:  # results.json from before bench/suite/equal_time.py: its figures came from per-frame medians
         method = ("The figures are read off per-frame medians of the runs' times and errors (the method before "
                   "bench/suite/equal_time.py).")
+    # Runs before 2026-11-27 (evening) rendered all of PT's repeats, then all of PG's.
+    order = ("PT and PG alternating run by run" if settings.get("equal_time_order") == "alternating"
+             else "all PT runs first, then all PG runs")
     lines = ["## Equal time: error of the accumulated image against wall time", "",
              f"{settings['time_frames']} accumulated frames per method, {settings['repeats']} runs each (seeds 100, "
-             "101, ...) in the same process tree; frame 0's one-time program build is replaced by the median frame "
-             f"time. {method}", "",
+             f"101, ...) in the same process tree, {order}; frame 0's one-time program build is replaced by the "
+             f"median frame time. {method}", "",
              "| scene | PT time | relMSE PT at PT's time | relMSE PG at the same time | PG time to PT's final error |",
              "|---|---|---|---|---|"]
     for scene, r in ex.items():
