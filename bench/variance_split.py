@@ -41,11 +41,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from suite import runner  # noqa: E402
 
-# The whole scene suite (scenes/README.md). The paper's two Sponza scenes (its Glossy Sponza and the
-# sky-lit stand-in for its San Miguel) joined on 2026-11-27; the tables of docs/guiding.md before
-# that date are over the first eight (docs/guiding.md, "The paper's scenes in the sweep").
-SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza", "slit-room", "corridor",
-          "sunlit-room", "sponza-glossy", "sponza-sky"]
+SCENES = runner.SUITE_SCENES
 RUNS = {  # name -> (spp multiplier: 1 or M, --share-randoms)
     "t": (False, "none"),
     "a": (True, "none"),

@@ -8,6 +8,12 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+# The scene suite of the variant sweep and the variance split (scenes/README.md), in their tables'
+# order. The paper's two Sponza scenes (its Glossy Sponza and the sky-lit stand-in for its San
+# Miguel) joined on 2026-11-27; docs/guiding.md's tables before that date are over the first
+# eight (docs/guiding.md, "The paper's scenes in the sweep").
+SUITE_SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza", "slit-room",
+                "corridor", "sunlit-room", "sponza-glossy", "sponza-sky"]
 SOURCE_DIRS = ("host", "kernels", "include")
 # Sources that only the denoiser builds from: `rtpg reference` never runs SVGF (host/app/commands.cpp,
 # run_reference), so a change to them leaves every reference valid (docs/denoising.md).
