@@ -29,8 +29,7 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ALL_SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "slit-room", "corridor", "sunlit-room",
-              "veach-ajar", "sponza", "sponza-glossy", "sponza-sky"]
+ALL_SCENES = runner.SUITE_SCENES  # --scenes all
 METHODS = ("off", "pmm")
 LABEL = {"off": "PT", "pmm": "PG"}
 
@@ -38,21 +37,21 @@ LABEL = {"off": "PT", "pmm": "PG"}
 # T: training frames of the equal-frame comparison; sweep: other T (all from one static run of
 # max(sweep) frames per method, saved with --save-frames). path_*: convergence along the scene's
 # camera path, per-frame references of path_ref_spp. trade_res: trade-offs, against the main
-# reference box-filtered down (metrics.downsample_box). equal_time_order: the equal-time runs'
-# order, recorded so that the report says it ("alternating": PT and PG run by run).
+# reference box-filtered down (metrics.downsample_box).
 MODES = {
     "quick": dict(res="48x32", ref_spp=64, T=8, sweep=[2, 8], time_frames=6, repeats=2, flicker_frames=4,
-                  equal_time_order="alternating",
                   path_res="24x16", path_frames=[1, 4], path_ref_spp=64, trade_res="24x16", trade_frames=8,
                   svgf_large_res="96x64",
                   scenes=["cornell-box", "cornell-indirect"], tradeoff_scenes=["cornell-indirect"]),
     "full": dict(res="960x540", ref_spp=1024, T=32, sweep=[1, 4, 8, 16, 32, 64], time_frames=32, repeats=3,
-                 equal_time_order="alternating",
                  flicker_frames=24, path_res="480x270", path_frames=[7, 15, 31, 59], path_ref_spp=256,
                  trade_res="480x270", trade_frames=32, svgf_large_res="1920x1080",
                  scenes=["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza"],
                  tradeoff_scenes=["cornell-indirect", "sponza"]),
 }
+# The equal-time runs' order (equal_time: PT and PG run by run), recorded in the results' settings
+# so that the report says it; results from before 2026-11-27 (evening) lack it (all PT runs first).
+EQUAL_TIME_ORDER = "alternating"
 LAST = 8  # equal-frame and trade-off errors: mean over the last 8 frames of a run
 
 
@@ -450,7 +449,7 @@ def main():
     command = "python3 bench/experiments.py" + (" --quick" if args.quick else "") + \
         (f" --only {' '.join(args.only)}" if args.only != list(EXPERIMENTS) else "") + \
         (f" --scenes {' '.join(args.scenes)}" if args.scenes else "")
-    results = {"machine": runner.machine_info(), "mode": "quick" if args.quick else "full", "settings": ctx.mode,
+    results = {"machine": runner.machine_info(), "mode": "quick" if args.quick else "full", "settings": {**ctx.mode, "equal_time_order": EQUAL_TIME_ORDER},
                "command": command, "started": time.strftime("%Y-%m-%d %H:%M:%S"), "skipped_scenes": {},
                "experiments": {}, "seconds": {}}
     usable = []

@@ -41,7 +41,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from suite import runner  # noqa: E402
 
-SCENES = runner.SUITE_SCENES
 RUNS = {  # name -> (spp multiplier: 1 or M, --share-randoms)
     "t": (False, "none"),
     "a": (True, "none"),
@@ -61,7 +60,7 @@ def split(f, m):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--scenes", nargs="+", default=SCENES)
+    parser.add_argument("--scenes", nargs="+", default=runner.SUITE_SCENES)
     parser.add_argument("--seeds", nargs="+", type=int, default=[1, 2, 3])
     parser.add_argument("--res", default="240x135")
     parser.add_argument("--frames", type=int, default=32)

@@ -31,7 +31,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from suite import metrics, runner  # noqa: E402
 
-SCENES = runner.SUITE_SCENES
 
 
 def window_relmse(stats, window):
@@ -53,7 +52,7 @@ def markdown_table(scenes, table):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--variants", required=True, help='JSON object: variant name -> list of extra rtpg arguments')
-    parser.add_argument("--scenes", nargs="+", default=SCENES)
+    parser.add_argument("--scenes", nargs="+", default=runner.SUITE_SCENES)
     parser.add_argument("--seeds", nargs="+", type=int, default=[1, 2, 3])
     parser.add_argument("--res", default="240x135")
     parser.add_argument("--frames", type=int, default=32)

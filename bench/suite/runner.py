@@ -8,8 +8,8 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-# The scene suite of the variant sweep and the variance split (scenes/README.md), in their tables'
-# order. The paper's two Sponza scenes (its Glossy Sponza and the sky-lit stand-in for its San
+# The scene suite (scenes/README.md): the variant sweep's and the variance split's default scenes,
+# in their tables' order, and experiments.py's `--scenes all`. The paper's two Sponza scenes (its Glossy Sponza and the sky-lit stand-in for its San
 # Miguel) joined on 2026-11-27; docs/guiding.md's tables before that date are over the first
 # eight (docs/guiding.md, "The paper's scenes in the sweep").
 SUITE_SCENES = ["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza", "slit-room",
