@@ -10,7 +10,7 @@
 # rtpg renders FRAMES frames (default 24) of SCENES at RESOLUTIONS path-traced and guided with each
 # host transfer, and with SVGF, into OUT/frames/*.json (--stats-json; RUNS names them: off,
 # off-svgf, and each --host-transfer alone or with -svgf) with their table in OUT/frames.md
-# (gpu_frames_summary.py), and bench_svgf and bench_frame run on the Cornell box (not with
+# (gpu_frames_summary.py; ROUNDS repeats them, interleaved), and bench_svgf and bench_frame run on the Cornell box (not with
 # NO_BENCH). TESTS narrows the tests there too.
 # Exit status: the number of test binaries that failed, 0 if none.
 set -uo pipefail
@@ -65,20 +65,27 @@ if [ -z "${NO_BENCH:-}" ]; then
 fi
 if [ -n "${RENDER:-}" ]; then
   mkdir -p "$out/frames"
+  for round in $(seq 1 "${ROUNDS:-1}"); do
+  # ROUNDS > 1 repeats every run, interleaved, into files named ...-RUN-rN.json (the summary
+  # pools a run's rounds).
+  suffix=""
+  [ "${ROUNDS:-1}" -gt 1 ] && suffix="-r$round"
   for scene in ${SCENES:-cornell-box cornell-indirect veach-ajar sunlit-room}; do
     for res in ${RESOLUTIONS:-960x540 1920x1080}; do
-      for name in ${RUNS:-off pinned pageable in-place off-svgf pinned-svgf}; do
+      for name in ${RUNS:-off pinned packed pageable in-place off-svgf pinned-svgf}; do
         case $name in
           off) set -- --guiding off ;;
           off-svgf) set -- --guiding off --denoise svgf ;;
           *-svgf) set -- --host-transfer "${name%-svgf}" --denoise svgf ;;
           *) set -- --host-transfer "$name" ;;
         esac
+        file="$out/frames/$scene-$res-$name$suffix"
         "$dir/bin/rtpg" render "scenes/$scene.json" --res "$res" --frames "${FRAMES:-24}" "$@" \
-          --stats-json "$out/frames/$scene-$res-$name.json" > "$out/frames/$scene-$res-$name.log" 2>&1
-        echo "== $scene $res $name: exit $?, $(grep 'time per frame' "$out/frames/$scene-$res-$name.log")"
+          --stats-json "$file.json" > "$file.log" 2>&1
+        echo "== $scene $res $name$suffix: exit $?, $(grep 'time per frame' "$file.log")"
       done
     done
+  done
   done
   python3 "$dir/gpu_frames_summary.py" "$out/frames" | tee "$out/frames.md"
 fi

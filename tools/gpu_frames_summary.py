@@ -2,7 +2,8 @@
 """The table of a GPU bundle's frame runs (tools/gpu_bundle_run.sh with RENDER=1 writes
 OUT/frames/SCENE-WxH-RUN.json, `rtpg render --stats-json`): per scene and size, each run's median
 frame and its ratio to the path-traced one ("off"), the guiding stages (upload, read-back, the
-three kernels) and SVGF's upload and total, medians over the frames after the first SKIP.
+kernels: reproject, sample, train and the packed G-buffer's unpack) and SVGF's upload and total,
+medians over the frames after the first SKIP (a run's rounds, files ...-RUN-rN.json, pooled).
 
 Usage: gpu_frames_summary.py OUT/frames [--skip N]   (prints a Markdown table)
 """
@@ -13,8 +14,8 @@ import statistics
 import sys
 from pathlib import Path
 
-NAME = re.compile(r"^(?P<scene>.+)-(?P<size>\d+x\d+)-(?P<run>[a-z-]+)\.json$")
-ORDER = ["off", "pinned", "pageable", "in-place", "auto"]
+NAME = re.compile(r"^(?P<scene>.+)-(?P<size>\d+x\d+)-(?P<run>[a-z-]+?)(?:-r\d+)?\.json$")
+ORDER = ["off", "pinned", "packed", "pageable", "in-place", "auto"]
 
 
 def median_stage(frames, stage):
@@ -29,7 +30,8 @@ def summarise(folder, skip):
             continue
         frames = json.loads(path.read_text())["frames"]
         frames = frames[skip:] or frames
-        runs[(m["scene"], m["size"], m["run"])] = frames
+        # The rounds of one run (ROUNDS in gpu_bundle_run.sh, files ...-RUN-rN.json) pool.
+        runs.setdefault((m["scene"], m["size"], m["run"]), []).extend(frames)
     if not runs:
         sys.exit(f"gpu_frames_summary: no SCENE-WxH-RUN.json files in {folder}")
 
@@ -47,7 +49,7 @@ def summarise(folder, skip):
         total = median_stage(frames, "total")
         base = runs.get((scene, size, "off"))
         ratio = f"{total / median_stage(base, 'total'):.3f}" if base else "-"
-        kernels = sum(median_stage(frames, s) for s in ("reproject", "sample", "train"))
+        kernels = sum(median_stage(frames, s) for s in ("reproject", "sample", "train", "unpack"))
         guided = any("train" in f["time_ms"] for f in frames)
         svgf = any("svgf_total" in f["time_ms"] for f in frames)
         cells = [scene, size, run, f"{total:.1f}", ratio,

@@ -72,9 +72,10 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
       ->capture_default_str();
   grp->add_option("--host-transfer", r.host_transfer,
                   "How the G-buffer and VPLs reach the device and the samples come back: auto "
-                  "(in-place where the device shares host memory, else pinned), in-place, pinned "
-                  "(through mapped staging) or pageable")
-      ->check(CLI::IsMember({"auto", "in-place", "pinned", "pageable"}))
+                  "(in-place where the device shares host memory, else packed), in-place, pinned "
+                  "(through mapped staging), packed (as pinned, the G-buffer in 48 bytes a "
+                  "pixel instead of 96) or pageable")
+      ->check(CLI::IsMember({"auto", "in-place", "pinned", "packed", "pageable"}))
       ->capture_default_str();
 }
 

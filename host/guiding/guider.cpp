@@ -26,11 +26,21 @@ std::size_t pixels(int width, int height) {
 #define RTPG_ALLOCATE(name, type, bytes) b.name = cl::Buffer(context, flags, n * (bytes));
 
 GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height,
-                                  cl_mem_flags host_flags) {
+                                  cl_mem_flags host_flags, KernelAccess access) {
   const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags = CL_MEM_READ_ONLY | host_flags;
+  const cl_mem_flags flags =
+      (access == KernelAccess::read_write ? CL_MEM_READ_WRITE : CL_MEM_READ_ONLY) | host_flags;
   GuiderGBuffer b;
   translate_cl_errors([&] { PG_GBUFFER_CHANNELS(RTPG_ALLOCATE) });
+  return b;
+}
+
+GuiderPackedGBuffer make_guider_packed_gbuffer(cl::Context& context, int width, int height,
+                                               cl_mem_flags host_flags) {
+  const std::size_t n = pixels(width, height);
+  const cl_mem_flags flags = CL_MEM_READ_ONLY | host_flags;
+  GuiderPackedGBuffer b;
+  translate_cl_errors([&] { PG_PACKED_GBUFFER_CHANNELS(RTPG_ALLOCATE) });
   return b;
 }
 
@@ -217,6 +227,35 @@ std::array<double, 4> Guider::sum_count_records(const cl::Buffer& records, std::
   for (std::size_t g = 0; g < groups; ++g)
     for (int c = 0; c < 4; ++c) sum[c] += r[g * 4 + c];
   return sum;
+}
+
+void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out) {
+#define RTPG_CHECK(name, type, bytes) check_buffer(packed.name, bytes, "packed." #name);
+  PG_PACKED_GBUFFER_CHANNELS(RTPG_CHECK)
+#undef RTPG_CHECK
+  check_gbuffer(out, "unpacked");
+  translate_cl_errors([&] {
+    if (out.position_depth.getInfo<CL_MEM_FLAGS>() & CL_MEM_READ_ONLY)
+      throw GuiderError(
+          "unpack_gbuffer: the G-buffer to write is read-only for kernels (make it with "
+          "KernelAccess::read_write)");
+    if (unpack_() == nullptr) unpack_ = runtime_.kernel("unpack_gbuffer.cl", "unpack_gbuffer");
+    const std::size_t n = static_cast<std::size_t>(width_) * height_;
+    KernelArgs args(unpack_);
+#define RTPG_ARG(name, type, bytes) args << packed.name;
+    PG_PACKED_GBUFFER_CHANNELS(RTPG_ARG)
+#undef RTPG_ARG
+    args << out << static_cast<cl_uint>(n);
+    // One work-item a pixel in groups of up to 64 (any size works: the kernel checks its bound).
+    const std::size_t group = std::min<std::size_t>(
+        64, unpack_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
+    cl::Event done;
+    runtime_.queue().enqueueNDRangeKernel(unpack_, cl::NullRange,
+                                          cl::NDRange((n + group - 1) / group * group),
+                                          cl::NDRange(group), nullptr, &done);
+    done.wait();
+    times_.unpack_ms = ClRuntime::event_ms(done);
+  });
 }
 
 void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous) {

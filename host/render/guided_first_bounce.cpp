@@ -1,11 +1,17 @@
 #include "render/guided_first_bounce.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "render/gbuffer_packer.h"
 #include "render/pinned_staging.h"
 #include "rtpg/cl_runtime.h"
+#include "shared/gbuffer_packing.h"
 
 namespace rtpg {
 namespace {
@@ -19,6 +25,7 @@ double ms_since(Clock::time_point start) {
 #define RTPG_ADD_BYTES(name, type, bytes) +(bytes)
 constexpr std::size_t kGBufferBytes = 0 PG_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kVplBytes = 0 PG_VPL_CHANNELS(RTPG_ADD_BYTES);
+constexpr std::size_t kPackedGBufferBytes = 0 PG_PACKED_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
 #undef RTPG_ADD_BYTES
 #define RTPG_COUNT(name, type, bytes) +1
 constexpr std::size_t kGBufferChannels = 0 PG_GBUFFER_CHANNELS(RTPG_COUNT);
@@ -38,11 +45,41 @@ void stage_channels(PinnedStaging& staging, const VplBuffer& host, const GuiderV
 #undef RTPG_STAGE
 }
 
+// The host G-buffer packed straight into the staging (render/gbuffer_packer.h), in parallel, and
+// its four channels' copies to the device enqueued. Throws GuiderError where a
+// material id or the flags do not fit in the packed word (nothing is enqueued then).
+void stage_packed_gbuffer(PinnedStaging& staging, const GBuffer& g,
+                          const GuiderPackedGBuffer& device) {
+  const std::size_t n = g.pixel_count();
+  auto* surface =
+      static_cast<shared::uint4*>(staging.reserve(n * 16, device.surface, "packed surface"));
+  auto* view_material = static_cast<shared::uint4*>(
+      staging.reserve(n * 16, device.view_material, "packed view_material"));
+  auto* shading =
+      static_cast<shared::uint2*>(staging.reserve(n * 8, device.shading, "packed shading"));
+  auto* motion =
+      static_cast<shared::float2*>(staging.reserve(n * 8, device.motion, "packed motion"));
+  const PackedGBufferView view{surface, view_material, shading, motion};
+  std::atomic<bool> unpackable{false};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 13),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      if (!pack_gbuffer(g, r.begin(), r.end(), view)) unpackable = true;
+                    });
+  if (unpackable)
+    throw GuiderError(
+        "packed G-buffer: a material id above " + std::to_string(PG_PACKED_MATERIAL_MAX) +
+        " or flags above 255 do not fit in the packed shading word (use --host-transfer pinned)");
+  staging.commit(surface, n * 16, device.surface);
+  staging.commit(view_material, n * 16, device.view_material);
+  staging.commit(shading, n * 8, device.shading);
+  staging.commit(motion, n * 8, device.motion);
+}
+
 }  // namespace
 
 template <class Host, class Device>
 void GuidedFirstBounce::copy_to_device(const Host& host, const Device& device, std::size_t bytes) {
-  if (transfer_ == HostTransfer::pinned) {
+  if (transfer_ == HostTransfer::pinned || transfer_ == HostTransfer::packed) {
     upload_staging_->begin();
     stage_channels(*upload_staging_, host, device);
   } else {
@@ -59,13 +96,17 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
       pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
   transfer_ = resolve_host_transfer(transfer, runtime.info().host_unified_memory);
   zero_copy_ = transfer_ == HostTransfer::in_place;
-  if (transfer_ == HostTransfer::pinned)
-    upload_staging_ = std::make_unique<PinnedStaging>(runtime.context(), runtime.queue(),
-                                                      std::max(kGBufferBytes, kVplBytes) * pixels_,
-                                                      std::max(kGBufferChannels, kVplChannels));
+  packed_ = transfer_ == HostTransfer::packed;
+  if (transfer_ == HostTransfer::pinned || packed_)
+    upload_staging_ = std::make_unique<PinnedStaging>(
+        runtime.context(), runtime.queue(),
+        std::max(packed_ ? kPackedGBufferBytes : kGBufferBytes, kVplBytes) * pixels_,
+        std::max(kGBufferChannels, kVplChannels));
+  if (packed_) packed_gbuffer_ = make_guider_packed_gbuffer(runtime.context(), width, height);
   if (!zero_copy_) {
     for (GuiderGBuffer& g : owned_gbuffers_)
-      g = make_guider_gbuffer(runtime.context(), width, height);
+      g = make_guider_gbuffer(runtime.context(), width, height, 0,
+                              packed_ ? KernelAccess::read_write : KernelAccess::read_only);
     owned_vpls_ = make_guider_vpls(runtime.context(), width, height);
   }
   samples_ =
@@ -130,10 +171,18 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   } else {
     owned_current_ = 1 - owned_current_;
     current_gbuffer_ = owned_gbuffers_[owned_current_];
-    copy_to_device(g, current_gbuffer_, kGBufferBytes * g.pixel_count());
+    if (packed_) {
+      upload_staging_->begin();
+      stage_packed_gbuffer(*upload_staging_, g, packed_gbuffer_);
+      translate_cl_errors([&] { runtime_.queue().finish(); });
+      bytes_ += kPackedGBufferBytes * g.pixel_count();
+    } else {
+      copy_to_device(g, current_gbuffer_, kGBufferBytes * g.pixel_count());
+    }
     copied_from_ = &g;
   }
   upload_ms_ = ms_since(t);
+  if (packed_) guider_->unpack_gbuffer(packed_gbuffer_, current_gbuffer_);
   if (have_previous_) {
     guider_->reproject(current_gbuffer_, previous_gbuffer_);
   } else {
@@ -254,6 +303,7 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   time_ms["sample"] = sample_ms_;
   time_ms["train"] = k.train_ms;
   time_ms["upload"] = upload_ms_;
+  if (packed_) time_ms["unpack"] = k.unpack_ms;
   time_ms["readback"] = readback_ms_;
   extra["guided_fraction"] = guided_fraction_;
   extra["trained_fraction"] = trained_fraction_;
@@ -263,7 +313,7 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   extra["sample_lanes"] = guider_->sample_lanes();
   extra["row_work_groups"] = guider_->row_work_groups() ? 1.0 : 0.0;
   extra["zero_copy"] = zero_copy_ ? 1.0 : 0.0;
-  // HostTransfer as a number: 1 in place, 2 pinned, 3 pageable.
+  // HostTransfer as a number: 1 in place, 2 pinned, 3 pageable, 4 packed.
   extra["host_transfer"] = static_cast<double>(static_cast<int>(transfer_));
   extra["host_device_bytes_per_pixel"] =
       static_cast<double>(bytes_) / static_cast<double>(std::max<std::size_t>(pixels_, 1));

@@ -85,6 +85,10 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void unmap_samples();
   HostTransfer transfer_ = HostTransfer::automatic;
   bool zero_copy_ = false, mapped_ = false;
+  // HostTransfer::packed: the G-buffer goes up packed into packed_gbuffer_ and the device
+  // unpacks it into current_gbuffer_ (Guider::unpack_gbuffer).
+  bool packed_ = false;
+  GuiderPackedGBuffer packed_gbuffer_;
   bool host_reads_mixture_ = true;  // expect_queries: pdf() or pixel_guide() will be asked
   GuiderSamples staging_;
   // HostTransfer::pinned: where the G-buffer and then the VPLs are copied on their way up.

@@ -11,7 +11,9 @@ HostTransfer parse_host_transfer(const std::string& name) {
   if (name == "in-place") return HostTransfer::in_place;
   if (name == "pinned") return HostTransfer::pinned;
   if (name == "pageable") return HostTransfer::pageable;
-  throw GuiderError("host transfer '" + name + "' is none of auto, in-place, pinned, pageable");
+  if (name == "packed") return HostTransfer::packed;
+  throw GuiderError("host transfer '" + name +
+                    "' is none of auto, in-place, pinned, packed, pageable");
 }
 
 const char* host_transfer_name(HostTransfer transfer) {
@@ -24,6 +26,8 @@ const char* host_transfer_name(HostTransfer transfer) {
       return "pinned";
     case HostTransfer::pageable:
       return "pageable";
+    case HostTransfer::packed:
+      return "packed";
   }
   return "?";
 }
@@ -39,7 +43,7 @@ HostTransfer resolve_host_transfer(HostTransfer transfer, bool host_unified_memo
     }
   }
   if (transfer == HostTransfer::automatic)
-    transfer = host_unified_memory ? HostTransfer::in_place : HostTransfer::pinned;
+    transfer = host_unified_memory ? HostTransfer::in_place : HostTransfer::packed;
   return transfer;
 }
 

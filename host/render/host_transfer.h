@@ -10,7 +10,8 @@ namespace rtpg {
 
 enum class HostTransfer {
   automatic,  // in_place where the device shares host memory (DeviceInfo::host_unified_memory),
-              // else pinned
+              // else packed (its uploads measured 8-15% shorter than pinned's on an H200:
+              // docs/guiding.md, "The G-buffer packed for the bus")
   in_place,   // the device reads the host's G-buffer and VPLs where they are
               // (CL_MEM_USE_HOST_PTR) and the host maps the samples: no copies where memory is
               // shared; elsewhere the OpenCL implementation copies when the kernels need them
@@ -19,15 +20,19 @@ enum class HostTransfer {
               // come back into such staging
   pageable,   // the device copies straight from the host's own (pageable) vectors; the samples
               // come back into pinned staging
+  packed,     // as pinned, but the G-buffer is packed into the staging in 48 bytes a pixel
+              // instead of 96 (include/rtpg/guiding_layout.h, "Packed G-buffer") and the device
+              // unpacks it (Guider::unpack_gbuffer); the SVGF denoiser copies as with pinned
 };
-// "auto", "in-place", "pinned", "pageable" (the CLI's --host-transfer); throws GuiderError else.
+// "auto", "in-place", "pinned", "packed", "pageable" (the CLI's --host-transfer); throws
+// GuiderError else.
 HostTransfer parse_host_transfer(const std::string& name);
 const char* host_transfer_name(HostTransfer transfer);
 
-// automatic resolved: RTPG_HOST_TRANSFER, where set (auto, in-place, pinned or pageable; the
-// tests run the guided and denoised renders once more with it set to pinned, so that the copies a
-// discrete GPU needs are exercised on PoCL too), else in_place where the device shares host
-// memory and pinned elsewhere. Any other choice is returned as it is. Throws GuiderError naming
+// automatic resolved: RTPG_HOST_TRANSFER, where set (auto, in-place, pinned, packed or pageable;
+// the tests run the guided and denoised renders once more with it set to packed, so that the copies
+// a discrete GPU takes are exercised on PoCL too), else in_place where the device shares host
+// memory and packed elsewhere. Any other choice is returned as it is. Throws GuiderError naming
 // the variable when its value is none of those.
 HostTransfer resolve_host_transfer(HostTransfer transfer, bool host_unified_memory);
 

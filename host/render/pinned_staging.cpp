@@ -33,8 +33,7 @@ PinnedStaging::~PinnedStaging() {
   }
 }
 
-void PinnedStaging::stage(const void* host, std::size_t bytes, const cl::Buffer& device,
-                          const std::string& what) {
+void* PinnedStaging::reserve(std::size_t bytes, const cl::Buffer& device, const std::string& what) {
   const std::size_t start = (used_ + kAlignment - 1) / kAlignment * kAlignment;
   if (start + bytes > size_)
     throw GuiderError("upload of " + what + ": " + std::to_string(bytes) +
@@ -44,14 +43,23 @@ void PinnedStaging::stage(const void* host, std::size_t bytes, const cl::Buffer&
       throw GuiderError("upload of " + what + ": " + std::to_string(bytes) +
                         " bytes do not fit in its device buffer");
   });
-  unsigned char* to = mapped_ + start;
+  used_ = start + bytes;
+  return mapped_ + start;
+}
+
+void PinnedStaging::commit(const void* reserved, std::size_t bytes, const cl::Buffer& device) {
+  translate_cl_errors([&] { queue_.enqueueWriteBuffer(device, CL_FALSE, 0, bytes, reserved); });
+}
+
+void PinnedStaging::stage(const void* host, std::size_t bytes, const cl::Buffer& device,
+                          const std::string& what) {
+  auto* to = static_cast<unsigned char*>(reserve(bytes, device, what));
   const auto* from = static_cast<const unsigned char*>(host);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bytes, std::size_t{1} << 18),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       std::memcpy(to + r.begin(), from + r.begin(), r.size());
                     });
-  translate_cl_errors([&] { queue_.enqueueWriteBuffer(device, CL_FALSE, 0, bytes, to); });
-  used_ = start + bytes;
+  commit(to, bytes, device);
 }
 
 }  // namespace rtpg

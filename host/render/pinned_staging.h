@@ -8,6 +8,9 @@
 // Per frame: begin(), then stage() each channel (copied into the staging in parallel, since one
 // core's memcpy reaches a fraction of the memory's bandwidth, and its write to the device
 // enqueued without blocking), then the caller finishes the queue before the next begin().
+// (Copying and enqueueing in 4 MiB chunks, each flushed, to overlap the host's copy with the
+// bus's, was tried on an H200 and measured no faster: docs/guiding.md, "The G-buffer packed for
+// the bus".)
 #pragma once
 
 #include <cstddef>
@@ -37,6 +40,10 @@ class PinnedStaging {
   void stage(const Container& host, const cl::Buffer& device, const std::string& what) {
     stage(host.data(), host.size() * sizeof(*host.data()), device, what);
   }
+  // For data the caller writes into the staging itself (packs, say): reserve() checks and
+  // returns `bytes` of staging, commit() enqueues their copy into `device` at offset 0.
+  void* reserve(std::size_t bytes, const cl::Buffer& device, const std::string& what);
+  void commit(const void* reserved, std::size_t bytes, const cl::Buffer& device);
   std::size_t size() const { return size_; }
 
  private:

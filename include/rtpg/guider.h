@@ -47,6 +47,10 @@ struct GuiderVpls {  // one VPL per pixel (PG_VPL_CHANNELS)
 struct GuiderSamples {  // what sample() writes (PG_SAMPLE_CHANNELS)
   PG_SAMPLE_CHANNELS(RTPG_DEVICE_CHANNEL)
 };
+// A G-buffer as it crossed the bus (PG_PACKED_GBUFFER_CHANNELS): what unpack_gbuffer() reads.
+struct GuiderPackedGBuffer {
+  PG_PACKED_GBUFFER_CHANNELS(RTPG_DEVICE_CHANNEL)
+};
 #undef RTPG_DEVICE_CHANNEL
 
 // What sample() writes besides the directions, their densities and strategies: the mixture each
@@ -72,8 +76,13 @@ constexpr std::size_t sample_bytes_per_pixel(SampleOutputs outputs) {
 // memory (DeviceInfo::host_unified_memory), the host can map the samples and read them in place
 // instead of copying them; elsewhere such buffers, mapped, are pinned staging that a discrete
 // GPU copies from and into several times faster (host/render/guided_first_bounce.cpp does both).
+// A G-buffer that Guider::unpack_gbuffer() writes must be made with KernelAccess::read_write.
+enum class KernelAccess { read_only, read_write };
 GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height,
-                                  cl_mem_flags host_flags = 0);
+                                  cl_mem_flags host_flags = 0,
+                                  KernelAccess access = KernelAccess::read_only);
+GuiderPackedGBuffer make_guider_packed_gbuffer(cl::Context& context, int width, int height,
+                                               cl_mem_flags host_flags = 0);
 GuiderVpls make_guider_vpls(cl::Context& context, int width, int height,
                             cl_mem_flags host_flags = 0);
 GuiderSamples make_guider_samples(cl::Context& context, int width, int height,
@@ -187,6 +196,7 @@ struct GuiderSampleCounts {
 
 struct GuiderTimes {
   double reproject_ms = 0.0, sample_ms = 0.0, train_ms = 0.0;  // from profiling events
+  double unpack_ms = 0.0;                                      // the last unpack_gbuffer()
 };
 
 class Guider {
@@ -213,6 +223,10 @@ class Guider {
   bool row_work_groups() const { return pixel_rows_; }
 
   void reset();  // every pixel back to the initial state (k = 0: BSDF sampling)
+  // Writes out's channels from a G-buffer the host packed (PG_PACKED_GBUFFER_CHANNELS;
+  // kernels/shared/gbuffer_packing.h packs): for a device with memory of its own, where the
+  // packed form halves what crosses the bus. out must be made with KernelAccess::read_write.
+  void unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out);
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
   void reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous);
   void sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint32_t frame,
@@ -277,6 +291,7 @@ class Guider {
   cl::Buffer sample_counts_, train_counts_;
   int current_ = 0;  // index of the buffers holding this frame's state
   cl::Kernel reproject_, sample_, train_;
+  cl::Kernel unpack_;  // built at the first unpack_gbuffer()
   GuiderTimes times_;
 };
 

@@ -30,6 +30,22 @@
   X(material, uint, 4)                \
   X(motion, float2, 8)
 
+/* ---- Packed G-buffer: the G-buffer as it crosses the bus -----------------------------------
+ * Where the device has memory of its own, the host packs each pixel into these 48 bytes
+ * (kernels/shared/gbuffer_packing.h, which packs and unpacks them) and the device's
+ * unpack_gbuffer kernel writes PG_GBUFFER_CHANNELS from them (rtpg::Guider::unpack_gbuffer).
+ * surface        xyz the position's float bits, w the shading normal (octahedral)
+ * view_material  x the depth's float bits, y the view direction (octahedral), z base colour r and
+ *                g as half floats, w base colour b and roughness as half floats (low half first)
+ * shading        x metallic and specular as half floats, y the flags (low 8 bits) and the
+ *                material id (the high 24)
+ * motion         the motion vector, exact */
+#define PG_PACKED_GBUFFER_CHANNELS(X) \
+  X(surface, uint4, 16)               \
+  X(view_material, uint4, 16)         \
+  X(shading, uint2, 8)                \
+  X(motion, float2, 8)
+
 /* Pixels guiding skips (paper, section 5: sky, emitters, transmission, roughness near 0). */
 #define PG_GBUF_SKY 1u          /* camera ray escaped: no surface */
 #define PG_GBUF_EMITTER 2u      /* surface emits towards the camera */

@@ -21,6 +21,7 @@
 #define pg_make_float2(x, y) ((float2)((x), (y)))
 #define pg_make_float3(x, y, z) ((float3)((x), (y), (z)))
 #define pg_make_float4(x, y, z, w) ((float4)((x), (y), (z), (w)))
+#define pg_make_uint2(x, y) ((uint2)((x), (y)))
 #define pg_make_uint4(x, y, z, w) ((uint4)((x), (y), (z), (w)))
 #define pg_float4_xyz(v) ((v).xyz)
 #define PG_PRIVATE __private
@@ -47,6 +48,7 @@ typedef glm::vec3 float3;
 typedef glm::vec4 float4;
 typedef std::uint32_t uint;
 typedef std::uint64_t ulong;
+typedef glm::uvec2 uint2;
 typedef glm::uvec4 uint4;
 
 using glm::cross;
@@ -71,6 +73,9 @@ PG_FN float3 pg_make_float3(float x, float y, float z) {
 }
 PG_FN float4 pg_make_float4(float x, float y, float z, float w) {
   return float4(x, y, z, w);
+}
+PG_FN uint2 pg_make_uint2(uint x, uint y) {
+  return uint2(x, y);
 }
 PG_FN uint4 pg_make_uint4(uint x, uint y, uint z, uint w) {
   return uint4(x, y, z, w);

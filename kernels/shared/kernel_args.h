@@ -18,7 +18,11 @@
 #define PG_ARG_STATE(name, type, bytes) __global type *name,
 #define PG_ARG_OUT(name, type, bytes) __global type *name,
 
-#define PG_ARGS_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_IN)           /* this frame's G-buffer */
+#define PG_ARG_IN_PACKED(name, type, bytes) __global const type *packed_##name,
+
+#define PG_ARGS_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_IN)      /* this frame's G-buffer */
+#define PG_ARGS_OUT_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_OUT) /* written by unpack_gbuffer */
+#define PG_ARGS_PACKED_GBUFFER PG_PACKED_GBUFFER_CHANNELS(PG_ARG_IN_PACKED)
 #define PG_ARGS_PREV_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_IN_PREV) /* last frame's */
 #define PG_ARGS_VPLS PG_VPL_CHANNELS(PG_ARG_IN_VPL)
 #define PG_ARGS_IN_STATE PG_STATE_CHANNELS(PG_ARG_IN_STATE)

@@ -653,7 +653,7 @@ TEST_F(Cli, DenoiseWritesTheFilteredAndTheNoisyFrameWithTheirStatistics) {
     EXPECT_TRUE(last["time_ms"].contains(key)) << key;
   EXPECT_TRUE(last.contains("flicker_mse_noisy"));
   // Nothing crosses where the guided frame reads in place (zero_copy, PoCL's CPU device);
-  // elsewhere (RTPG_HOST_TRANSFER=pinned, the tests' second run) SVGF reads the guider's copy of
+  // elsewhere (RTPG_HOST_TRANSFER=packed, the tests' second run) SVGF reads the guider's copy of
   // the G-buffer and moves the colour and emission up and the denoised colour down: 48 bytes.
   ASSERT_TRUE(last.contains("zero_copy"));
   EXPECT_EQ(last.value("svgf_host_device_bytes_per_pixel", -1.0),

@@ -13,6 +13,7 @@ int main(void) {
     failed = 1;
   }
   if (0 PG_GBUFFER_CHANNELS(PG_SUM_BYTES) != 5 * 16 + 4 + 4 + 8 ||
+      0 PG_PACKED_GBUFFER_CHANNELS(PG_SUM_BYTES) != 16 + 16 + 8 + 8 ||
       0 PG_VPL_CHANNELS(PG_SUM_BYTES) != 2 * 16 ||
       0 PG_SAMPLE_CHANNELS(PG_SUM_BYTES) != 16 + 4 + 16 + 8 ||
       0 PG_STATE_CHANNELS(PG_SUM_BYTES) != 4 * PG_STATE_FLOATS_PER_PIXEL) {

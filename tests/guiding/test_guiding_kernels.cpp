@@ -24,6 +24,7 @@
 #include "rtpg/guiding_settings.h"
 #include "rtpg/guider.h"
 #include "support/guiding_buffers.h"
+#include "shared/gbuffer_packing.h"
 #include "shared/guiding_pixel.h"
 #include "shared/pmm.h"
 #include "shared/pmm_train.h"
@@ -1160,6 +1161,83 @@ TEST(GuidingKernels, ReprojectionFollowsAMovingCamera) {
       kept, kept_reframed, worst, outside, disoccluded, sky);
 }
 
+// ---- unpack_gbuffer ------------------------------------------------------------------------
+
+// The device's unpack of a packed G-buffer (kernels/unpack_gbuffer.cl) equals the host's
+// (kernels/shared/gbuffer_packing.h) at odd sizes (the last work-group's padding must write
+// nothing): bit for bit where the unpacking is integer arithmetic and exact float products
+// (positions, depths, halves, flags, material ids, motion), and within 4 units in the last place
+// per component for the unit vectors, whose normalisation uses sqrt and a division (3 and 2.5
+// ulp in OpenCL 1.2). A guided frame then reads these channels as if they had been uploaded.
+TEST(GuidingKernels, UnpackGBufferMatchesTheHostUnpack) {
+  ClRuntime rt;
+  Random r(808);
+  const std::vector<std::pair<int, int>> sizes =
+      simulated(rt) ? std::vector<std::pair<int, int>>{{13, 9}, {1, 1}, {65, 1}}
+                    : std::vector<std::pair<int, int>>{{93, 61}, {1, 1}, {301, 3}, {64, 2}};
+  for (const auto& [w, h] : sizes) {
+    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+    HostGBuffer g = random_gbuffer(r, w, h);
+    const std::size_t n = g.n();
+    for (std::size_t i = 0; i < n; ++i) {
+      g.motion[i] = float2(r.uniform(-40.0f, 40.0f), r.uniform(-40.0f, 40.0f));
+      g.material[i] = static_cast<std::uint32_t>(r.uniform(0.0f, 1.0f) * PG_PACKED_MATERIAL_MAX);
+      if (i % 7 == 0) g.base_color_roughness[i].x = r.uniform(0.0f, 1e-5f);  // subnormal halves
+    }
+    std::vector<sh::uint4> surface(n), view_material(n);
+    std::vector<sh::uint2> shading(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      surface[i] = sh::pg_pack_gbuffer_surface(g.position_depth[i], g.shading_normal[i]);
+      view_material[i] = sh::pg_pack_gbuffer_view_material(g.position_depth[i], g.view_dir[i],
+                                                           g.base_color_roughness[i]);
+      shading[i] = sh::pg_pack_gbuffer_shading(g.metallic_specular[i], g.flags[i], g.material[i]);
+    }
+    const GuiderPackedGBuffer packed = make_guider_packed_gbuffer(rt.context(), w, h);
+    rt.queue().enqueueWriteBuffer(packed.surface, CL_FALSE, 0, n * 16, surface.data());
+    rt.queue().enqueueWriteBuffer(packed.view_material, CL_FALSE, 0, n * 16, view_material.data());
+    rt.queue().enqueueWriteBuffer(packed.shading, CL_FALSE, 0, n * 8, shading.data());
+    rt.queue().enqueueWriteBuffer(packed.motion, CL_FALSE, 0, n * 8, g.motion.data());
+    const GuiderGBuffer out = make_guider_gbuffer(rt.context(), w, h, 0, KernelAccess::read_write);
+    Guider guider(rt, w, h);
+    guider.unpack_gbuffer(packed, out);
+    EXPECT_GE(guider.last_times().unpack_ms, 0.0);
+    HostGBuffer d(w, h);
+#define RTPG_READ(name, type, bytes) \
+  rt.queue().enqueueReadBuffer(out.name, CL_TRUE, 0, n*(bytes), d.name.data());
+    PG_GBUFFER_CHANNELS(RTPG_READ)
+#undef RTPG_READ
+    const auto same4 = [](float4 a, float4 b) {
+      return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z) &&
+             same_bits(a.w, b.w);
+    };
+    const auto near_unit = [](float4 a, float4 b) {
+      for (int c = 0; c < 4; ++c)
+        if (!(std::fabs(a[c] - b[c]) <= 4.0f * std::numeric_limits<float>::epsilon())) return false;
+      return true;
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_TRUE(same4(d.position_depth[i],
+                        sh::pg_unpack_gbuffer_position_depth(surface[i], view_material[i])))
+          << i;
+      ASSERT_TRUE(same_bits(d.position_depth[i].w, g.position_depth[i].w)) << i;
+      ASSERT_TRUE(near_unit(d.shading_normal[i], sh::pg_unpack_gbuffer_shading_normal(surface[i])))
+          << i;
+      ASSERT_TRUE(near_unit(d.view_dir[i], sh::pg_unpack_gbuffer_view_dir(view_material[i]))) << i;
+      ASSERT_TRUE(same4(d.base_color_roughness[i],
+                        sh::pg_unpack_gbuffer_base_color_roughness(view_material[i])))
+          << i;
+      ASSERT_TRUE(
+          same4(d.metallic_specular[i], sh::pg_unpack_gbuffer_metallic_specular(shading[i])))
+          << i;
+      ASSERT_EQ(d.flags[i], g.flags[i]) << i;
+      ASSERT_EQ(d.material[i], g.material[i]) << i;
+      ASSERT_TRUE(same_bits(d.motion[i].x, g.motion[i].x) &&
+                  same_bits(d.motion[i].y, g.motion[i].y))
+          << i;
+    }
+  }
+}
+
 // ---- misuse of the public header -----------------------------------------------------------
 
 // Runs f and expects a GuiderError whose message contains `needle`.
@@ -1254,6 +1332,29 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
   guider.train(good, vpls, 1, 0);
   guider.reproject(good, good);
   EXPECT_GT(guider.count_trained(), 0u);
+}
+
+// unpack_gbuffer refuses a G-buffer kernels may not write, and packed channels of another size,
+// naming them.
+TEST(GuiderMisuse, UnpackGBufferRefusesReadOnlyAndMissizedBuffers) {
+  ClRuntime rt;
+  const int w = 9, h = 5;
+  Guider guider(rt, w, h);
+  const GuiderPackedGBuffer packed = make_guider_packed_gbuffer(rt.context(), w, h);
+  const GuiderGBuffer writable =
+      make_guider_gbuffer(rt.context(), w, h, 0, KernelAccess::read_write);
+  expect_guider_error(
+      [&] { guider.unpack_gbuffer(packed, make_guider_gbuffer(rt.context(), w, h)); },
+      "KernelAccess::read_write");
+  GuiderPackedGBuffer bad = packed;
+  bad.shading = cl::Buffer(rt.context(), CL_MEM_READ_WRITE, (w * h - 1) * 8);
+  expect_guider_error([&] { guider.unpack_gbuffer(bad, writable); }, "packed.shading");
+  expect_guider_error(
+      [&] {
+        guider.unpack_gbuffer(
+            packed, make_guider_gbuffer(rt.context(), w + 1, h, 0, KernelAccess::read_write));
+      },
+      "unpacked.position_depth");
 }
 
 TEST(GuiderMisuse, ConfigurationsTheDeviceCannotRunAreRefused) {

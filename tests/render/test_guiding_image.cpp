@@ -45,6 +45,7 @@ struct RunShape {
   bool pi_learning = false;      // the variance-aware mixing weight (GuidingSettings)
   FirstBounceMis first_bounce_mis = FirstBounceMis::bsdf;  // PathTracerSettings
   bool direct_light_in_vpls = true;                        // PathTracerSettings
+  HostTransfer transfer = HostTransfer::automatic;         // the guided first bounce's
 };
 
 // A guided sampler whose first-bounce samples claim a density 5% too high: every path that
@@ -83,7 +84,7 @@ TileSeries run(const Scene& scene, Method method, int size, int frames, ClRuntim
     GuidingSettings guiding;
     guiding.pi_learning = shape.pi_learning ? 1 : 0;
     std::unique_ptr<FirstBounceSampler> sampler =
-        std::make_unique<GuidedFirstBounce>(cl, size, size, guiding);
+        std::make_unique<GuidedFirstBounce>(cl, size, size, guiding, shape.transfer);
     if (method == Method::GuidedWithBias)
       sampler = std::make_unique<PdfTooHigh>(std::move(sampler));
     renderer.set_first_bounce_sampler(std::move(sampler));
@@ -282,6 +283,17 @@ TEST(GuidingImage, UnbiasedUnderALargeLightWithEitherMisDensity) {
   }
 }
 
+// The G-buffer packed on its way to the device (--host-transfer packed): the device samples with a
+// BSDF and a frame rounded to half floats and octahedral vectors, and returns the density of
+// what it did, so the image stays unbiased (kernels/shared/gbuffer_packing.h). Along the camera
+// path at 2 spp, the other host transfers' images being the same to the bit
+// (EveryHostTransferGivesTheSameImage).
+TEST(GuidingImage, UnbiasedWithThePackedGBufferAlongCameraPathAtTwoSpp) {
+  RunShape shape{2, "pan"};
+  shape.transfer = HostTransfer::packed;
+  expect_same_means("cornell-box.json", 120, 0.0015, shape);
+}
+
 TEST(GuidingImage, UnbiasedAlongCameraPathAtFourSpp) {
   expect_same_means("cornell-box.json", 60, 0.0015, RunShape{4, "pan"});
 }
@@ -314,11 +326,15 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
     HostTransfer transfer;
     bool mixture;  // the host announced as reading the mixture
   };
+  // The packed G-buffer (last) rounds what the device samples with: its image is checked for
+  // bias elsewhere (UnbiasedWithThePackedGBufferAlongCameraPathAtTwoSpp), its bytes here.
   const Case cases[] = {{HostTransfer::in_place, false}, {HostTransfer::pinned, false},
                         {HostTransfer::pageable, false}, {HostTransfer::automatic, false},
-                        {HostTransfer::in_place, true},  {HostTransfer::pinned, true}};
+                        {HostTransfer::in_place, true},  {HostTransfer::pinned, true},
+                        {HostTransfer::packed, false}};
   constexpr int kCases = static_cast<int>(std::size(cases));
   std::vector<glm::vec3> images[kCases];
+  HostTransfer used_by[kCases];
   for (int t = 0; t < kCases; ++t) {
     SCOPED_TRACE(std::string(host_transfer_name(cases[t].transfer)) +
                  (cases[t].mixture ? ", mixture read" : ""));
@@ -327,6 +343,7 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
                                                       GuidingSettings{}, cases[t].transfer);
     GuidedFirstBounce* sampler = guided.get();
     const HostTransfer used = guided->host_transfer();
+    used_by[t] = used;
     const double count_records = static_cast<double>(sampler->guider().sample_count_record_bytes() +
                                                      sampler->guider().train_count_record_bytes()) /
                                  (settings.width * settings.height);
@@ -338,20 +355,23 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
       EXPECT_EQ(stats.extra.at("zero_copy"), in_place ? 1.0 : 0.0);
       EXPECT_EQ(stats.extra.at("host_transfer"), static_cast<double>(used));
       // In place only the kernels' count records are copied; otherwise the G-buffer (96 bytes
-      // a pixel) and VPLs (32, packed) go up and each sample's direction, density and strategy (20)
-      // come down, with the mixture (24) where the host reads it (include/rtpg/guiding_layout.h).
+      // a pixel, 48 packed) and VPLs (32, packed) go up and each sample's direction, density and
+      // strategy (20) come down, with the mixture (24) where the host reads it
+      // (include/rtpg/guiding_layout.h).
       const double sample_bytes = cases[t].mixture ? 44.0 : 20.0;
+      const double gbuffer_bytes = used == HostTransfer::packed ? 48.0 : 96.0;
       EXPECT_DOUBLE_EQ(
           stats.extra.at("host_device_bytes_per_pixel"),
-          (in_place ? 0.0 : 96.0 + sample_bytes * settings.spp + 32.0) + count_records);
+          (in_place ? 0.0 : gbuffer_bytes + sample_bytes * settings.spp + 32.0) + count_records);
+      EXPECT_EQ(stats.time_ms.count("unpack"), used == HostTransfer::packed ? 1u : 0u);
     }
     if (cases[t].transfer == HostTransfer::automatic) {
-      // RTPG_HOST_TRANSFER chooses where set (the tests' second run sets it to pinned).
+      // RTPG_HOST_TRANSFER chooses where set (the tests' second run sets it to packed).
       const char* env = std::getenv("RTPG_HOST_TRANSFER");
       const HostTransfer expected = env && *env && std::string(env) != "auto"
                                         ? parse_host_transfer(env)
                                     : cl.info().host_unified_memory ? HostTransfer::in_place
-                                                                    : HostTransfer::pinned;
+                                                                    : HostTransfer::packed;
       EXPECT_EQ(used, expected);
     }
     const GBuffer& g = renderer.gbuffer();
@@ -370,6 +390,7 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
   }
   for (int t = 1; t < kCases; ++t) {
     ASSERT_EQ(images[0].size(), images[t].size());
+    if (used_by[t] == HostTransfer::packed) continue;
     std::size_t differ = 0;
     for (std::size_t i = 0; i < images[0].size(); ++i) differ += images[0][i] != images[t][i];
     EXPECT_EQ(differ, 0u) << host_transfer_name(cases[t].transfer)
