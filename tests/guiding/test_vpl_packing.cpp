@@ -10,19 +10,14 @@
 
 #include "rtpg/errors.h"
 #include "rtpg/vpl_packing.h"
+#include "support/angles.h"
 #include "shared/vpl_packing.h"
 
 using namespace rtpg::shared;
 
 namespace {
 
-// In double precision, by atan2 of the cross and dot products (a float dot product's rounding
-// alone would read as 3e-4 rad through acos near 1).
-double angle_between(float3 a, float3 b) {
-  const double ax = a.x, ay = a.y, az = a.z, bx = b.x, by = b.y, bz = b.z;
-  const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
-  return std::atan2(std::sqrt(cx * cx + cy * cy + cz * cz), ax * bx + ay * by + az * bz);
-}
+using rtpg::testing::angle_between;
 
 TEST(VplPacking, UnitVectorsWithinTheirAngularBound) {
   std::mt19937 gen(11);
