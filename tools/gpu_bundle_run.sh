@@ -10,8 +10,9 @@
 # rtpg renders FRAMES frames (default 24) of SCENES at RESOLUTIONS path-traced and guided with each
 # host transfer, and with SVGF, into OUT/frames/*.json (--stats-json; RUNS names them: off,
 # off-svgf, and each --host-transfer alone or with -svgf) with their table in OUT/frames.md
-# (gpu_frames_summary.py; ROUNDS repeats them, interleaved), and bench_svgf and bench_frame run on the Cornell box (not with
-# NO_BENCH). TESTS narrows the tests there too.
+# (gpu_frames_summary.py; ROUNDS repeats them, interleaved, into ...-RUN-rN.json), and
+# bench_svgf and bench_frame run on the Cornell box (not with NO_BENCH). TESTS narrows the tests
+# there too.
 # Exit status: the number of test binaries that failed, 0 if none.
 set -uo pipefail
 dir=$(cd "$(dirname "$0")" && pwd)
