@@ -5,6 +5,7 @@ the denoiser's median time per frame (docs/denoising.md, "Cost").
 
     python3 bench/svgf_tradeoffs.py                                  # cornell-box and sponza, 960x540
     python3 bench/svgf_tradeoffs.py --scenes cornell-box --frames 16
+    python3 bench/svgf_tradeoffs.py --variants "defaults (5 iterations)" "3x3 kernel (5 iterations)"
 
 References come from the suite's cache (bench/experiments.py --out, default build/bench-results):
 a full run of the suite leaves them there; a missing one is rendered (1024 spp, minutes).
@@ -23,6 +24,8 @@ VARIANTS = {
     "3 iterations": ["--svgf-iterations", 3],
     "2 iterations": ["--svgf-iterations", 2],
     "one pixel per work-item": ["--svgf-lanes", 1],
+    "3x3 kernel (5 iterations)": ["--svgf-atrous-radius", 1],
+    "3x3 kernel, 6 iterations": ["--svgf-atrous-radius", 1, "--svgf-iterations", 6],
 }
 
 
@@ -33,6 +36,8 @@ def main():
     ap.add_argument("--frames", type=int, default=32)
     ap.add_argument("--ref-spp", type=int, default=1024)
     ap.add_argument("--out", default=str(runner.ROOT / "build" / "bench-results"))
+    ap.add_argument("--variants", nargs="*", default=list(VARIANTS), choices=list(VARIANTS),
+                    help="which variants to run (default all)")
     args = ap.parse_args()
     out = Path(args.out)
     refs = runner.ReferenceCache(out / "references")
@@ -44,6 +49,8 @@ def main():
         exposure = runner.scene_exposure(scene)
         rows = {}
         for k, (name, flags) in enumerate(VARIANTS.items()):
+            if name not in args.variants:
+                continue
             stats, image = runner.render(scene, args.res, args.frames, "off", out / "svgf-tradeoffs" / scene,
                                          f"v{k}", extra=["--denoise", "svgf", *flags])
             img = metrics.load_exr(image)

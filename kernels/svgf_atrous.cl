@@ -18,6 +18,12 @@
 #include "shared/planar.h"
 #include "shared/svgf.h"
 
+/* The kernel's radius, a build option (SvgfSettings::atrous_radius): 2, the paper's 5x5, or 1,
+ * a 3x3 (pg_svgf_atrous_weight). Fixed at build time so that the tap loops stay unrolled. */
+#ifndef PG_SVGF_ATROUS_RADIUS
+#define PG_SVGF_ATROUS_RADIUS 2
+#endif
+
 /* clang-format off */
 __kernel void svgf_atrous(__global const float* in, __global float* out,
                           __global const float* surface, __global const float* depth_slope,
@@ -47,20 +53,22 @@ __kernel void svgf_atrous(__global const float* in, __global float* out,
   }
   float inverse_phi_l = pg_svgf_inverse_phi_luminance(sqrt(fmax(sum_gv / sum_g, 0.0f)), settings);
   float slope = depth_slope[i];
-  float inverse_phi_z[PG_SVGF_SQUARED_DISTANCES(2)];
-  pg_svgf_inverse_phi_depth_table(slope, sc.w, (float)step, 2, settings, inverse_phi_z);
+  float inverse_phi_z[PG_SVGF_SQUARED_DISTANCES(PG_SVGF_ATROUS_RADIUS)];
+  pg_svgf_inverse_phi_depth_table(slope, sc.w, (float)step, PG_SVGF_ATROUS_RADIUS, settings,
+                                  inverse_phi_z);
   float lc = pg_luminance(c.xyz);
   float3 sum_c = (float3)(0.0f);
   float sum_v = 0.0f, sum_w = 0.0f;
-  for (int dy = -2; dy <= 2; ++dy) {
+  for (int dy = -PG_SVGF_ATROUS_RADIUS; dy <= PG_SVGF_ATROUS_RADIUS; ++dy) {
     int qy = (int)y + dy * step;
     if (qy < 0 || qy >= (int)height) continue;
-    for (int dx = -2; dx <= 2; ++dx) {
+    for (int dx = -PG_SVGF_ATROUS_RADIUS; dx <= PG_SVGF_ATROUS_RADIUS; ++dx) {
       int qx = (int)x + dx * step;
       if (qx < 0 || qx >= (int)width) continue;
       uint j = (uint)qy * width + (uint)qx;
       float4 q = pg_planar_get(in, n, j);
-      float w = pg_svgf_b3(dx) * pg_svgf_b3(dy) *
+      float w = pg_svgf_atrous_weight(dx, PG_SVGF_ATROUS_RADIUS) *
+                pg_svgf_atrous_weight(dy, PG_SVGF_ATROUS_RADIUS) *
                 pg_svgf_edge_weight(sc, lc, pg_planar_get(surface, n, j), pg_luminance(q.xyz),
                                     inverse_phi_z[pg_svgf_squared_distance(dx, dy)], inverse_phi_l,
                                     settings);
@@ -69,6 +77,7 @@ __kernel void svgf_atrous(__global const float* in, __global float* out,
       sum_w += w;
     }
   }
-  /* sum_w >= 9/64: the centre's weight is b3(0)^2 exp(0). */
+  /* sum_w >= 9/64 (1/4 at radius 1): the centre's weight is its kernel weight squared times
+   * exp(0). */
   pg_planar_set(out, n, i, (float4)(sum_c / sum_w, sum_v / (sum_w * sum_w)));
 }

@@ -13,6 +13,12 @@
 
 #include "shared/planar.h"
 #include "shared/svgf.h"
+
+/* The kernel's radius, a build option (SvgfSettings::atrous_radius): 2, the paper's 5x5, or 1,
+ * a 3x3 (pg_svgf_atrous_weight). Fixed at build time so that the tap loops stay unrolled. */
+#ifndef PG_SVGF_ATROUS_RADIUS
+#define PG_SVGF_ATROUS_RADIUS 2
+#endif
 #include "wide/lanes.h"
 #include "wide/svgf_wide.h"
 
@@ -53,20 +59,22 @@ __kernel void svgf_atrous_wide(__global const float* in, __global float* out,
     pg_floatw inverse_phi_l = 1.0f / (settings.phi_luminance * sqrt(fmax(sum_gv / sum_g, 0.0f)) +
                                       PG_SVGF_LUMINANCE_EPSILON);
     pg_floatw slope = pg_load_row_floats(depth_slope + row_start, x0, w);
-    pg_floatw inverse_phi_z[PG_SVGF_SQUARED_DISTANCES(2)];
-    pg_svgf_inverse_phi_depth_table_w(slope, z_c, (float)step, 2, settings, inverse_phi_z);
+    pg_floatw inverse_phi_z[PG_SVGF_SQUARED_DISTANCES(PG_SVGF_ATROUS_RADIUS)];
+    pg_svgf_inverse_phi_depth_table_w(slope, z_c, (float)step, PG_SVGF_ATROUS_RADIUS, settings,
+                                      inverse_phi_z);
     pg_floatw luminance_c = pg_luminance3w(c);
-    for (int dy = -2; dy <= 2; ++dy) {
+    for (int dy = -PG_SVGF_ATROUS_RADIUS; dy <= PG_SVGF_ATROUS_RADIUS; ++dy) {
       int qy = y + dy * step;
       if (qy < 0 || qy >= h) continue;
-      for (int dx = -2; dx <= 2; ++dx) {
+      for (int dx = -PG_SVGF_ATROUS_RADIUS; dx <= PG_SVGF_ATROUS_RADIUS; ++dx) {
         int offset = dx * step;
         pg_float3w q, n_q;
         pg_floatw variance_q, z_q;
         pg_load_planar_row(in, n, qy * w, x0 + offset, w, &q, &variance_q);
         pg_load_planar_row(surface, n, qy * w, x0 + offset, w, &n_q, &z_q);
         pg_intw inside = (lane_x + offset >= 0) & (lane_x + offset < w);
-        pg_floatw weight = pg_svgf_b3(dx) * pg_svgf_b3(dy) *
+        pg_floatw weight = pg_svgf_atrous_weight(dx, PG_SVGF_ATROUS_RADIUS) *
+                           pg_svgf_atrous_weight(dy, PG_SVGF_ATROUS_RADIUS) *
                            pg_svgf_edge_weight_w(n_c, z_c, luminance_c, n_q, z_q, pg_luminance3w(q),
                                                  inverse_phi_z[pg_svgf_squared_distance(dx, dy)],
                                                  inverse_phi_l, settings);
@@ -77,8 +85,8 @@ __kernel void svgf_atrous_wide(__global const float* in, __global float* out,
       }
     }
   }
-  /* sum_w >= 9/64 where the centre has a surface: its weight is b3(0)^2 exp(0). Pixels without
-   * one keep their input. */
+  /* sum_w >= 9/64 (1/4 at radius 1) where the centre has a surface: its weight is its kernel
+   * weight squared times exp(0). Pixels without one keep their input. */
   pg_floatw safe_w = select((pg_floatw)(1.0f), sum_w, filtered);
   pg_float3w mean_c = pg_make_float3w(sum_c.x / safe_w, sum_c.y / safe_w, sum_c.z / safe_w);
   pg_float3w result = pg_select3w(c, mean_c, filtered);

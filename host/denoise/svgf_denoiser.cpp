@@ -56,8 +56,10 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
   variance_ = lanes_ > 1
                   ? runtime.kernel("svgf_variance_wide.cl", "svgf_variance_wide", wide_options)
                   : runtime.kernel("svgf_variance.cl", "svgf_variance", options);
-  atrous_ = lanes_ > 1 ? runtime.kernel("svgf_atrous_wide.cl", "svgf_atrous_wide", wide_options)
-                       : runtime.kernel("svgf_atrous.cl", "svgf_atrous", options);
+  const std::string radius = " -DPG_SVGF_ATROUS_RADIUS=" + std::to_string(settings.atrous_radius);
+  atrous_ = lanes_ > 1
+                ? runtime.kernel("svgf_atrous_wide.cl", "svgf_atrous_wide", wide_options + radius)
+                : runtime.kernel("svgf_atrous.cl", "svgf_atrous", options + radius);
   remodulate_ = runtime.kernel("svgf_remodulate.cl", "svgf_remodulate", options);
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   translate_cl_errors([&] {

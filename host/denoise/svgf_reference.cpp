@@ -233,10 +233,11 @@ void SvgfReference::atrous(const std::vector<glm::vec4>& in, std::vector<glm::ve
       const float lc = sh::pg_luminance(xyz(c));
       glm::vec3 sum_c(0.0f);
       float sum_v = 0.0f, sum_w = 0.0f;
-      for (int dy = -2; dy <= 2; ++dy) {
+      const int r = settings_.atrous_radius;
+      for (int dy = -r; dy <= r; ++dy) {
         const int qy = y + dy * step;
         if (qy < 0 || qy >= height_) continue;
-        for (int dx = -2; dx <= 2; ++dx) {
+        for (int dx = -r; dx <= r; ++dx) {
           const int qx = x + dx * step;
           if (qx < 0 || qx >= width_) continue;
           const std::size_t j = static_cast<std::size_t>(qy) * width_ + qx;
@@ -244,7 +245,7 @@ void SvgfReference::atrous(const std::vector<glm::vec4>& in, std::vector<glm::ve
           const float distance =
               static_cast<float>(step) * std::sqrt(static_cast<float>(dx * dx + dy * dy));
           const float w =
-              sh::pg_svgf_b3(dx) * sh::pg_svgf_b3(dy) *
+              sh::pg_svgf_atrous_weight(dx, r) * sh::pg_svgf_atrous_weight(dy, r) *
               sh::pg_svgf_edge_weight(sc, lc, surface_[j], sh::pg_luminance(xyz(q)),
                                       sh::pg_svgf_inverse_phi_depth(slope, sc.w, distance, s),
                                       inverse_phi_l, s);

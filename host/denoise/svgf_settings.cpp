@@ -39,6 +39,8 @@ const std::vector<SvgfSettingInfo>& svgf_settings_table() {
               "1: where no bilinear tap keeps history, the 3x3 neighbourhood's same-surface pixels "
               "(SVGF's reference implementation); 0: the history restarts there"),
       integer("iterations", &S::iterations, 1, 12, "A-trous iterations (steps 1, 2, 4, ...)"),
+      integer("atrous_radius", &S::atrous_radius, 1, 2,
+              "A-trous kernel radius: 2 the paper's 5x5 B3 spline, 1 a 3x3 (1/4, 1/2, 1/4)"),
       integer("history_iteration", &S::history_iteration, 0, 11,
               "The a-trous iteration (from 0) whose output is the next frame's history"),
       integer("local_x", &S::local_x, 0, 65536,

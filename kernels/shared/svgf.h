@@ -155,10 +155,12 @@ PG_FN float pg_svgf_blend(float history, float current, float weight_new) {
   return history + (current - history) * weight_new;
 }
 
-/* The 1D B3-spline weights of the 5x5 a-trous kernel at offset -2..2 (SVGF 4.3): 1/16, 1/4,
- * 3/8, 1/4, 1/16. */
-PG_FN float pg_svgf_b3(int offset) {
+/* The 1D weights of the a-trous kernel of radius 2, the paper's 5x5 B3 spline (SVGF 4.3: 1/16,
+ * 1/4, 3/8, 1/4, 1/16 at offsets -2..2), or of radius 1, a 3x3 kernel with the linear B-spline's
+ * 1/4, 1/2, 1/4 (SvgfSettings::atrous_radius; docs/denoising.md, "A 3x3 a-trous kernel"). */
+PG_FN float pg_svgf_atrous_weight(int offset, int radius) {
   int a = offset < 0 ? -offset : offset;
+  if (radius == 1) return a == 0 ? 0.5f : 0.25f;
   return a == 0 ? 0.375f : (a == 1 ? 0.25f : 0.0625f);
 }
 

@@ -115,11 +115,13 @@ void expect_close(const std::vector<glm::vec4>& device, const std::vector<glm::v
 
 struct Case {
   int width, height, local_x, local_y, lanes;
+  int atrous_radius = 2;
 };
 
 // Every stage of three frames of a panning camera, device against host, with the variance and
 // a-trous kernels one pixel per work-item and in vector lanes (widths that are not a multiple of
-// the lanes, images narrower than one work-item's lanes).
+// the lanes, images narrower than one work-item's lanes), with the paper's 5x5 a-trous kernel and
+// the 3x3 one.
 TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
   ClRuntime rt;
   std::vector<Case> cases = {{37, 23, 16, 16, 1},
@@ -133,7 +135,12 @@ TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
                              {37, 23, 16, 16, 0},
                              // Work-groups per device (rows on CPUs: host/cl/work_groups.h).
                              {37, 23, 0, 0, 0},
-                             {37, 23, 0, 0, 1}};
+                             {37, 23, 0, 0, 1},
+                             // The 3x3 a-trous kernel (SvgfSettings::atrous_radius 1).
+                             {37, 23, 16, 16, 1, 1},
+                             {37, 23, 4, 4, 16, 1},
+                             {40, 9, 7, 3, 8, 1},
+                             {1, 1, 8, 8, 16, 1}};
   if (!simulated(rt)) {
     cases.push_back({130, 71, 16, 8, 1});
     cases.push_back({130, 71, 16, 8, 16});
@@ -147,8 +154,9 @@ TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
   for (const Case& c : cases) {
     SCOPED_TRACE(std::to_string(c.width) + "x" + std::to_string(c.height) + ", local " +
                  std::to_string(c.local_x) + "x" + std::to_string(c.local_y) + ", lanes " +
-                 std::to_string(c.lanes));
+                 std::to_string(c.lanes) + ", a-trous radius " + std::to_string(c.atrous_radius));
     SvgfSettings s;
+    s.atrous_radius = c.atrous_radius;
     s.local_x = c.local_x;
     s.local_y = c.local_y;
     s.lanes = c.lanes;
@@ -186,56 +194,79 @@ TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
 }
 
 // A frame whose illumination is the same everywhere comes out as it went in, texture included:
-// every weight sums colours equal to the centre's.
+// every weight sums colours equal to the centre's (with either a-trous kernel).
 TEST(SvgfKernels, FlatIlluminationPassesThroughUnchanged) {
   ClRuntime rt;
   const int w = simulated(rt) ? 20 : 64, h = simulated(rt) ? 14 : 40;
-  SvgfDenoiser device(rt, w, h);
-  std::mt19937 rng(3);
-  for (int f = 0; f < 3; ++f) {
-    const GBuffer g = scene_gbuffer(w, h, 0.0f, rng);
-    std::vector<glm::vec4> colour(g.pixel_count());
-    for (std::size_t i = 0; i < colour.size(); ++i)
-      colour[i] =
-          g.has_surface(i)
-              ? glm::vec4(glm::vec3(g.base_color_roughness[i]) * 0.7f + glm::vec3(g.emission[i]),
-                          1.0f)
-              : g.emission[i];
-    const std::vector<glm::vec4> out = device.denoise(colour, g);
-    for (std::size_t i = 0; i < out.size(); ++i)
-      for (int c = 0; c < 3; ++c)
-        ASSERT_NEAR(out[i][c], colour[i][c], 1e-5f * std::max(1.0f, colour[i][c]))
-            << "frame " << f << " pixel " << i;
+  for (const int radius : {2, 1}) {
+    SCOPED_TRACE("a-trous radius " + std::to_string(radius));
+    SvgfSettings s;
+    s.atrous_radius = radius;
+    SvgfDenoiser device(rt, w, h, s);
+    std::mt19937 rng(3);
+    for (int f = 0; f < 3; ++f) {
+      const GBuffer g = scene_gbuffer(w, h, 0.0f, rng);
+      std::vector<glm::vec4> colour(g.pixel_count());
+      for (std::size_t i = 0; i < colour.size(); ++i)
+        colour[i] =
+            g.has_surface(i)
+                ? glm::vec4(glm::vec3(g.base_color_roughness[i]) * 0.7f + glm::vec3(g.emission[i]),
+                            1.0f)
+                : g.emission[i];
+      const std::vector<glm::vec4> out = device.denoise(colour, g);
+      for (std::size_t i = 0; i < out.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+          ASSERT_NEAR(out[i][c], colour[i][c], 1e-5f * std::max(1.0f, colour[i][c]))
+              << "frame " << f << " pixel " << i;
+    }
   }
 }
 
 // Two constant regions side by side: a depth step, then a normal step at equal depth. Neither
-// leaks into the other, though the a-trous taps reach 32 pixels across.
+// leaks into the other, though the a-trous taps reach 32 pixels across (16 with the 3x3 kernel).
 TEST(SvgfKernels, EdgesOfDepthAndNormalAreNotBlurred) {
   ClRuntime rt;
   const int w = simulated(rt) ? 24 : 80, h = simulated(rt) ? 8 : 24;
-  for (const bool normal_edge : {false, true}) {
-    SCOPED_TRACE(normal_edge ? "normal edge" : "depth edge");
-    GBuffer g;
-    g.resize(w, h);
-    std::vector<glm::vec4> colour(g.pixel_count());
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * w + x;
-        const bool right = x >= w / 2;
-        const float depth = right && !normal_edge ? 3.0f : 2.0f;
-        g.flags[i] = 0;
-        g.position_depth[i] = glm::vec4(0.01f * x, 0.01f * y, depth, depth);
-        g.shading_normal[i] = right && normal_edge ? glm::vec4(1, 0, 0, 0) : glm::vec4(0, 0, 1, 0);
-        g.base_color_roughness[i] = glm::vec4(0.5f, 0.5f, 0.5f, 0.5f);
-        colour[i] = right ? glm::vec4(2.0f, 1.0f, 0.5f, 1.0f) : glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
-      }
-    SvgfDenoiser device(rt, w, h);
-    const std::vector<glm::vec4> out = device.denoise(colour, g);
-    for (std::size_t i = 0; i < out.size(); ++i)
-      for (int c = 0; c < 3; ++c)
-        ASSERT_NEAR(out[i][c], colour[i][c], 1e-5f) << "pixel " << i % w << "," << i / w;
-  }
+  for (const int radius : {2, 1})
+    for (const bool normal_edge : {false, true}) {
+      SCOPED_TRACE(std::string(normal_edge ? "normal edge" : "depth edge") + ", a-trous radius " +
+                   std::to_string(radius));
+      GBuffer g;
+      g.resize(w, h);
+      std::vector<glm::vec4> colour(g.pixel_count());
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * w + x;
+          const bool right = x >= w / 2;
+          const float depth = right && !normal_edge ? 3.0f : 2.0f;
+          g.flags[i] = 0;
+          g.position_depth[i] = glm::vec4(0.01f * x, 0.01f * y, depth, depth);
+          g.shading_normal[i] =
+              right && normal_edge ? glm::vec4(1, 0, 0, 0) : glm::vec4(0, 0, 1, 0);
+          g.base_color_roughness[i] = glm::vec4(0.5f, 0.5f, 0.5f, 0.5f);
+          colour[i] = right ? glm::vec4(2.0f, 1.0f, 0.5f, 1.0f) : glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+        }
+      SvgfSettings s;
+      s.atrous_radius = radius;
+      SvgfDenoiser device(rt, w, h, s);
+      const std::vector<glm::vec4> out = device.denoise(colour, g);
+      for (std::size_t i = 0; i < out.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+          ASSERT_NEAR(out[i][c], colour[i][c], 1e-5f) << "pixel " << i % w << "," << i / w;
+    }
+}
+
+// The a-trous kernels' 1D weights (pg_svgf_atrous_weight, shared by the kernels and the host
+// reference, so the reference comparisons cannot see them): the paper's B3 spline at radius 2
+// (SVGF 4.3: 1/16, 1/4, 3/8, 1/4, 1/16), the linear B-spline at radius 1 (1/4, 1/2, 1/4); each
+// sums to 1, so a flat image passes through.
+TEST(SvgfKernels, AtrousWeightsAreTheSplines) {
+  const float b3[] = {0.0625f, 0.25f, 0.375f, 0.25f, 0.0625f};
+  const float linear[] = {0.25f, 0.5f, 0.25f};
+  for (int offset = -2; offset <= 2; ++offset)
+    EXPECT_EQ(shared::pg_svgf_atrous_weight(offset, 2), b3[offset + 2]) << offset;
+  for (int offset = -1; offset <= 1; ++offset)
+    EXPECT_EQ(shared::pg_svgf_atrous_weight(offset, 1), linear[offset + 1]) << offset;
 }
 
 // A static camera. The luminance moments are a purely temporal average: with alpha 0 the first
