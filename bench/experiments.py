@@ -14,6 +14,7 @@ the same command renders only the experiments (bench/compare.py compares two run
 """
 import argparse
 import json
+import shlex
 import statistics
 import subprocess
 import sys
@@ -274,7 +275,7 @@ def denoised(ctx, scene):
     for method in METHODS:
         noisy_path = out / f"{method}-noisy.exr"
         stats, image = runner.render(scene, m["res"], T, method, out, method, reference=ctx.reference(scene, m["res"]),
-                                     extra=["--denoise", "svgf", "--noisy-output", noisy_path])
+                                     extra=["--denoise", "svgf", "--noisy-output", noisy_path, *ctx.svgf_args])
         img, noisy = metrics.load_exr(image), metrics.load_exr(noisy_path)
         images[method] = img
         result["static"][method] = {
@@ -284,7 +285,8 @@ def denoised(ctx, scene):
     # SVGF's cost against the path-traced frame it filters (the renderer's part of "total").
     for res, method_stats in ((m["res"], result["static"]["off"]["time_ms"]), (m["svgf_large_res"], None)):
         if method_stats is None:
-            stats, _ = runner.render(scene, res, 4, "off", out, "cost-large", extra=["--denoise", "svgf"])
+            stats, _ = runner.render(scene, res, 4, "off", out, "cost-large",
+                                    extra=["--denoise", "svgf", *ctx.svgf_args])
             method_stats = {k: runner.median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}
         svgf = method_stats["svgf_total"]
         result["cost"][res] = {"svgf_ms": svgf, "pt_frame_ms": method_stats["total"] - svgf,
@@ -298,7 +300,7 @@ def denoised(ctx, scene):
         for method in METHODS:
             stats, image = runner.render(scene, m["path_res"], max(frames) + 1, method, out, f"path-{method}",
                                          extra=["--camera-path", name, "--denoise", "svgf",
-                                                "--save-frames", ",".join(map(str, frames))])
+                                                "--save-frames", ",".join(map(str, frames)), *ctx.svgf_args])
             imgs = {f: metrics.load_exr(runner.saved_frame(image, f)) for f in frames}
             flicker = [f["flicker_mse"] for f in stats["frames"] if "flicker_mse" in f]
             flicker_noisy = [f["flicker_mse_noisy"] for f in stats["frames"] if "flicker_mse_noisy" in f]
@@ -401,6 +403,8 @@ class Context:
     def __init__(self, args):
         self.quick = args.quick
         self.mode = dict(MODES["quick" if args.quick else "full"])
+        # Extra flags of every denoised render (--svgf-args, e.g. "--svgf-atrous-radius 1").
+        self.svgf_args = shlex.split(args.svgf_args or "")
         self.out = Path(args.out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.refs = runner.ReferenceCache(self.out / "references")
@@ -436,6 +440,8 @@ def main():
     ap.add_argument("--only", nargs="*", choices=list(EXPERIMENTS), default=list(EXPERIMENTS))
     ap.add_argument("--scenes", nargs="*", default=None, help="scene names, or 'all' (%s)" % ", ".join(ALL_SCENES))
     ap.add_argument("--report-from", help="only rewrite the report from this results.json")
+    ap.add_argument("--svgf-args", default="", help="extra rtpg flags of every denoised render, e.g. "
+                    "'--svgf-atrous-radius 1' (recorded in the results' settings)")
     args = ap.parse_args()
     from suite import report
     if args.report_from:
@@ -448,8 +454,10 @@ def main():
     scenes = ALL_SCENES if args.scenes == ["all"] else (args.scenes or ctx.mode["scenes"])
     command = "python3 bench/experiments.py" + (" --quick" if args.quick else "") + \
         (f" --only {' '.join(args.only)}" if args.only != list(EXPERIMENTS) else "") + \
-        (f" --scenes {' '.join(args.scenes)}" if args.scenes else "")
-    results = {"machine": runner.machine_info(), "mode": "quick" if args.quick else "full", "settings": {**ctx.mode, "equal_time_order": EQUAL_TIME_ORDER},
+        (f" --scenes {' '.join(args.scenes)}" if args.scenes else "") + \
+        (f" --svgf-args {shlex.quote(args.svgf_args)}" if args.svgf_args else "")
+    results = {"machine": runner.machine_info(), "mode": "quick" if args.quick else "full", "settings": {**ctx.mode, "equal_time_order": EQUAL_TIME_ORDER,
+                                                                                             "svgf_args": ctx.svgf_args},
                "command": command, "started": time.strftime("%Y-%m-%d %H:%M:%S"), "skipped_scenes": {},
                "experiments": {}, "seconds": {}}
     usable = []
