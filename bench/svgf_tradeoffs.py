@@ -24,8 +24,10 @@ VARIANTS = {
     "3 iterations": ["--svgf-iterations", 3],
     "2 iterations": ["--svgf-iterations", 2],
     "one pixel per work-item": ["--svgf-lanes", 1],
-    "3x3 kernel (5 iterations)": ["--svgf-atrous-radius", 1],
-    "3x3 kernel, 6 iterations": ["--svgf-atrous-radius", 1, "--svgf-iterations", 6],
+    "3x3 kernel (5 iterations)": ["--svgf-atrous-radius", 1, "--svgf-history-atrous-radius", 1],
+    "3x3 kernel, 6 iterations": ["--svgf-atrous-radius", 1, "--svgf-history-atrous-radius", 1,
+                                 "--svgf-iterations", 6],
+    "5x5 up to the history, 3x3 after": ["--svgf-atrous-radius", 1],
 }
 
 

@@ -56,17 +56,24 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
   variance_ = lanes_ > 1
                   ? runtime.kernel("svgf_variance_wide.cl", "svgf_variance_wide", wide_options)
                   : runtime.kernel("svgf_variance.cl", "svgf_variance", options);
-  const std::string radius = " -DPG_SVGF_ATROUS_RADIUS=" + std::to_string(settings.atrous_radius);
-  atrous_ = lanes_ > 1
-                ? runtime.kernel("svgf_atrous_wide.cl", "svgf_atrous_wide", wide_options + radius)
-                : runtime.kernel("svgf_atrous.cl", "svgf_atrous", options + radius);
+  // One build per kernel radius (a build option, so that the tap loops stay unrolled): the
+  // iterations up to the history iteration and those after it may differ.
+  const auto atrous_kernel = [&](int radius) {
+    const std::string r = " -DPG_SVGF_ATROUS_RADIUS=" + std::to_string(radius);
+    return lanes_ > 1 ? runtime.kernel("svgf_atrous_wide.cl", "svgf_atrous_wide", wide_options + r)
+                      : runtime.kernel("svgf_atrous.cl", "svgf_atrous", options + r);
+  };
+  atrous_ = atrous_kernel(settings.atrous_radius);
+  history_atrous_ = settings.history_atrous_radius == settings.atrous_radius
+                        ? atrous_
+                        : atrous_kernel(settings.history_atrous_radius);
   remodulate_ = runtime.kernel("svgf_remodulate.cl", "svgf_remodulate", options);
   const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   translate_cl_errors([&] {
     const std::vector<std::size_t> max_items =
         runtime.device().getInfo<CL_DEVICE_MAX_WORK_ITEM_SIZES>();
-    const std::size_t max_group =
-        largest_row_group(runtime.device(), {&temporal_, &variance_, &atrous_, &remodulate_});
+    const std::size_t max_group = largest_row_group(
+        runtime.device(), {&temporal_, &variance_, &atrous_, &history_atrous_, &remodulate_});
     // Temporal and remodulate read their own pixel (temporal also the bilinear taps of one
     // back-projected position); variance and a-trous filter neighbourhoods, from global memory.
     pixel_groups_ = resolve_work_groups(runtime.info(), settings.local_x, settings.local_y,
@@ -74,7 +81,7 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
     filter_groups_ = resolve_work_groups(runtime.info(), settings.local_x, settings.local_y,
                                          KernelReach::GlobalNeighbourhood, max_group);
     const std::size_t group = static_cast<std::size_t>(filter_groups_.x) * filter_groups_.y;
-    for (cl::Kernel* k : {&temporal_, &variance_, &atrous_, &remodulate_}) {
+    for (cl::Kernel* k : {&temporal_, &variance_, &atrous_, &history_atrous_, &remodulate_}) {
       const std::size_t limit = k->getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime.device());
       if (group > limit || static_cast<std::size_t>(filter_groups_.x) > max_items.at(0) ||
           static_cast<std::size_t>(filter_groups_.y) > max_items.at(1))
@@ -254,15 +261,16 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     const cl::Buffer* in = &illumination_[2];
     for (int k = 0; k < settings_.iterations; ++k) {
       const cl::Buffer* out = k == settings_.history_iteration ? &history_ : &illumination_[k % 2];
-      atrous_.setArg(0, *in);
-      atrous_.setArg(1, *out);
-      atrous_.setArg(2, surface_);
-      atrous_.setArg(3, depth_slope_);
-      atrous_.setArg(4, w);
-      atrous_.setArg(5, h);
-      atrous_.setArg(6, static_cast<cl_int>(1 << k));
-      atrous_.setArg(7, kernel_settings_);
-      atrous_ms += run(atrous_, lanes_, filter_groups_);
+      cl::Kernel& atrous = k <= settings_.history_iteration ? history_atrous_ : atrous_;
+      atrous.setArg(0, *in);
+      atrous.setArg(1, *out);
+      atrous.setArg(2, surface_);
+      atrous.setArg(3, depth_slope_);
+      atrous.setArg(4, w);
+      atrous.setArg(5, h);
+      atrous.setArg(6, static_cast<cl_int>(1 << k));
+      atrous.setArg(7, kernel_settings_);
+      atrous_ms += run(atrous, lanes_, filter_groups_);
       in = out;
     }
     filtered_ = in;

@@ -100,6 +100,9 @@ class SvgfDenoiser {
   std::unique_ptr<PinnedStaging> staging_;  // the uploads' way where !zero_copy_
   shared::pg_svgf_settings kernel_settings_;
   cl::Kernel temporal_, variance_, atrous_, remodulate_;
+  // The a-trous kernel of the iterations up to the history iteration (atrous_ itself where both
+  // radii are the same: SvgfSettings::history_atrous_radius).
+  cl::Kernel history_atrous_;
   std::array<Surfaces, 2> surfaces_;
   std::array<cl::Buffer, 2> moments_;  // this frame's and last frame's
   int current_ = 0;

@@ -72,7 +72,9 @@ const std::vector<glm::vec4>& SvgfReference::denoise(const std::vector<glm::vec4
   const std::vector<glm::vec4>* in = &illumination_;
   for (int k = 0; k < settings_.iterations; ++k) {
     std::vector<glm::vec4>& out = (k % 2 == 0) ? scratch_ : filtered_;
-    atrous(*in, out, 1 << k);
+    atrous(*in, out, 1 << k,
+           k <= settings_.history_iteration ? settings_.history_atrous_radius
+                                            : settings_.atrous_radius);
     if (k == settings_.history_iteration) history_ = out;
     in = &out;
   }
@@ -203,8 +205,8 @@ void SvgfReference::variance() {
     }
 }
 
-void SvgfReference::atrous(const std::vector<glm::vec4>& in, std::vector<glm::vec4>& out,
-                           int step) const {
+void SvgfReference::atrous(const std::vector<glm::vec4>& in, std::vector<glm::vec4>& out, int step,
+                           int radius) const {
   const sh::pg_svgf_settings& s = kernel_settings_;
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
@@ -233,7 +235,7 @@ void SvgfReference::atrous(const std::vector<glm::vec4>& in, std::vector<glm::ve
       const float lc = sh::pg_luminance(xyz(c));
       glm::vec3 sum_c(0.0f);
       float sum_v = 0.0f, sum_w = 0.0f;
-      const int r = settings_.atrous_radius;
+      const int r = radius;
       for (int dy = -r; dy <= r; ++dy) {
         const int qy = y + dy * step;
         if (qy < 0 || qy >= height_) continue;

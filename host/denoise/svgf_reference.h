@@ -30,7 +30,8 @@ class SvgfReference {
  private:
   void temporal(const std::vector<glm::vec4>& colour, const GBuffer& g);
   void variance();
-  void atrous(const std::vector<glm::vec4>& in, std::vector<glm::vec4>& out, int step) const;
+  void atrous(const std::vector<glm::vec4>& in, std::vector<glm::vec4>& out, int step,
+              int radius) const;
   void remodulate(const std::vector<glm::vec4>& colour, const GBuffer& g);
 
   int width_, height_;

@@ -40,7 +40,10 @@ const std::vector<SvgfSettingInfo>& svgf_settings_table() {
               "(SVGF's reference implementation); 0: the history restarts there"),
       integer("iterations", &S::iterations, 1, 12, "A-trous iterations (steps 1, 2, 4, ...)"),
       integer("atrous_radius", &S::atrous_radius, 1, 2,
-              "A-trous kernel radius: 2 the paper's 5x5 B3 spline, 1 a 3x3 (1/4, 1/2, 1/4)"),
+              "A-trous kernel radius after the history iteration: 2 the paper's 5x5 B3 spline, 1 a "
+              "3x3 (1/4, 1/2, 1/4)"),
+      integer("history_atrous_radius", &S::history_atrous_radius, 1, 2,
+              "A-trous kernel radius up to the history iteration (2 or 1, as atrous_radius)"),
       integer("history_iteration", &S::history_iteration, 0, 11,
               "The a-trous iteration (from 0) whose output is the next frame's history"),
       integer("local_x", &S::local_x, 0, 65536,

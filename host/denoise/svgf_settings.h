@@ -30,8 +30,11 @@ struct SvgfSettings {
   int history_fallback = 1;
   int iterations = 5;  // a-trous iterations (steps 1, 2, 4, ...)
   // The a-trous kernel's radius: 2, the paper's 5x5 B3 spline; 1, a 3x3 kernel (1/4, 1/2, 1/4)
-  // at 44% of the 5x5's cost per iteration (docs/denoising.md, "A 3x3 a-trous kernel").
+  // at 44% of the 5x5's cost per iteration (docs/denoising.md, "A 3x3 a-trous kernel"), in the
+  // iterations after history_iteration; history_atrous_radius in those up to it (whose output
+  // becomes next frame's history).
   int atrous_radius = 2;
+  int history_atrous_radius = 2;
   int history_iteration = 0;     // the iteration whose output is next frame's history
   int local_x = 0, local_y = 0;  // work-group size of the kernels; 0 and 0 = per device:
                                  // on CPUs temporal and remodulate in rows, the filters in

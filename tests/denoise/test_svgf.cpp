@@ -115,7 +115,7 @@ void expect_close(const std::vector<glm::vec4>& device, const std::vector<glm::v
 
 struct Case {
   int width, height, local_x, local_y, lanes;
-  int atrous_radius = 2;
+  int atrous_radius = 2, history_atrous_radius = 2;
 };
 
 // Every stage of three frames of a panning camera, device against host, with the variance and
@@ -136,11 +136,15 @@ TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
                              // Work-groups per device (rows on CPUs: host/cl/work_groups.h).
                              {37, 23, 0, 0, 0},
                              {37, 23, 0, 0, 1},
-                             // The 3x3 a-trous kernel (SvgfSettings::atrous_radius 1).
-                             {37, 23, 16, 16, 1, 1},
-                             {37, 23, 4, 4, 16, 1},
-                             {40, 9, 7, 3, 8, 1},
-                             {1, 1, 8, 8, 16, 1}};
+                             // The 3x3 a-trous kernel (SvgfSettings::atrous_radius 1) in every
+                             // iteration, and after the history iteration only.
+                             {37, 23, 16, 16, 1, 1, 1},
+                             {37, 23, 4, 4, 16, 1, 1},
+                             {40, 9, 7, 3, 8, 1, 1},
+                             {1, 1, 8, 8, 16, 1, 1},
+                             {37, 23, 16, 16, 1, 1, 2},
+                             {40, 9, 7, 3, 8, 1, 2},
+                             {37, 23, 4, 4, 16, 2, 1}};
   if (!simulated(rt)) {
     cases.push_back({130, 71, 16, 8, 1});
     cases.push_back({130, 71, 16, 8, 16});
@@ -154,9 +158,11 @@ TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
   for (const Case& c : cases) {
     SCOPED_TRACE(std::to_string(c.width) + "x" + std::to_string(c.height) + ", local " +
                  std::to_string(c.local_x) + "x" + std::to_string(c.local_y) + ", lanes " +
-                 std::to_string(c.lanes) + ", a-trous radius " + std::to_string(c.atrous_radius));
+                 std::to_string(c.lanes) + ", a-trous radius " + std::to_string(c.atrous_radius) +
+                 " (" + std::to_string(c.history_atrous_radius) + " up to the history)");
     SvgfSettings s;
     s.atrous_radius = c.atrous_radius;
+    s.history_atrous_radius = c.history_atrous_radius;
     s.local_x = c.local_x;
     s.local_y = c.local_y;
     s.lanes = c.lanes;
@@ -202,6 +208,7 @@ TEST(SvgfKernels, FlatIlluminationPassesThroughUnchanged) {
     SCOPED_TRACE("a-trous radius " + std::to_string(radius));
     SvgfSettings s;
     s.atrous_radius = radius;
+    s.history_atrous_radius = radius;
     SvgfDenoiser device(rt, w, h, s);
     std::mt19937 rng(3);
     for (int f = 0; f < 3; ++f) {
@@ -248,6 +255,7 @@ TEST(SvgfKernels, EdgesOfDepthAndNormalAreNotBlurred) {
         }
       SvgfSettings s;
       s.atrous_radius = radius;
+      s.history_atrous_radius = radius;
       SvgfDenoiser device(rt, w, h, s);
       const std::vector<glm::vec4> out = device.denoise(colour, g);
       for (std::size_t i = 0; i < out.size(); ++i)
