@@ -81,3 +81,22 @@ def downsample_box(image, factor):
         raise ValueError(f"{image.shape[1]}x{image.shape[0]} is not a multiple of {factor}")
     return image.reshape(h, factor, w, factor, -1).mean(axis=(1, 3)).astype(np.float32)
 
+
+def paired_ratio(base, other):
+    """Two runs that filtered or rendered the same frames (same seeds, one setting changed), frame
+    by frame: values base[i] and other[i] of frame i (None where a run has none). Returns the ratio
+    of the means, the mean of the per-frame ratios other / base with its standard error, how many
+    frames are higher in `other`, and the number of pairs. Paired, the frames' common noise cancels:
+    docs/denoising.md, "The rest of the suite" resolves a kernel change this way that the two runs'
+    own standard errors do not. Frames where base is 0 are left out of the per-frame ratios."""
+    pairs = [(a, b) for a, b in zip(base, other) if a is not None and b is not None]
+    if not pairs:
+        raise ValueError("no frame has a value in both runs")
+    ratios = [b / a for a, b in pairs if a != 0]
+    mean_ratio = float(np.mean(ratios)) if ratios else float("nan")
+    sem = float(np.std(ratios, ddof=1) / np.sqrt(len(ratios))) if len(ratios) > 1 else float("nan")
+    mean_base = float(np.mean([a for a, _ in pairs]))
+    ratio_of_means = float(np.mean([b for _, b in pairs])) / mean_base if mean_base != 0 else float("nan")
+    higher = sum(1 for a, b in pairs if b > a)
+    return {"ratio_of_means": ratio_of_means, "mean_ratio": mean_ratio, "sem": sem, "higher": higher,
+            "pairs": len(pairs)}

@@ -22,6 +22,23 @@ class MetricTests(unittest.TestCase):
         self.assertEqual(metrics.flip_hdr(r, r), 0.0)
         self.assertEqual(metrics.flicker([r, r, r]), 0.0)
 
+    def test_paired_ratio_compares_frame_by_frame(self):
+        base = [1.0, 2.0, None, 4.0]
+        other = [2.0, 4.0, 5.0, 8.0]  # twice base wherever both have a frame
+        r = metrics.paired_ratio(base, other)
+        self.assertEqual(r["pairs"], 3)
+        self.assertEqual(r["higher"], 3)
+        self.assertAlmostEqual(r["ratio_of_means"], 2.0)
+        self.assertAlmostEqual(r["mean_ratio"], 2.0)
+        self.assertAlmostEqual(r["sem"], 0.0)
+        # Common noise cancels: frames that vary 10x between them but keep a 1.1 ratio.
+        r = metrics.paired_ratio([1.0, 10.0, 0.5, 3.0], [1.1, 11.0, 0.55, 3.3])
+        self.assertAlmostEqual(r["mean_ratio"], 1.1)
+        self.assertLess(r["sem"], 1e-12)
+        self.assertEqual(metrics.paired_ratio([1.0, 2.0], [1.0, 1.0])["higher"], 0)
+        with self.assertRaises(ValueError):
+            metrics.paired_ratio([None], [1.0])
+
     def test_key_exposure_puts_the_lit_log_average_at_the_key(self):
         # Half the pixels at luminance 0.045 and half at 0.18: log-average 0.09, so exposure 2
         # (0.18 / 0.09); black background pixels are left out, a non-power of two rounds to one.
