@@ -26,11 +26,13 @@ DENOISER_ONLY = ("host/denoise/", "kernels/svgf_", "kernels/wide/svgf_wide.h", "
 DEVICE_ONLY = ("host/cl/", "host/guiding/", "kernels/wide/")
 # Host sources of the guided render alone: `rtpg reference` samples the first bounce with BsdfFirstBounce,
 # never the guided one and its device buffers (host/render/guided_first_bounce.*, include/rtpg/guider.h,
-# and the host-device copies of host/render/host_transfer.* and host/render/pinned_staging.*), and reports
-# no flicker (host/render/temporal_flicker.*). On 2026-11-26 two changes to these re-rendered every
-# reference of the suite.
+# the host-device copies of host/render/host_transfer.* and host/render/pinned_staging.*, and the G-buffer
+# packed for them by host/render/gbuffer_packer.* with kernels/shared/gbuffer_packing.h, which nothing else
+# includes), and reports no flicker (host/render/temporal_flicker.*). On 2026-11-26 two changes to these
+# re-rendered every reference of the suite, and on 2026-11-27 the packed G-buffer (docs/guiding.md).
 GUIDED_RENDER_ONLY = ("host/render/guided_first_bounce.", "host/render/temporal_flicker.", "include/rtpg/guider.h",
-                      "host/render/host_transfer.", "host/render/pinned_staging.")
+                      "host/render/host_transfer.", "host/render/pinned_staging.", "host/render/gbuffer_packer.",
+                      "kernels/shared/gbuffer_packing.h")
 
 
 def reference_independent(rel):

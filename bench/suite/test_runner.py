@@ -53,13 +53,15 @@ class ReferenceSourceTests(unittest.TestCase):
     def test_host_path_tracer_sources_count_and_device_only_ones_do_not(self):
         for rel in ("host/render/path_tracer.cpp", "host/scene/scene.cpp", "host/trace/embree_scene.cpp",
                     "host/app/commands.cpp", "kernels/shared/pmm.h", "kernels/shared/bsdf.h",
-                    "include/rtpg/guiding_layout.h"):
+                    "include/rtpg/guiding_layout.h", "kernels/shared/bit_packing.h",
+                    "kernels/shared/vpl_packing.h"):
             self.assertFalse(runner.reference_independent(rel), rel)
         for rel in ("kernels/train_wide.cl", "kernels/sample.cl", "kernels/wide/lanes.h", "host/guiding/guider.cpp",
                     "host/cl/device.cpp", "host/denoise/svgf_denoiser.cpp", "kernels/svgf_atrous.cl",
                     "kernels/shared/svgf.h", "host/render/guided_first_bounce.cpp",
                     "host/render/guided_first_bounce.h", "host/render/temporal_flicker.cpp", "include/rtpg/guider.h",
-                    "host/render/host_transfer.cpp", "host/render/pinned_staging.h"):
+                    "host/render/host_transfer.cpp", "host/render/pinned_staging.h",
+                    "host/render/gbuffer_packer.cpp", "kernels/shared/gbuffer_packing.h"):
             self.assertTrue(runner.reference_independent(rel), rel)
 
     def test_hash_moves_with_a_path_tracer_source_only(self):
