@@ -67,9 +67,8 @@ def main():
         if len(a) != len(b):
             raise SystemExit(f"{scene} {method}: {len(a)} frames against {len(b)}; not the same path")
         r = metrics.paired_ratio(a, b)
-        mean_a = sum(v for v in a if v is not None) / max(1, sum(v is not None for v in a))
-        mean_b = sum(v for v in b if v is not None) / max(1, sum(v is not None for v in b))
-        print(f"| {scene} | {METHODS[method]} | {mean_a:.4g} | {mean_b:.4g} | {r['ratio_of_means']:.3f} | "
+        print(f"| {scene} | {METHODS[method]} | {r['mean_base']:.4g} | {r['mean_other']:.4g} | "
+              f"{r['ratio_of_means']:.3f} | "
               f"{r['mean_ratio']:.3f} ({r['sem']:.3f}) | {r['higher']}/{r['pairs']} |")
 
 

@@ -98,5 +98,6 @@ def paired_ratio(base, other):
     mean_base = float(np.mean([a for a, _ in pairs]))
     ratio_of_means = float(np.mean([b for _, b in pairs])) / mean_base if mean_base != 0 else float("nan")
     higher = sum(1 for a, b in pairs if b > a)
-    return {"ratio_of_means": ratio_of_means, "mean_ratio": mean_ratio, "sem": sem, "higher": higher,
+    return {"mean_base": mean_base, "mean_other": float(np.mean([b for _, b in pairs])),
+            "ratio_of_means": ratio_of_means, "mean_ratio": mean_ratio, "sem": sem, "higher": higher,
             "pairs": len(pairs)}

@@ -29,6 +29,8 @@ class MetricTests(unittest.TestCase):
         self.assertEqual(r["pairs"], 3)
         self.assertEqual(r["higher"], 3)
         self.assertAlmostEqual(r["ratio_of_means"], 2.0)
+        self.assertAlmostEqual(r["mean_base"], 7.0 / 3.0)  # frames with a value in both runs only
+        self.assertAlmostEqual(r["mean_other"], 14.0 / 3.0)
         self.assertAlmostEqual(r["mean_ratio"], 2.0)
         self.assertAlmostEqual(r["sem"], 0.0)
         # Common noise cancels: frames that vary 10x between them but keep a 1.1 ratio.
