@@ -246,7 +246,7 @@ int run_render(const RenderCommand& command) {
   if (command.guiding == "pmm") {
     auto sampler = std::make_unique<GuidedFirstBounce>(
         cl, command.settings.width, command.settings.height, command.guiding_settings,
-        parse_host_transfer(command.host_transfer));
+        parse_host_transfer(command.host_transfer), parse_train_overlap(command.train_overlap));
     guided = sampler.get();
     renderer.set_first_bounce_sampler(std::move(sampler));
   }
@@ -298,7 +298,19 @@ int run_render(const RenderCommand& command) {
     m["render_time_ms"] = fmt::format("{:.3f}", totals.back());
     write_output(path, to_image(renderer, renderer.image()), cl, m, scene.exposure);
   };
+  // Each frame's wall time, from its start to the next frame's (the last frame's: to the end of
+  // the loop), in the stats JSON as wall_ms: everything the run does per frame, including what
+  // the frame's `total` leaves out (the statistics below) and the work that a device with cores
+  // of its own does beside the host (docs/guiding.md, "Training overlapped with the next frame,
+  // on a GPU").
+  using WallClock = std::chrono::steady_clock;
+  auto wall_ms_since = [](WallClock::time_point t) {
+    return std::chrono::duration<double, std::milli>(WallClock::now() - t).count();
+  };
+  WallClock::time_point frame_started{};
   for (int f = 0; f < command.frames; ++f) {
+    if (f > 0) frames.back()["wall_ms"] = wall_ms_since(frame_started);
+    frame_started = WallClock::now();
     FrameStats stats = renderer.render_frame(f);
     const std::vector<glm::vec3>& image = renderer.image();
     // The flicker metrics and their copies of last frame's images go only to the stats JSON.
@@ -381,6 +393,7 @@ int run_render(const RenderCommand& command) {
                   last_relmse >= 0.0 ? fmt::format(", relMSE {:.4g}", last_relmse).c_str() : "");
   }
 
+  if (!frames.empty()) frames.back()["wall_ms"] = wall_ms_since(frame_started);
   if (!command.output.empty()) write_frame(command.output, command.frames - 1);
   if (!command.noisy_output.empty()) write_noisy_frame(command.noisy_output, command.frames - 1);
   if (!command.stats_json.empty()) {

@@ -77,6 +77,12 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
                   "pixel instead of 96) or pageable")
       ->check(CLI::IsMember({"auto", "in-place", "pinned", "packed", "pageable"}))
       ->capture_default_str();
+  grp->add_option("--train-overlap", r.train_overlap,
+                  "Whether training runs on the device while the host makes the next frame's "
+                  "camera rays and G-buffer: auto (where the device has memory of its own), on "
+                  "or off")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
 }
 
 // "--svgf-" and the setting's name with '-' for '_', one flag per row of the denoiser's table

@@ -290,7 +290,8 @@ void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint3
 }
 
 void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::uint32_t seed,
-                   std::uint32_t frame) {
+                   std::uint32_t frame, TrainWait wait) {
+  wait_for_training();  // its time is recorded before this one's
   check_gbuffer(current, "current");
 #define RTPG_CHECK(name, type, bytes) check_buffer(vpls.name, bytes, "vpls." #name);
   PG_VPL_CHANNELS(RTPG_CHECK)
@@ -307,7 +308,23 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
          << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame) << kernel_settings_;
     if (train_lanes_ == 1) args << cl::Local(tile) << cl::Local(tile);
     args << cl::Local(train_launch_.group_items * PG_COUNT_RECORD_BYTES);
-    times_.train_ms = run(train_, train_launch_);
+    if (wait == TrainWait::finish) {
+      times_.train_ms = run(train_, train_launch_);
+      return;
+    }
+    runtime_.queue().enqueueNDRangeKernel(train_, cl::NullRange, train_launch_.global,
+                                          train_launch_.local, nullptr, &train_done_);
+    runtime_.queue().flush();  // so that it starts now, not at the next blocking call
+    train_pending_ = true;
+  });
+}
+
+void Guider::wait_for_training() {
+  if (!train_pending_) return;
+  train_pending_ = false;
+  translate_cl_errors([&] {
+    train_done_.wait();
+    times_.train_ms = ClRuntime::event_ms(train_done_);
   });
 }
 

@@ -78,24 +78,38 @@ void stage_packed_gbuffer(PinnedStaging& staging, const GBuffer& g,
 }  // namespace
 
 template <class Host, class Device>
-void GuidedFirstBounce::copy_to_device(const Host& host, const Device& device, std::size_t bytes) {
+void GuidedFirstBounce::copy_to_device(const Host& host, const Device& device, std::size_t bytes,
+                                       bool wait) {
   if (transfer_ == HostTransfer::pinned || transfer_ == HostTransfer::packed) {
     upload_staging_->begin();
     stage_channels(*upload_staging_, host, device);
   } else {
     enqueue_upload(runtime_.queue(), host, device);
   }
-  translate_cl_errors([&] { runtime_.queue().finish(); });
+  if (wait) translate_cl_errors([&] { runtime_.queue().finish(); });
   bytes_ += bytes;
 }
 
+TrainOverlap parse_train_overlap(const std::string& name) {
+  if (name == "auto") return TrainOverlap::automatic;
+  if (name == "on") return TrainOverlap::on;
+  if (name == "off") return TrainOverlap::off;
+  throw GuiderError("train overlap '" + name + "' is none of auto, on, off");
+}
+
 GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
-                                     const GuidingSettings& settings, HostTransfer transfer)
+                                     const GuidingSettings& settings, HostTransfer transfer,
+                                     TrainOverlap overlap)
     : runtime_(runtime),
       guider_(std::make_unique<Guider>(runtime, width, height, settings)),
       pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
   transfer_ = resolve_host_transfer(transfer, runtime.info().host_unified_memory);
   zero_copy_ = transfer_ == HostTransfer::in_place;
+  // automatic: only where the device has cores of its own to train on while the host works; on
+  // PoCL's CPU device the kernel and the host share the cores and overlapping saved nothing
+  // (docs/guiding.md, "Training overlapped with the next frame's host work").
+  overlap_ = overlap == TrainOverlap::on ||
+             (overlap == TrainOverlap::automatic && !runtime.info().host_unified_memory);
   packed_ = transfer_ == HostTransfer::packed;
   if (transfer_ == HostTransfer::pinned || packed_)
     upload_staging_ = std::make_unique<PinnedStaging>(
@@ -155,10 +169,30 @@ void GuidedFirstBounce::unmap_samples() {
   view_ = SampleView{};
 }
 
+void GuidedFirstBounce::finish_training() {
+  const auto t = Clock::now();
+  guider_->wait_for_training();
+  train_wait_ms_ = ms_since(t);
+  pending_vpls_ = GuiderVpls{};
+  bytes_ += guider_->train_count_record_bytes();  // what count_trained reads
+  trained_fraction_ =
+      surfaces_ ? static_cast<double>(guider_->count_trained()) / static_cast<double>(surfaces_)
+                : 0.0;
+}
+
 void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& at) {
+  bytes_ = 0;
+  // Last frame's training, left running by end_frame: the staging the G-buffer goes up through,
+  // and the host memory it read in place, are free once it is done. Its figures (train,
+  // trained_fraction) are reported with this frame's.
+  train_wait_ms_ = 0.0;
+  if (guider_->training_pending()) {
+    finish_training();
+  } else {
+    trained_fraction_ = 0.0;
+  }
   auto t = Clock::now();
   previous_gbuffer_ = current_gbuffer_;
-  bytes_ = 0;
   if (zero_copy_) {
     // The host wrote this G-buffer after last frame's buffers over it were released; had it
     // written last frame's, there would be no previous G-buffer left to reproject from.
@@ -191,7 +225,6 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   have_previous_ = true;
   readback_ms_ = 0.0;
   sample_ms_ = 0.0;
-  trained_fraction_ = 0.0;
 }
 
 void GuidedFirstBounce::expect_queries(const HostQueries& queries) {
@@ -286,14 +319,19 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   if (zero_copy_) {
     device_vpls = wrap_host_vpls(runtime_.context(), vpls);  // released when train is done
   } else {
-    copy_to_device(vpls, device_vpls, kVplBytes * g.pixel_count());
+    copy_to_device(vpls, device_vpls, kVplBytes * g.pixel_count(), /*wait=*/!overlap_);
   }
   upload_ms_ += ms_since(t);
+  if (overlap_) {
+    // Nothing touches the VPLs, their staging or this G-buffer before the next begin_frame
+    // waits: the renderer writes the other G-buffer next frame (in place) and rewrites the VPLs
+    // only after the next sample(), and begin_frame waits before staging anything.
+    pending_vpls_ = device_vpls;
+    guider_->train(current_gbuffer_, device_vpls, at.seed, at.frame, Guider::TrainWait::later);
+    return;
+  }
   guider_->train(current_gbuffer_, device_vpls, at.seed, at.frame);
-  bytes_ += guider_->train_count_record_bytes();  // what count_trained reads
-  trained_fraction_ =
-      surfaces_ ? static_cast<double>(guider_->count_trained()) / static_cast<double>(surfaces_)
-                : 0.0;
+  finish_training();
 }
 
 void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
@@ -303,6 +341,7 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   time_ms["sample"] = sample_ms_;
   time_ms["train"] = k.train_ms;
   time_ms["upload"] = upload_ms_;
+  if (overlap_) time_ms["train_wait"] = train_wait_ms_;
   if (packed_) time_ms["unpack"] = k.unpack_ms;
   time_ms["readback"] = readback_ms_;
   extra["guided_fraction"] = guided_fraction_;
@@ -313,6 +352,7 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   extra["sample_lanes"] = guider_->sample_lanes();
   extra["row_work_groups"] = guider_->row_work_groups() ? 1.0 : 0.0;
   extra["zero_copy"] = zero_copy_ ? 1.0 : 0.0;
+  extra["train_overlap"] = overlap_ ? 1.0 : 0.0;
   // HostTransfer as a number: 1 in place, 2 pinned, 3 pageable, 4 packed.
   extra["host_transfer"] = static_cast<double>(static_cast<int>(transfer_));
   extra["host_device_bytes_per_pixel"] =

@@ -17,13 +17,22 @@ namespace rtpg {
 class ClRuntime;
 class PinnedStaging;
 
+// Whether end_frame waits for training (off) or leaves it running on the device while the host
+// makes the next frame's camera rays and G-buffer (on); the next begin_frame waits for it
+// (docs/guiding.md, "Training overlapped with the next frame, on a GPU"). automatic: see
+// resolve_train_overlap.
+enum class TrainOverlap { automatic, on, off };
+// "auto", "on", "off" (the CLI's --train-overlap); throws GuiderError else.
+TrainOverlap parse_train_overlap(const std::string& name);
+
 class GuidedFirstBounce final : public FirstBounceSampler {
  public:
   // With HostTransfer::in_place (automatic on a device that shares host memory) the renderer
   // must alternate two G-buffers (reads_gbuffers_in_place()). automatic is resolved by
   // resolve_host_transfer (host/render/host_transfer.h).
   GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingSettings& settings,
-                    HostTransfer transfer = HostTransfer::automatic);
+                    HostTransfer transfer = HostTransfer::automatic,
+                    TrainOverlap overlap = TrainOverlap::automatic);
   ~GuidedFirstBounce() override;
 
   void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) override;
@@ -39,6 +48,7 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   // and nothing of it is copied or mapped; the statistics come from the kernels' counts.
   void expect_queries(const HostQueries& queries) override;
   HostTransfer host_transfer() const { return transfer_; }  // automatic resolved
+  bool overlaps_training() const { return overlap_; }       // TrainOverlap resolved
   // This frame's G-buffer on the device where begin_frame copied g there (not in place): the
   // denoiser reads it instead of copying it again (SvgfDenoiser::denoise). Valid until the next
   // begin_frame; nullptr for any other G-buffer.
@@ -58,10 +68,13 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   shared::pg_pmm_model model_at(std::size_t i) const;
   // surfaces_, guided_fraction_ and mean_pi_ from the counts of the last sample().
   void count_models();
-  // Copies a host G-buffer or VPL buffer into its device buffers (pinned or pageable), waits,
-  // and counts the bytes.
+  // Waits for the training end_frame left running (overlap_) and counts what it trained.
+  void finish_training();
+  // Copies a host G-buffer or VPL buffer into its device buffers (pinned or pageable), waits
+  // unless told not to (then the staging, or the pageable host memory, stays in use until the
+  // queue gets past the copy), and counts the bytes.
   template <class Host, class Device>
-  void copy_to_device(const Host& host, const Device& device, std::size_t bytes);
+  void copy_to_device(const Host& host, const Device& device, std::size_t bytes, bool wait = true);
 
   ClRuntime& runtime_;
   ClRuntime::Use runtime_use_{runtime_};  // the runtime must outlive this
@@ -75,7 +88,11 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   int owned_current_ = 0;
   bool have_previous_ = false;
   bool training_ = true;
-  GuiderVpls owned_vpls_;
+  // TrainOverlap resolved. While training runs past end_frame, pending_vpls_ holds the VPL
+  // buffers it reads (in place: the wrapper of the host's vector).
+  bool overlap_ = false;
+  GuiderVpls owned_vpls_, pending_vpls_;
+  double train_wait_ms_ = 0.0;  // how long begin_frame waited for the overlapped training
   GuiderSamples samples_;
   // Where the device shares host memory the samples are read in place (mapped from the time
   // sample() returns until the next sample() or the end). Elsewhere they are copied into

@@ -232,8 +232,19 @@ class Guider {
   void sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint32_t frame,
               std::uint32_t sample_index, const GuiderSamples& out,
               SampleOutputs outputs = SampleOutputs::directions_and_mixture);
+  // With TrainWait::finish (the default) train() returns when the kernel is done and its time
+  // is in last_times(). With TrainWait::later it returns once the kernel is enqueued (and the
+  // queue flushed): on a device with cores of its own it runs while the host goes on, and
+  // wait_for_training() waits for it and records its time. Everything the guider enqueues after
+  // it waits for it (one in-order queue), so the state that reproject, sample, read_state and
+  // count_trained see is the trained one either way; the caller must leave the G-buffer and the
+  // VPLs it read (and host memory they wrap) untouched until then.
+  enum class TrainWait { finish, later };
   void train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::uint32_t seed,
-             std::uint32_t frame);
+             std::uint32_t frame, TrainWait wait = TrainWait::finish);
+  // Waits for a train() enqueued with TrainWait::later (none pending: returns at once).
+  void wait_for_training();
+  bool training_pending() const { return train_pending_; }
 
   // The state, PG_STATE_FLOATS_PER_PIXEL floats per pixel (state0 then state1;
   // include/rtpg/guiding_layout.h).
@@ -291,7 +302,9 @@ class Guider {
   cl::Buffer sample_counts_, train_counts_;
   int current_ = 0;  // index of the buffers holding this frame's state
   cl::Kernel reproject_, sample_, train_;
-  cl::Kernel unpack_;  // built at the first unpack_gbuffer()
+  cl::Kernel unpack_;     // built at the first unpack_gbuffer()
+  cl::Event train_done_;  // the last train() enqueued with TrainWait::later
+  bool train_pending_ = false;
   GuiderTimes times_;
 };
 

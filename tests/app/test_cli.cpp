@@ -412,6 +412,9 @@ TEST_F(Cli, RenderOfDefaultSceneWritesExrAndStatistics) {
     for (const char* stage : {"primary", "gbuffer", "first_bounce", "trace", "shade", "compact"})
       stages += frame["time_ms"][stage].get<double>();
     EXPECT_LE(stages, frame["time_ms"]["total"].get<double>()) << "frame " << f;
+    // The frame's wall time runs from its start to the next frame's: it holds the frame.
+    ASSERT_TRUE(frame.contains("wall_ms")) << "frame " << f;
+    EXPECT_GE(frame["wall_ms"].get<double>(), frame["time_ms"]["total"].get<double>());
     ASSERT_TRUE(frame.contains("nonfinite_samples"));
     EXPECT_EQ(frame["nonfinite_samples"].get<long long>(), 0);
     EXPECT_FALSE(frame.contains("relmse")) << "relmse without a reference";

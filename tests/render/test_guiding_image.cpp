@@ -339,8 +339,11 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
     SCOPED_TRACE(std::string(host_transfer_name(cases[t].transfer)) +
                  (cases[t].mixture ? ", mixture read" : ""));
     Renderer renderer(scene, settings);
-    auto guided = std::make_unique<GuidedFirstBounce>(cl, settings.width, settings.height,
-                                                      GuidingSettings{}, cases[t].transfer);
+    // Training waited for, so that every frame reads the count records of its own training
+    // (TrainingOverlappedGivesTheSameImage checks the overlapped order).
+    auto guided =
+        std::make_unique<GuidedFirstBounce>(cl, settings.width, settings.height, GuidingSettings{},
+                                            cases[t].transfer, TrainOverlap::off);
     GuidedFirstBounce* sampler = guided.get();
     const HostTransfer used = guided->host_transfer();
     used_by[t] = used;
@@ -397,6 +400,67 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
                           << (cases[t].mixture ? ", mixture read" : "") << ": of "
                           << images[0].size() << " pixels";
   }
+}
+
+// Training left running on the device while the host makes the next frame's camera rays and
+// G-buffer (TrainOverlap::on, the default where the device has memory of its own) changes only
+// when the host waits for it: with every host transfer, along a moving camera at 2 spp and an odd
+// size, the image and the trained state are those of training waited for, to the bit, and each
+// frame reports the previous frame's training (its trained share, its kernel time, the wait).
+TEST(GuidingImage, TrainingOverlappedGivesTheSameImage) {
+  ClRuntime cl;
+  const Scene scene = load_scene(scene_file("cornell-box.json"));
+  RenderSettings settings;
+  settings.width = 37;
+  settings.height = 23;
+  settings.spp = 2;
+  settings.camera_path = scene.camera.paths.begin()->first;
+  constexpr int kFrames = 5;
+  for (HostTransfer transfer : {HostTransfer::in_place, HostTransfer::pinned,
+                                HostTransfer::pageable, HostTransfer::packed}) {
+    SCOPED_TRACE(host_transfer_name(transfer));
+    std::vector<glm::vec3> image[2];
+    std::vector<float> state[2];
+    std::vector<FrameStats> stats[2];
+    for (int overlapped = 0; overlapped < 2; ++overlapped) {
+      Renderer renderer(scene, settings);
+      auto guided = std::make_unique<GuidedFirstBounce>(
+          cl, settings.width, settings.height, GuidingSettings{}, transfer,
+          overlapped ? TrainOverlap::on : TrainOverlap::off);
+      GuidedFirstBounce* sampler = guided.get();
+      EXPECT_EQ(sampler->overlaps_training(), overlapped == 1);
+      renderer.set_first_bounce_sampler(std::move(guided));
+      for (int f = 0; f < kFrames; ++f) stats[overlapped].push_back(renderer.render_frame(f));
+      EXPECT_EQ(sampler->guider().training_pending(), overlapped == 1);
+      image[overlapped] = renderer.image();
+      sampler->guider().read_state(state[overlapped]);  // after the last frame's training
+    }
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < image[0].size(); ++i) differ += image[0][i] != image[1][i];
+    EXPECT_EQ(differ, 0u) << "of " << image[0].size() << " pixels";
+    EXPECT_EQ(state[0], state[1]);
+    for (int f = 0; f < kFrames; ++f) {
+      SCOPED_TRACE("frame " + std::to_string(f));
+      const FrameStats &waited = stats[0][f], &overlapped = stats[1][f];
+      EXPECT_EQ(waited.extra.at("train_overlap"), 0.0);
+      EXPECT_EQ(overlapped.extra.at("train_overlap"), 1.0);
+      EXPECT_EQ(waited.time_ms.count("train_wait"), 0u);
+      ASSERT_EQ(overlapped.time_ms.count("train_wait"), 1u);
+      EXPECT_GE(overlapped.time_ms.at("train_wait"), 0.0);
+      const double trained_before = f > 0 ? stats[0][f - 1].extra.at("trained_fraction") : 0.0;
+      EXPECT_EQ(overlapped.extra.at("trained_fraction"), trained_before);
+      EXPECT_EQ(overlapped.time_ms.at("train") > 0.0, f > 0);
+      // The count records of frame 0's training are read in frame 1.
+      if (f > 0)
+        EXPECT_DOUBLE_EQ(overlapped.extra.at("host_device_bytes_per_pixel"),
+                         waited.extra.at("host_device_bytes_per_pixel"));
+      else
+        EXPECT_LT(overlapped.extra.at("host_device_bytes_per_pixel"),
+                  waited.extra.at("host_device_bytes_per_pixel"));
+    }
+  }
+  EXPECT_THROW(parse_train_overlap("sometimes"), GuiderError);
+  EXPECT_EQ(parse_train_overlap("auto"), TrainOverlap::automatic);
 }
 
 // Every guiding setting at a value away from its default still trains and guides: the Cornell
