@@ -306,6 +306,16 @@ TEST(GuidingImage, RejectsAFivePercentPdfError) {
   EXPECT_LT(c.whole_relative_difference, 0.0);
 }
 
+// The transfer tests' frames: 37x23 at 2 spp along the scene's first camera path.
+RenderSettings odd_size_along_camera_path(const Scene& scene) {
+  RenderSettings settings;
+  settings.width = 37;
+  settings.height = 23;
+  settings.spp = 2;
+  settings.camera_path = scene.camera.paths.begin()->first;
+  return settings;
+}
+
 // Where the device shares host memory (as PoCL's CPU device does) the guided first bounce
 // reads the G-buffer and VPLs in place (the renderer alternating two G-buffers) and the host
 // reads the samples in place; elsewhere all three are copied. Both give the same image to the
@@ -317,11 +327,7 @@ TEST(GuidingImage, RejectsAFivePercentPdfError) {
 TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
   ClRuntime cl;
   const Scene scene = load_scene(scene_file("cornell-box.json"));
-  RenderSettings settings;
-  settings.width = 37;
-  settings.height = 23;
-  settings.spp = 2;
-  settings.camera_path = scene.camera.paths.begin()->first;
+  const RenderSettings settings = odd_size_along_camera_path(scene);
   struct Case {
     HostTransfer transfer;
     bool mixture;  // the host announced as reading the mixture
@@ -410,11 +416,7 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
 TEST(GuidingImage, TrainingOverlappedGivesTheSameImage) {
   ClRuntime cl;
   const Scene scene = load_scene(scene_file("cornell-box.json"));
-  RenderSettings settings;
-  settings.width = 37;
-  settings.height = 23;
-  settings.spp = 2;
-  settings.camera_path = scene.camera.paths.begin()->first;
+  const RenderSettings settings = odd_size_along_camera_path(scene);
   constexpr int kFrames = 5;
   for (HostTransfer transfer : {HostTransfer::in_place, HostTransfer::pinned,
                                 HostTransfer::pageable, HostTransfer::packed}) {
