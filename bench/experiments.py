@@ -15,7 +15,6 @@ the same command renders only the experiments (bench/compare.py compares two run
 import argparse
 import json
 import shlex
-import statistics
 import subprocess
 import sys
 import time
@@ -31,7 +30,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 ALL_SCENES = runner.SUITE_SCENES  # --scenes all
-METHODS = ("off", "pmm")
+METHODS = runner.METHODS
 LABEL = {"off": "PT", "pmm": "PG"}
 
 # res: equal frame, equal time, static convergence and flicker, against references of ref_spp.
@@ -170,21 +169,9 @@ def equal_time(ctx, scene):
     different seeds. Every figure is read off each run's own curve, then the median over the runs
     (suite/equal_time.py); the plot shows every run."""
     m = ctx.mode
-    ref_path = ctx.reference(scene, m["res"])
     out = ctx.out / "equal_time" / scene
-    curves = {method: {"runs": []} for method in METHODS}
-    # The methods alternate run by run (PT, PG, PT, PG, ...), so that a machine whose speed
-    # drifts during the experiment slows both alike rather than one method's block of runs.
-    for r in range(m["repeats"]):
-        for method in METHODS:
-            stats, _ = runner.render(scene, m["res"], m["time_frames"], method, out, f"{method}-r{r}",
-                                     reference=ref_path, extra=["--accumulate", "--seed", 100 + r])
-            ms = [f["time_ms"]["total"] for f in stats["frames"]]
-            # Frame 0 also builds the OpenCL programs (from the disk cache) and compiles
-            # work-group functions: a one-time start-up cost, replaced by a typical frame.
-            ms[0] = statistics.median(ms[1:]) if len(ms) > 1 else ms[0]
-            curves[method]["runs"].append({"time_ms": np.cumsum(ms).tolist(),
-                                           "relmse": [f["relmse_accumulated"] for f in stats["frames"]]})
+    curves = equal_time_figures.runs(scene, m["res"], m["time_frames"], m["repeats"], out,
+                                     ctx.reference(scene, m["res"]))
     fig, ax = plt.subplots(figsize=(5, 4))
     for i, (method, c) in enumerate(curves.items()):
         for j, run in enumerate(c["runs"]):
@@ -199,8 +186,7 @@ def equal_time(ctx, scene):
     plt.close(fig)
     # The error each method reaches within PT's time for all its frames, and the time PG needs to
     # reach the error PT ends with (ratio PG/PT: below 1, guiding pays for itself).
-    result = equal_time_figures.figures([(r["time_ms"], r["relmse"]) for r in curves["off"]["runs"]],
-                                        [(r["time_ms"], r["relmse"]) for r in curves["pmm"]["runs"]])
+    result = equal_time_figures.figures_of(curves)
     return {"scene": scene, "curves": curves, **result, "figure": str(out / "equal_time.png")}
 
 

@@ -17,27 +17,36 @@ The figures: PT's time budget is the median over PT runs of the time each took f
 and the target is the median of their final errors (PT at its own budget). PG's time to PT's error
 is the median over PG runs of the time each reaches the target; PG's error at PT's budget is the
 median over PG runs of each run's error at that time.
+
+`runs` makes the curves (PT and PG alternating, each run accumulating its frames against a
+reference) and `figures` reads them. Plain Python, no NumPy, so that the same experiment runs where
+no package can be installed (tools/gpu_equal_time.py, on the GPU bundle's machine).
 """
+import bisect
 import math
 import statistics
 
-import numpy as np
+from . import runner
 
 NOT_REACHED = "not reached"
 
 
 def check_curve(times, errors):
-    """(times, errors) as float arrays; ValueError unless both are finite and positive (their logs
-    are taken), of the same non-zero length, and the times strictly increase (they are cumulative)."""
-    times = np.asarray(times, dtype=np.float64)
-    errors = np.asarray(errors, dtype=np.float64)
-    if times.ndim != 1 or times.shape != errors.shape or times.size == 0:
-        raise ValueError(f"a curve needs as many times as errors, at least one: {times.shape}, {errors.shape}")
-    if not (np.all(np.isfinite(times)) and np.all(np.isfinite(errors))):
+    """(times, errors) as lists of floats; ValueError unless both are finite and positive (their
+    logs are taken), of the same non-zero length, and the times strictly increase (they are
+    cumulative)."""
+    try:
+        times = [float(t) for t in times]
+        errors = [float(e) for e in errors]
+    except TypeError:
+        raise ValueError("a curve's times and errors must be sequences of numbers") from None
+    if len(times) != len(errors) or not times:
+        raise ValueError(f"a curve needs as many times as errors, at least one: {len(times)}, {len(errors)}")
+    if not all(math.isfinite(v) for v in times + errors):
         raise ValueError("a curve with a NaN or infinite time or error")
-    if np.any(times <= 0.0) or np.any(errors <= 0.0):
+    if any(v <= 0.0 for v in times + errors):
         raise ValueError("times and errors must be positive (log-log interpolation)")
-    if np.any(np.diff(times) <= 0.0):
+    if any(b <= a for a, b in zip(times, times[1:])):
         raise ValueError("cumulative times must strictly increase")
     return times, errors
 
@@ -60,10 +69,9 @@ def time_to_reach(times, errors, target):
     earliest time measured); NOT_REACHED when no sample gets there."""
     times, errors = check_curve(times, errors)
     target = _check_value("target", target)
-    below = np.flatnonzero(errors <= target)
-    if below.size == 0:
+    i = next((k for k, e in enumerate(errors) if e <= target), None)
+    if i is None:
         return NOT_REACHED
-    i = int(below[0])
     if i == 0:
         return float(times[0])
     # Here the error is the abscissa: time as a power of error through the two samples.
@@ -77,7 +85,7 @@ def error_at_time(times, errors, t):
     t = _check_value("time", t)
     if t < times[0] or t > times[-1]:
         return NOT_REACHED
-    i = int(np.searchsorted(times, t))  # times[i - 1] < t <= times[i], or i = 0 when t = times[0]
+    i = bisect.bisect_left(times, t)  # times[i - 1] < t <= times[i], or i = 0 when t = times[0]
     if times[i] == t:
         return float(errors[i])
     return _log_lerp(times[i - 1], times[i], errors[i - 1], errors[i], t)
@@ -110,3 +118,29 @@ def figures(pt_runs, pg_runs):
                                     "pmm": median_over_runs(error_at_time(t, e, budget) for t, e in pg)},
             "pg_time_to_pt_error_ms": pg_time, "pg_time_to_pt_error_runs_ms": pg_times,
             "time_ratio_pg_pt": NOT_REACHED if pg_time == NOT_REACHED else pg_time / budget}
+
+
+def runs(scene, res, frames, repeats, out, reference, extra=()):
+    """The curves of `repeats` runs of each method (`rtpg render --accumulate --reference`, seeds
+    100, 101, ...), PT and PG alternating run by run, so that a machine whose speed drifts slows
+    both alike rather than one method's block of runs: {method: {"runs": [{"time_ms": cumulative
+    frame totals, "relmse": accumulated relMSE per frame}]}}. Frame 0 also builds the OpenCL
+    programs (from the disk cache) and compiles work-group functions, a one-time start-up cost, so
+    its time is replaced by the median frame's. `extra`: more rtpg arguments for both methods."""
+    curves = {method: {"runs": []} for method in runner.METHODS}
+    for r in range(repeats):
+        for method in runner.METHODS:
+            stats, _ = runner.render(scene, res, frames, method, out, f"{method}-r{r}", reference=reference,
+                                     extra=["--accumulate", "--seed", 100 + r, *extra])
+            ms = [f["time_ms"]["total"] for f in stats["frames"]]
+            ms[0] = statistics.median(ms[1:]) if len(ms) > 1 else ms[0]
+            cumulative = [sum(ms[:k + 1]) for k in range(len(ms))]
+            curves[method]["runs"].append({"time_ms": cumulative,
+                                           "relmse": [f["relmse_accumulated"] for f in stats["frames"]]})
+    return curves
+
+
+def figures_of(curves):
+    """figures() of the curves `runs` made."""
+    return figures([(r["time_ms"], r["relmse"]) for r in curves["off"]["runs"]],
+                   [(r["time_ms"], r["relmse"]) for r in curves["pmm"]["runs"]])

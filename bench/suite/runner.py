@@ -30,6 +30,7 @@ DEVICE_ONLY = ("host/cl/", "host/guiding/", "kernels/wide/")
 # packed for them by host/render/gbuffer_packer.* with kernels/shared/gbuffer_packing.h, which nothing else
 # includes), and reports no flicker (host/render/temporal_flicker.*). On 2026-11-26 two changes to these
 # re-rendered every reference of the suite, and on 2026-11-27 the packed G-buffer (docs/guiding.md).
+METHODS = ("off", "pmm")  # path tracing and PMM path guiding: the values of rtpg render --guiding
 GUIDED_RENDER_ONLY = ("host/render/guided_first_bounce.", "host/render/temporal_flicker.", "include/rtpg/guider.h",
                       "host/render/host_transfer.", "host/render/pinned_staging.", "host/render/gbuffer_packer.",
                       "kernels/shared/gbuffer_packing.h")
