@@ -87,13 +87,16 @@ class Renderer {
   std::unique_ptr<TriangleTable> triangles_;  // built with the BVH, from the same positions
   std::unique_ptr<Lights> lights_;
   std::unique_ptr<PathTracer> path_tracer_;
-  std::unique_ptr<FirstBounceSampler> sampler_;
   // The frame's G-buffer is gbuffers_[current_gbuffer_]; the second is allocated only for a
   // sampler that reads G-buffers in place (FirstBounceSampler::reads_gbuffers_in_place), and
   // then the frames alternate between the two.
   GBuffer gbuffers_[2];
   int current_gbuffer_ = 0;
   VplBuffer vpls_;
+  // Declared after the buffers it may read, so that it is destroyed before them: a guided
+  // sampler can leave the last frame's training running on the device, reading the G-buffer and
+  // the VPLs in place, and its destructor waits for it (GuidedFirstBounce, TrainOverlap).
+  std::unique_ptr<FirstBounceSampler> sampler_;
   std::vector<glm::vec3> image_, pass_;
   std::vector<Ray> camera_rays_;
   std::vector<Hit> camera_hits_;

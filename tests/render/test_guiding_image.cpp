@@ -465,6 +465,29 @@ TEST(GuidingImage, TrainingOverlappedGivesTheSameImage) {
   EXPECT_EQ(parse_train_overlap("auto"), TrainOverlap::automatic);
 }
 
+// A renderer destroyed right after a frame whose training it left running (TrainOverlap::on)
+// waits for that training before its host buffers go: read in place, the train kernel reads the
+// renderer's VPL and G-buffer memory, which large images allocate by mmap and free by munmap.
+TEST(GuidingImage, RendererDestroyedWhileTrainingRuns) {
+  ClRuntime cl;
+  const Scene scene = load_scene(scene_file("cornell-box.json"));
+  RenderSettings settings;
+  settings.width = 480;
+  settings.height = 270;
+  for (HostTransfer transfer : {HostTransfer::in_place, HostTransfer::pageable}) {
+    for (int run = 0; run < 8; ++run) {
+      Renderer renderer(scene, settings);
+      auto guided = std::make_unique<GuidedFirstBounce>(
+          cl, settings.width, settings.height, GuidingSettings{}, transfer, TrainOverlap::on);
+      GuidedFirstBounce* sampler = guided.get();
+      renderer.set_first_bounce_sampler(std::move(guided));
+      renderer.render_frame(0);
+      renderer.render_frame(1);
+      ASSERT_TRUE(sampler->guider().training_pending());
+    }
+  }
+}
+
 // Every guiding setting at a value away from its default still trains and guides: the Cornell
 // box at 48x27, six frames, each row of guiding_settings_table() changed alone (the work-group
 // size in both directions at once). A setting whose value silently stopped all training went
