@@ -19,8 +19,9 @@ class PinnedStaging;
 
 // Whether end_frame waits for training (off) or leaves it running on the device while the host
 // makes the next frame's camera rays and G-buffer (on); the next begin_frame waits for it
-// (docs/guiding.md, "Training overlapped with the next frame, on a GPU"). automatic: see
-// resolve_train_overlap.
+// (docs/guiding.md, "Training overlapped with the next frame, on a GPU"). automatic: on where
+// the device has memory of its own (not DeviceInfo::host_unified_memory), off where its kernels
+// share the host's cores (PoCL), where overlapping saved nothing.
 enum class TrainOverlap { automatic, on, off };
 // "auto", "on", "off" (the CLI's --train-overlap); throws GuiderError else.
 TrainOverlap parse_train_overlap(const std::string& name);
@@ -68,7 +69,8 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   shared::pg_pmm_model model_at(std::size_t i) const;
   // surfaces_, guided_fraction_ and mean_pi_ from the counts of the last sample().
   void count_models();
-  // Waits for the training end_frame left running (overlap_) and counts what it trained.
+  // Waits for the last training (at once where end_frame waited for it) and reads back what it
+  // trained, for trained_fraction.
   void finish_training();
   // Copies a host G-buffer or VPL buffer into its device buffers (pinned or pageable), waits
   // unless told not to (then the staging, or the pageable host memory, stays in use until the
