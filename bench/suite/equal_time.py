@@ -23,6 +23,7 @@ reference) and `figures` reads them. Plain Python, no NumPy, so that the same ex
 no package can be installed (tools/gpu_equal_time.py, on the GPU bundle's machine).
 """
 import bisect
+import itertools
 import math
 import statistics
 
@@ -134,8 +135,7 @@ def runs(scene, res, frames, repeats, out, reference, extra=()):
                                      extra=["--accumulate", "--seed", 100 + r, *extra])
             ms = [f["time_ms"]["total"] for f in stats["frames"]]
             ms[0] = statistics.median(ms[1:]) if len(ms) > 1 else ms[0]
-            cumulative = [sum(ms[:k + 1]) for k in range(len(ms))]
-            curves[method]["runs"].append({"time_ms": cumulative,
+            curves[method]["runs"].append({"time_ms": list(itertools.accumulate(ms)),
                                            "relmse": [f["relmse_accumulated"] for f in stats["frames"]]})
     return curves
 
