@@ -51,7 +51,8 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
       ->capture_default_str();
   cmd->add_option("--first-bounce-mis", r.first_bounce_mis,
                   "With --guiding pmm and next-event estimation: the density the primary hit's "
-                  "light sample and first bounce weigh each other with: bsdf (the BSDF's; the "
+                  "light sample and first bounce weigh each other with, and with "
+                  "--guide-vertices all a guided later vertex's: bsdf (the BSDF's; the "
                   "mixture is not evaluated for the light sample) or mixture (the guided "
                   "mixture's); both unbiased")
       ->check(CLI::IsMember({"mixture", "bsdf"}))

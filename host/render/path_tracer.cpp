@@ -32,8 +32,11 @@ constexpr std::size_t kGrain = 2048;
 constexpr int kNextEventDraws = 3;
 constexpr int kBounceDraws = 4;
 // How many vertices ahead the shading loop starts loading the pixel a later vertex borrows
-// from (prefetch_borrowable).
+// from (prefetch_borrowable), and the ring of those pixels' indices (a power of two above it).
 constexpr std::size_t kPrefetchAhead = 4;
+constexpr std::size_t kBorrowRing = 8;
+static_assert(kBorrowRing > kPrefetchAhead && (kBorrowRing & (kBorrowRing - 1)) == 0,
+              "the ring holds the vertices between a prefetch and its use");
 // How many vertices ahead the shading loop starts loading a path's state: after compaction
 // the live paths' pixels are sparse, and a state read cold stalled the loop on its first field
 // (prefetch_path).
@@ -312,14 +315,17 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
   std::atomic<std::uint64_t> guided_vertices{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
     std::uint64_t guided_here = 0;
+    // The pixel each of the next vertices projects to, found once where its entry is
+    // prefetched.
+    std::size_t borrow_from[kBorrowRing];
     if (settings_.guide_secondary) {
       for (std::size_t j = range.begin(); j < std::min(range.end(), range.begin() + kPrefetchAhead);
            ++j)
-        prefetch_borrowable(j);
+        borrow_from[j % kBorrowRing] = prefetch_borrowable(j);
     }
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
       if (settings_.guide_secondary && j + kPrefetchAhead < range.end())
-        prefetch_borrowable(j + kPrefetchAhead);
+        borrow_from[(j + kPrefetchAhead) % kBorrowRing] = prefetch_borrowable(j + kPrefetchAhead);
       if (j + kPathPrefetchAhead < range.end()) prefetch_path(active_[j + kPathPrefetchAhead]);
       if (prefetch_surfaces_)
         prefetch_surfaces_ahead(scene_, triangles_, hits_.data(), j, range.end());
@@ -387,14 +393,19 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       // A borrowed lobe is the lending pixel's product of incident light and its BSDF for its
       // own view direction: it carries over to a vertex whose reflection is mostly diffuse
       // (view-independent), not to a glossy one seen from elsewhere.
-      const bool guided =
-          settings_.guide_secondary && lobes.p_specular <= 0.5f && borrow_guide(sp, guide);
+      const bool guided = settings_.guide_secondary && lobes.p_specular <= 0.5f &&
+                          borrow_guide(borrow_from[j % kBorrowRing], sp, guide);
       guided_here += guided;
-      // Beyond the first bounce the vertex's sampler competes with the light: its BSDF, or
-      // the borrowed guide's mixture.
+      // Beyond the first bounce the vertex's sampler competes with the light. The density
+      // they weigh each other with: the BSDF's, or at a guided vertex the borrowed guide's
+      // mixture, unless first_bounce_mis says the BSDF's there too (as at the primary hit:
+      // the same function of the direction on both sides, so the weights still sum to one;
+      // docs/guiding.md, "Later vertices weighed by the BSDF's density").
+      const bool mis_with_bsdf = guided && settings_.first_bounce_mis == FirstBounceMis::bsdf;
       const auto vertex_pdf = [&](const glm::vec3& w, const glm::vec3& wi) {
         const float bsdf = shared::pg_bsdf_pdf(lobes, wo, wi);
-        return guided ? guide_density(guide, w, bsdf) : bsdf;
+        if (!guided) return bsdf;
+        return mis_with_bsdf ? bsdf_mis_density(bsdf) : guide_density(guide, w, bsdf);
       };
       glm::vec3 c;
       if (nee && next_event(sp.position, sp.geometric_normal, frame, wo, lobes, origin, u_sel, u1,
@@ -408,6 +419,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       p.rng = shared_y ? own.state : rng.state;
       shared::pg_bsdf_sample_t bs;
       glm::vec3 wi_world;
+      float mis_pdf = 0.0f;  // the density the hit's MIS weight uses (vertex_pdf's function)
       if (!guided) {
         bs = shared::pg_bsdf_sample(lobes, wo, u_lobe, v1, v2);
         if (bs.pdf <= 0.0f) continue;
@@ -430,8 +442,10 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
           wi_world = shared::pg_to_world(frame, bs.wi);
         }
         if (bs.wi.z <= 0.0f) continue;
-        bs.pdf = guide_density(guide, wi_world, shared::pg_bsdf_pdf(lobes, wo, bs.wi));
+        const float bsdf_pdf = shared::pg_bsdf_pdf(lobes, wo, bs.wi);
+        bs.pdf = guide_density(guide, wi_world, bsdf_pdf);
         if (!(bs.pdf > 0.0f)) continue;
+        if (mis_with_bsdf) mis_pdf = bsdf_mis_density(bsdf_pdf);
       }
       if (glm::dot(wi_world, sp.geometric_normal) <= 0.0f) continue;
       const glm::vec3 weight = shared::pg_bsdf_eval(lobes, wo, bs.wi) * (bs.wi.z / bs.pdf);
@@ -447,7 +461,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       }
       const glm::vec3 from_camera = to_y * p.throughput;
       if (is_black(from_camera) || !is_finite(from_camera)) continue;
-      p.prev_pdf = bs.pdf;
+      p.prev_pdf = mis_with_bsdf ? mis_pdf : bs.pdf;
       p.prev_position = sp.position;
       set_ray(rays_[j], origin, wi_world, 0.0f, 1e30f);
       alive_[j] = 1;
@@ -497,16 +511,16 @@ void PathTracer::prefetch_path(std::uint32_t i) const {
   if (keep_vpls_) __builtin_prefetch(&vpl_paths_[i]);
 }
 
-void PathTracer::prefetch_borrowable(std::size_t j) const {
+std::size_t PathTracer::prefetch_borrowable(std::size_t j) const {
   const Hit& hit = hits_[j];
-  if (!hit.valid()) return;
+  if (!hit.valid()) return kNotOnScreen;
   const Ray& ray = rays_[j];
   const std::size_t i = borrowable_index(ray.origin + ray.direction * hit.t);
   if (i != kNotOnScreen) __builtin_prefetch(&borrowable_[i]);
+  return i;
 }
 
-bool PathTracer::borrow_guide(const SurfacePoint& sp, PixelGuide& guide) const {
-  const std::size_t i = borrowable_index(sp.position);
+bool PathTracer::borrow_guide(std::size_t i, const SurfacePoint& sp, PixelGuide& guide) const {
   if (i == kNotOnScreen) return false;
   const BorrowablePixel& b = borrowable_[i];
   const GBuffer& g = *gbuffer_;

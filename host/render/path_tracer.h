@@ -184,16 +184,17 @@ class PathTracer {
   // The pixel a world position projects to in this frame's camera, or kNotOnScreen.
   static constexpr std::size_t kNotOnScreen = ~std::size_t{0};
   std::size_t borrowable_index(const glm::vec3& position) const;
-  // Starts loading the borrowable pixel that the hit of slot j projects to, a few vertices
-  // before borrow_guide() reads it: later vertices land all over the image, and a table entry
-  // read cold stalls the shading loop for a whole cache miss (docs/guiding.md, "Later
-  // vertices, revisited").
-  void prefetch_borrowable(std::size_t j) const;
+  // The pixel the hit of slot j projects to (kNotOnScreen for none), whose borrowable entry
+  // it starts loading: the shading loop asks a few vertices before borrow_guide() reads it,
+  // since later vertices land all over the image and a table entry read cold stalls the loop
+  // for a whole cache miss (docs/guiding.md, "Later vertices, revisited").
+  std::size_t prefetch_borrowable(std::size_t j) const;
   // Starts loading path i's PathState (and VplPath where VPLs are kept) a few vertices before
   // the shading loop reads it.
   void prefetch_path(std::uint32_t i) const;
-  // The guide of the pixel that shows surface point sp, if any (guide_secondary).
-  bool borrow_guide(const SurfacePoint& sp, PixelGuide& guide) const;
+  // The guide of pixel i (from prefetch_borrowable) if it shows surface point sp
+  // (guide_secondary).
+  bool borrow_guide(std::size_t i, const SurfacePoint& sp, PixelGuide& guide) const;
   // Pixel estimates (non-finite ones dropped and counted) and the VPLs' radiance.
   void gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite) const;
 

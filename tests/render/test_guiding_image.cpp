@@ -261,24 +261,30 @@ TEST(GuidingImage, UnbiasedWithLearnedMixingWeightAlongCameraPathAtTwoSpp) {
 // seen, where the small light's were not: its light sample's density dwarfs both others. The
 // third run leaves the light y emits out of the VPLs (--guide-direct-light off), so that the
 // pixel keeps it apart from its path (PathTracer::VplPath; mutant vpl-left-out-light-unweighted).
+// The last two guide later vertices too (--guide-vertices all), whose light sample and bounce
+// weigh each other with the same density as the primary hit's.
 TEST(GuidingImage, UnbiasedUnderALargeLightWithEitherMisDensity) {
   Scene scene = load_scene(scene_file("cornell-box.json"));
   test::resize_emitters(scene, 3.6f, 1.0f / (3.6f * 3.6f));
   struct Variant {
     FirstBounceMis mis;
     bool direct_light_in_vpls;
+    bool guide_secondary;
   };
   for (const Variant v :
-       {Variant{FirstBounceMis::mixture, true}, Variant{FirstBounceMis::bsdf, true},
-        Variant{FirstBounceMis::bsdf, false}}) {
+       {Variant{FirstBounceMis::mixture, true, false}, Variant{FirstBounceMis::bsdf, true, false},
+        Variant{FirstBounceMis::bsdf, false, false}, Variant{FirstBounceMis::mixture, true, true},
+        Variant{FirstBounceMis::bsdf, true, true}}) {
     RunShape shape{2, "pan"};
     shape.first_bounce_mis = v.mis;
     shape.direct_light_in_vpls = v.direct_light_in_vpls;
+    shape.guide_secondary = v.guide_secondary;
     const Comparison c =
         compare_means("cornell-box.json, large light", scene, Method::Guided, 120, shape);
     for (const std::string& r : c.rejected)
       ADD_FAILURE() << "mis " << static_cast<int>(v.mis) << ", direct light in VPLs "
-                    << v.direct_light_in_vpls << ": " << r;
+                    << v.direct_light_in_vpls << ", later vertices guided " << v.guide_secondary
+                    << ": " << r;
     EXPECT_LE(c.whole_relative_se, 0.0015);
   }
 }
