@@ -82,18 +82,6 @@ ImageRgb to_image(const Renderer& renderer, const std::vector<glm::vec3>& pixels
   return image;
 }
 
-// Temporal flicker (docs/design.md, "Metrics"): MSE between consecutive frames over pixels and
-// channels; -1 for the first frame.
-double flicker_mse(const std::vector<glm::vec3>& image, const std::vector<glm::vec3>& previous) {
-  if (previous.size() != image.size()) return -1.0;
-  double sum = 0.0;
-  for (std::size_t i = 0; i < image.size(); ++i) {
-    const glm::vec3 d = image[i] - previous[i];
-    sum += static_cast<double>(glm::dot(d, d));
-  }
-  return sum / (3.0 * static_cast<double>(image.size()));
-}
-
 // EXR: linear radiance; PNG: the documented display transform (kernels/shared/tonemap.h) after
 // the scene's exposure (Scene::exposure).
 void write_output(const std::string& path, const ImageRgb& image, ClRuntime& cl,
@@ -268,7 +256,9 @@ int run_render(const RenderCommand& command) {
   std::vector<glm::vec3> previous, previous_noisy;
   ReprojectedFlicker reprojected_flicker, reprojected_flicker_noisy;
   std::vector<glm::vec4> frame_rgba;
-  std::vector<glm::vec3> shown;  // this frame's output: the denoised image with --denoise
+  // This frame's output: the renderer's image, or with --denoise the denoised one.
+  std::vector<glm::vec3> denoised_rgb;
+  const std::vector<glm::vec3>* shown = &renderer.image();
   ImageRgb accumulated{settings.width, settings.height, {}};
   const std::map<std::string, std::string> metadata = {
       {"scene", scene_path},
@@ -279,7 +269,7 @@ int run_render(const RenderCommand& command) {
   // The current frame's output (the running mean with --accumulate) to --output or a
   // --save-frames file, with the metadata that says which frame it is.
   auto write_frame = [&](const std::string& path, int f) {
-    ImageRgb out = to_image(renderer, shown);
+    ImageRgb out = to_image(renderer, *shown);
     if (accumulator) {
       const std::vector<glm::vec4> mean = accumulator->read();
       for (std::size_t i = 0; i < mean.size(); ++i) out.pixels[i] = glm::vec3(mean[i]);
@@ -316,7 +306,7 @@ int run_render(const RenderCommand& command) {
     // The flicker metrics and their copies of last frame's images go only to the stats JSON.
     const bool want_stats = !command.stats_json.empty();
     double svgf_bytes = 0.0;
-    if (!denoiser) shown = image;
+    shown = &image;
     if (denoiser) {
       frame_rgba.resize(image.size());
       for (std::size_t i = 0; i < image.size(); ++i) frame_rgba[i] = glm::vec4(image[i], 1.0f);
@@ -325,28 +315,29 @@ int run_render(const RenderCommand& command) {
       const std::vector<glm::vec4>& denoised =
           denoiser->denoise(frame_rgba, renderer.gbuffer(),
                             guided ? guided->device_gbuffer_of(renderer.gbuffer()) : nullptr);
-      shown.resize(image.size());
-      for (std::size_t i = 0; i < image.size(); ++i) shown[i] = glm::vec3(denoised[i]);
+      denoised_rgb.resize(image.size());
+      for (std::size_t i = 0; i < image.size(); ++i) denoised_rgb[i] = glm::vec3(denoised[i]);
+      shown = &denoised_rgb;
       for (const auto& [name, ms] : denoiser->times_ms()) stats.time_ms[name] = ms;
       stats.time_ms["total"] += denoiser->times_ms().at("svgf_total");
       svgf_bytes = denoiser->host_device_bytes_per_pixel();
     }
     totals.push_back(stats.time_ms["total"]);
-    const double flicker = want_stats ? flicker_mse(shown, previous) : -1.0;
+    const double flicker = want_stats ? flicker_mse(*shown, previous) : -1.0;
     const double flicker_noisy = want_stats && denoiser ? flicker_mse(image, previous_noisy) : -1.0;
     // A tonemap and a copy of the G-buffer per frame.
     const ReprojectedFlicker::Frame tracked =
-        want_stats ? reprojected_flicker.add(shown, renderer.gbuffer(), scene.exposure)
+        want_stats ? reprojected_flicker.add(*shown, renderer.gbuffer(), scene.exposure)
                    : ReprojectedFlicker::Frame{};
     const ReprojectedFlicker::Frame tracked_noisy =
         want_stats && denoiser
             ? reprojected_flicker_noisy.add(image, renderer.gbuffer(), scene.exposure)
             : ReprojectedFlicker::Frame{};
-    if (want_stats) previous = shown;
+    if (want_stats) previous = *shown;
     if (want_stats && denoiser) previous_noisy = image;
     if (accumulator) {
-      frame_rgba.resize(shown.size());
-      for (std::size_t i = 0; i < shown.size(); ++i) frame_rgba[i] = glm::vec4(shown[i], 1.0f);
+      frame_rgba.resize(shown->size());
+      for (std::size_t i = 0; i < shown->size(); ++i) frame_rgba[i] = glm::vec4((*shown)[i], 1.0f);
       const auto t = std::chrono::steady_clock::now();
       accumulator->add(frame_rgba).wait();
       stats.time_ms["accumulate_kernel"] =
@@ -371,7 +362,7 @@ int run_render(const RenderCommand& command) {
     if (tracked_noisy.mse >= 0.0) frame["flicker_reprojected_noisy"] = tracked_noisy.mse;
     if (denoiser) frame["svgf_host_device_bytes_per_pixel"] = svgf_bytes;
     if (!command.reference.empty()) {
-      last_relmse = relative_mse(to_image(renderer, shown), reference);
+      last_relmse = relative_mse(to_image(renderer, *shown), reference);
       frame["relmse"] = last_relmse;
       if (denoiser) frame["relmse_noisy"] = relative_mse(to_image(renderer, image), reference);
       if (accumulator) {

@@ -18,6 +18,11 @@
 
 namespace rtpg {
 
+// Temporal flicker (docs/design.md, "Metrics"): MSE between consecutive frames over pixels and
+// channels; -1 for the first frame (previous empty or of another size). Summed in parallel over
+// fixed blocks of pixels, so the figure does not depend on the thread count.
+double flicker_mse(const std::vector<glm::vec3>& image, const std::vector<glm::vec3>& previous);
+
 class ReprojectedFlicker {
  public:
   struct Frame {
@@ -30,10 +35,15 @@ class ReprojectedFlicker {
   Frame add(const std::vector<glm::vec3>& image, const GBuffer& gbuffer, float exposure);
 
  private:
+  // A frame's history: displayed values and what the history test reads of its G-buffer
+  // (everything but the flags only where a pixel has a surface).
+  struct History {
+    std::vector<glm::vec3> shown;
+    std::vector<glm::vec4> position_depth, normal;
+    std::vector<std::uint32_t> material, flags;
+  };
   int width_ = 0, height_ = 0;
-  std::vector<glm::vec3> previous_;  // displayed values
-  std::vector<glm::vec4> previous_position_depth_, previous_normal_;
-  std::vector<std::uint32_t> previous_material_, previous_flags_;
+  History previous_, next_;
 };
 
 }  // namespace rtpg

@@ -1,6 +1,7 @@
 // ReprojectedFlicker (host/render/temporal_flicker.h): the flicker of a moving camera's sequence
 // measured through the motion vectors, on synthetic G-buffers whose answer is known.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
 #include <random>
@@ -123,6 +124,47 @@ TEST(ReprojectedFlicker, AnotherSurfaceIsNotCompared) {
   EXPECT_EQ(r.mse, 0.0);
   EXPECT_LT(r.tracked_fraction, 0.5);
   EXPECT_GT(r.tracked_fraction, 0.3);
+}
+
+// A size change (a new --res in one process, or a library user's resize) starts the history
+// again: the frame after it has no flicker, the one after that has.
+TEST(ReprojectedFlicker, ASizeChangeStartsTheHistoryAgain) {
+  const Pan wide, narrow{33, 7};
+  std::mt19937 rng(5);
+  ReprojectedFlicker flicker;
+  const GBuffer w0 = wide.gbuffer(0), n1 = narrow.gbuffer(1), n2 = narrow.gbuffer(2);
+  EXPECT_EQ(flicker.add(wide.image(w0, 0, 0.0f, rng), w0, 1.0f).mse, -1.0);
+  EXPECT_EQ(flicker.add(narrow.image(n1, 1, 0.0f, rng), n1, 1.0f).mse, -1.0);
+  const ReprojectedFlicker::Frame r = flicker.add(narrow.image(n2, 2, 0.0f, rng), n2, 1.0f);
+  EXPECT_NEAR(r.mse, 0.0, 1e-10);
+  EXPECT_GT(r.tracked_fraction, 0.5);
+}
+
+// The plain flicker of consecutive frames: the mean squared change over pixels and channels,
+// -1 without a previous frame of the same size, and the same bits whatever the thread count
+// (the blocks' sums are added in order).
+TEST(FlickerMse, IsTheMeanSquaredChangeWhateverTheThreadCount) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 2.0f);
+  std::vector<glm::vec3> a(100003), b(100003);
+  double serial = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    a[i] = glm::vec3(u(rng), u(rng), u(rng));
+    b[i] = glm::vec3(u(rng), u(rng), u(rng));
+    const glm::vec3 d = a[i] - b[i];
+    serial += static_cast<double>(glm::dot(d, d));
+  }
+  serial /= 3.0 * static_cast<double>(a.size());
+  const double many = flicker_mse(a, b);
+  double one = 0.0;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = flicker_mse(a, b);
+  }
+  EXPECT_EQ(many, one);
+  EXPECT_NEAR(many, serial, 1e-12 * serial);
+  EXPECT_EQ(flicker_mse(a, {}), -1.0);
+  EXPECT_EQ(flicker_mse(a, std::vector<glm::vec3>(7)), -1.0);
 }
 
 TEST(ReprojectedFlicker, MismatchedSizesAreAClearError) {
