@@ -68,6 +68,81 @@ PG_FN float2 pg_hemisphere_to_square(float3 w) {
   return pg_make_float2(clamp(0.5f * (a + 1.0f), 0.0f, 1.0f), clamp(0.5f * (b + 1.0f), 0.0f, 1.0f));
 }
 
+/* M and its partial derivatives along u.x and u.y (*dx, *dy), for carrying a Gaussian's
+ * covariance through a change of frame (pg_pmm_reframe). The point is computed by the same
+ * operations as pg_square_to_hemisphere. Returns 0 at the square's centre, where the concentric
+ * map has no derivative (the same point, w = (0, 0, 1)). In the wedge |ox| > |oy| the disk point is
+ * ox (cos t, sin t) with t = (pi/4) q, q = oy / ox, so d/dox = (cos t + (pi/4) q sin t, sin t -
+ * (pi/4) q cos t) and d/doy = (pi/4) (-sin t, cos t); the other wedge mirrors it; ox = 2 u.x - 1
+ * adds a factor 2. The lift (d s, 1 - r^2), s = sqrt(2 - r^2), has ds/dd = -d / s. */
+PG_FN int pg_square_to_hemisphere_d(float2 u, PG_PRIVATE float3* w, PG_PRIVATE float3* dx,
+                                    PG_PRIVATE float3* dy) {
+  float ox = 2.0f * u.x - 1.0f;
+  float oy = 2.0f * u.y - 1.0f;
+  if (ox == 0.0f && oy == 0.0f) {
+    *w = pg_make_float3(0.0f, 0.0f, 1.0f);
+    return 0;
+  }
+  float2 d, d_ox, d_oy; /* the disk point and its derivatives along ox and oy */
+  if (fabs(ox) > fabs(oy)) {
+    float q = oy / ox;
+    float2 cs = pg_cos_sin_octant((PG_PI / 4.0f) * q);
+    d = pg_make_float2(ox * cs.x, ox * cs.y);
+    d_ox = pg_make_float2(cs.x + (PG_PI / 4.0f) * q * cs.y, cs.y - (PG_PI / 4.0f) * q * cs.x);
+    d_oy = pg_make_float2(-(PG_PI / 4.0f) * cs.y, (PG_PI / 4.0f) * cs.x);
+  } else {
+    float q = ox / oy;
+    float2 cs = pg_cos_sin_octant((PG_PI / 4.0f) * q);
+    d = pg_make_float2(oy * cs.y, oy * cs.x);
+    d_ox = pg_make_float2((PG_PI / 4.0f) * cs.x, -(PG_PI / 4.0f) * cs.y);
+    d_oy = pg_make_float2(cs.y - (PG_PI / 4.0f) * q * cs.x, cs.x + (PG_PI / 4.0f) * q * cs.y);
+  }
+  float r2 = d.x * d.x + d.y * d.y;
+  float s = pg_safe_sqrt(2.0f - r2); /* at least 1 on the disk */
+  *w = pg_make_float3(d.x * s, d.y * s, 1.0f - r2);
+  float3 w_dx = pg_make_float3(s - d.x * d.x / s, -d.x * d.y / s, -2.0f * d.x);
+  float3 w_dy = pg_make_float3(-d.x * d.y / s, s - d.y * d.y / s, -2.0f * d.y);
+  *dx = (w_dx * d_ox.x + w_dy * d_ox.y) * 2.0f;
+  *dy = (w_dx * d_oy.x + w_dy * d_oy.y) * 2.0f;
+  return 1;
+}
+
+/* M^-1 (pg_hemisphere_to_square, by the same operations) and the gradients of its two coordinates
+ * with respect to w (*gx, *gy); along a direction tangent to the sphere they are the map's
+ * derivative there. Returns 0 where the disk radius r = sqrt(1 - z) is below min_radius (the
+ * pole, where the map has no derivative and the gradients grow as 1 / r). With |x| >= |y|:
+ * a = +-r, b = a atan(y / x) 4 / pi, so a' = (0, 0, -+1 / (2 r)) and b' from atan' = 1 / (1 + t^2)
+ * (the polynomial's derivative to within its 2e-8); the other wedge mirrors it; u = (a + 1) / 2. */
+PG_FN int pg_hemisphere_to_square_d(float3 w, float min_radius, PG_PRIVATE float2* u,
+                                    PG_PRIVATE float3* gx, PG_PRIVATE float3* gy) {
+  float r = sqrt(clamp(1.0f - w.z, 0.0f, 1.0f));
+  if (r == 0.0f || (w.x == 0.0f && w.y == 0.0f)) {
+    *u = pg_make_float2(0.5f, 0.5f);
+    return 0;
+  }
+  float a, b;
+  float3 da, db;
+  if (fabs(w.x) >= fabs(w.y)) {
+    a = w.x > 0.0f ? r : -r;
+    float t = w.y / w.x, at = pg_atan_unit(t);
+    b = a * at * (4.0f / PG_PI);
+    float k = a * (4.0f / PG_PI) / (1.0f + t * t); /* d b / d t */
+    da = pg_make_float3(0.0f, 0.0f, -0.5f * a / (r * r));
+    db = pg_make_float3(-k * t / w.x, k / w.x, da.z * at * (4.0f / PG_PI));
+  } else {
+    b = w.y > 0.0f ? r : -r;
+    float t = w.x / w.y, at = pg_atan_unit(t);
+    a = b * at * (4.0f / PG_PI);
+    float k = b * (4.0f / PG_PI) / (1.0f + t * t); /* d a / d t */
+    db = pg_make_float3(0.0f, 0.0f, -0.5f * b / (r * r));
+    da = pg_make_float3(k / w.y, -k * t / w.y, db.z * at * (4.0f / PG_PI));
+  }
+  *u = pg_make_float2(clamp(0.5f * (a + 1.0f), 0.0f, 1.0f), clamp(0.5f * (b + 1.0f), 0.0f, 1.0f));
+  *gx = da * 0.5f;
+  *gy = db * 0.5f;
+  return r >= min_radius;
+}
+
 /* Cosine-weighted hemisphere sampling (Malley's method) and its solid-angle density. */
 PG_FN float3 pg_sample_cosine_hemisphere(float2 u) {
   float2 d = pg_square_to_disk(u);

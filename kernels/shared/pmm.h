@@ -392,8 +392,9 @@ PG_FN int pg_pmm_needs_reframe(pg_frame from, pg_frame to) {
 
 /* Carries a state from the hemisphere frame `from` to the frame `to` (reprojection onto a
  * pixel whose normal differs): the mean moves with its direction, the covariance with the
- * Jacobian of the change of frame at the mean (by central differences). A mean that ends up
- * below the new horizon cannot be carried: the initial state is returned. */
+ * Jacobian of the change of frame at the mean (in closed form; by differences where the maps
+ * have no derivative: docs/guiding.md, "The reframe's Jacobian in closed form"). A mean that
+ * ends up below the new horizon cannot be carried: the initial state is returned. */
 PG_FN float2 pg_pmm_reframe_point(float2 u, pg_frame from, pg_frame to, PG_PRIVATE int* ok) {
   float3 w = pg_to_local(to, pg_to_world(from, pg_square_to_hemisphere(u)));
   if (w.z <= 1e-4f) *ok = 0;
@@ -424,21 +425,38 @@ PG_FN pg_pmm_state pg_pmm_reframe(pg_pmm_state s, pg_frame from, pg_frame to) {
   if (!(s.s1.w > 0.0f) || !(s.s0.y > 0.0f)) return s;
   float mx = clamp(s.s0.z / s.s0.y, 0.0f, 1.0f), my = clamp(s.s0.w / s.s0.y, 0.0f, 1.0f);
   float3 c = pg_pmm_raw_covariance(s, mx, my);
-  int ok = 1;
-  float2 m2 = pg_pmm_reframe_point(pg_make_float2(mx, my), from, to, &ok);
-  if (!ok) return pg_pmm_initial_state();
-  /* Jacobian columns; probe inside the square, on the side away from its border. */
-  float h = 1e-3f;
-  float hx = mx < 0.5f ? h : -h, hy = my < 0.5f ? h : -h;
-  int okx = 1, oky = 1;
-  float2 px = pg_pmm_reframe_point(pg_make_float2(mx + hx, my), from, to, &okx);
-  float2 py = pg_pmm_reframe_point(pg_make_float2(mx, my + hy), from, to, &oky);
+  /* The mean through the change of frame, and the Jacobian there: in closed form (the maps'
+   * derivatives, pg_square_to_hemisphere_d and pg_hemisphere_to_square_d, chained through the
+   * rotation, which carries tangent vectors as it carries points), or by differences where a
+   * map has none (the square's centre, the pole). */
+  float3 w, w_dx, w_dy;
+  int smooth = pg_square_to_hemisphere_d(pg_make_float2(mx, my), &w, &w_dx, &w_dy);
+  w = pg_to_local(to, pg_to_world(from, w));
+  if (w.z <= 1e-4f) return pg_pmm_initial_state();
+  float2 m2;
+  float3 gx, gy;
+  smooth &= pg_hemisphere_to_square_d(w, 1e-2f, &m2, &gx, &gy);
   float j11 = 1.0f, j12 = 0.0f, j21 = 0.0f, j22 = 1.0f;
-  if (okx && oky) {
-    j11 = (px.x - m2.x) / hx;
-    j21 = (px.y - m2.y) / hx;
-    j12 = (py.x - m2.x) / hy;
-    j22 = (py.y - m2.y) / hy;
+  if (smooth) {
+    w_dx = pg_to_local(to, pg_to_world(from, w_dx));
+    w_dy = pg_to_local(to, pg_to_world(from, w_dy));
+    j11 = dot(gx, w_dx);
+    j12 = dot(gx, w_dy);
+    j21 = dot(gy, w_dx);
+    j22 = dot(gy, w_dy);
+  } else {
+    /* Probe inside the square, on the side away from its border. */
+    float h = 1e-3f;
+    float hx = mx < 0.5f ? h : -h, hy = my < 0.5f ? h : -h;
+    int okx = 1, oky = 1;
+    float2 px = pg_pmm_reframe_point(pg_make_float2(mx + hx, my), from, to, &okx);
+    float2 py = pg_pmm_reframe_point(pg_make_float2(mx, my + hy), from, to, &oky);
+    if (okx && oky) {
+      j11 = (px.x - m2.x) / hx;
+      j21 = (px.y - m2.y) / hx;
+      j12 = (py.x - m2.x) / hy;
+      j22 = (py.y - m2.y) / hy;
+    }
   }
   /* Sigma' = J Sigma J^T */
   float a = c.x, b = c.z, d = c.y;
