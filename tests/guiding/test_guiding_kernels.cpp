@@ -591,10 +591,11 @@ void make_reprojection_pair(Random& r, int w, int h, HostGBuffer& prev, HostGBuf
 // Device and host agree: bit for bit where the state is copied or reset; within 1e-3 relative
 // (of the value, plus of S0 for the moments) where it is reframed. The reframe maps the mean
 // through sin/cos/atan2/sqrt, which OpenCL allows to be 4-6 ulp off the host's libm, and builds
-// the covariance from a Jacobian by central differences of step 1e-3 (an error of a few ulp of
-// 0.5 in a probe, 3e-7, becomes 3e-4 in the Jacobian). A reframed mean that lands within ulps of
-// the horizon threshold (w.z = 1e-4) may be carried on one side and dropped on the other:
-// such pixels are counted and bounded (none are expected at these sizes). The first and last
+// the covariance from a Jacobian in closed form, or by differences of step 1e-3 near the square's
+// centre and the pole (there an error of a few ulp of 0.5 in a probe, 3e-7, becomes 3e-4 in the
+// Jacobian; docs/guiding.md, "The reframe's Jacobian in closed form"). A reframed mean that lands
+// within ulps of the horizon threshold (w.z = 1e-4) may be carried on one side and dropped on the
+// other: such pixels are counted and bounded (none are expected at these sizes). The first and last
 // cases age glossy models as their view turns (reproject_view_memory); k then goes through
 // atan2 and exp, which may differ by a few ulp between the device and the host: within 1e-5
 // relative plus twice aged_k_relative_error (the exponent's conditioning; on an NVIDIA H100,
