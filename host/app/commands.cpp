@@ -325,7 +325,7 @@ int run_render(const RenderCommand& command) {
     totals.push_back(stats.time_ms["total"]);
     const double flicker = want_stats ? flicker_mse(*shown, previous) : -1.0;
     const double flicker_noisy = want_stats && denoiser ? flicker_mse(image, previous_noisy) : -1.0;
-    // A tonemap and a copy of the G-buffer per frame.
+    // One pass over the image that also keeps the next frame's history (temporal_flicker.h).
     const ReprojectedFlicker::Frame tracked =
         want_stats ? reprojected_flicker.add(*shown, renderer.gbuffer(), scene.exposure)
                    : ReprojectedFlicker::Frame{};
