@@ -23,6 +23,7 @@
 #include "scene/scene_loader.h"
 #include "util/atomic_file.h"
 #include "rtpg/errors.h"
+#include "rtpg/guiding_settings.h"
 #include "util/stderr_capture.h"
 
 #ifndef RTPG_SOURCE_DIR
@@ -224,6 +225,12 @@ int run_render(const RenderCommand& command) {
   settings.path_tracer.guide_secondary =
       command.guiding == "pmm" && command.guide_vertices == "all";
   settings.path_tracer.direct_light_in_vpls = command.guide_direct_light == "mis";
+  settings.world_guide = command.guide_vertices == "world";
+  settings.world_guide_settings.resolution = command.world_guide_resolution;
+  settings.world_guide_settings.record_every = command.world_guide_record_every;
+  if (command.world_guide_max_depth > 0)
+    settings.world_guide_settings.max_depth = command.world_guide_max_depth;
+  settings.world_guide_settings.em = to_kernel_settings(command.guiding_settings);
   settings.path_tracer.first_bounce_mis =
       command.first_bounce_mis == "bsdf" ? FirstBounceMis::bsdf : FirstBounceMis::mixture;
   settings.path_tracer.shared_randoms = parse_shared_randoms(command.share_randoms);

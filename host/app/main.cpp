@@ -40,9 +40,25 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
       ->check(CLI::IsMember({"off", "pmm"}))
       ->capture_default_str();
   cmd->add_option("--guide-vertices", r.guide_vertices,
-                  "With --guiding pmm: first (the first bounce only, as the paper) or all (later "
-                  "vertices seen by the camera borrow their pixel's mixture)")
-      ->check(CLI::IsMember({"first", "all"}))
+                  "first (the first bounce only, as the paper), all (with --guiding pmm: later "
+                  "vertices seen by the camera borrow their pixel's mixture) or world (later "
+                  "vertices sample a world-space hash grid of mixtures trained from every later "
+                  "vertex; an experiment)")
+      ->check(CLI::IsMember({"first", "all", "world"}))
+      ->capture_default_str();
+  cmd->add_option("--world-guide-resolution", r.world_guide_resolution,
+                  "With --guide-vertices world: cells along the scene's longest extent")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--world-guide-max-depth", r.world_guide_max_depth,
+                  "With --guide-vertices world: the deepest path vertex that samples and trains "
+                  "the world guide (1: the first bounce's hit; 0: every vertex)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  cmd->add_option("--world-guide-record-every", r.world_guide_record_every,
+                  "With --guide-vertices world: one path in n (chosen afresh every frame) records "
+                  "its vertices to train the world guide")
+      ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   cmd->add_option("--guide-direct-light", r.guide_direct_light,
                   "With --guiding pmm and next-event estimation: off (the VPLs leave out the light "

@@ -132,6 +132,7 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSamples* first,
     times.compact_ms += ms_since(start);
   }
   start = Clock::now();
+  if (world_guide_) collect_world_samples();
   gather(radiance, vpls, nonfinite);
   times.compact_ms += ms_since(start);
 }
@@ -149,6 +150,25 @@ void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
   rays_.resize(n);
   hits_.resize(n);
   alive_.assign(n, 0);
+  if (world_guide_) {
+    world_vertices_.resize(n * static_cast<std::size_t>(std::max(settings_.max_bounces, 1)));
+    world_depth_.resize(n);
+    // The paths that record for training: one in record_every, chosen afresh every sample by
+    // a hash of the pixel (the others still sample the guide).
+    const std::uint32_t every = static_cast<std::uint32_t>(world_guide_->settings().record_every);
+    const std::uint32_t salt = at_.frame * 0x9e3779b9u + at_.sample * 0x85ebca6bu + at_.seed;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        std::uint32_t h = static_cast<std::uint32_t>(i) ^ salt;
+        h ^= h >> 16;
+        h *= 0x7feb352du;
+        h ^= h >> 15;
+        h *= 0x846ca68bu;
+        h ^= h >> 16;
+        world_depth_[i] = every <= 1 || h % every == 0 ? 0 : kNotRecording;
+      }
+    });
+  }
   next_event_on_ = settings_.next_event && !lights_.empty();
 }
 
@@ -327,10 +347,19 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       if (settings_.guide_secondary && j + kPrefetchAhead < range.end())
         borrow_from[(j + kPrefetchAhead) % kBorrowRing] = prefetch_borrowable(j + kPrefetchAhead);
       if (j + kPathPrefetchAhead < range.end()) prefetch_path(active_[j + kPathPrefetchAhead]);
+      if (world_guide_ && j + kPrefetchAhead < range.end() && hits_[j + kPrefetchAhead].valid()) {
+        const Ray& ahead = rays_[j + kPrefetchAhead];
+        world_guide_->prefetch(ahead.origin + ahead.direction * hits_[j + kPrefetchAhead].t);
+      }
       if (prefetch_surfaces_)
         prefetch_surfaces_ahead(scene_, triangles_, hits_.data(), j, range.end());
       const std::uint32_t i = active_[j];
       PathState& p = paths_[i];
+      // The previous vertex's light sample is in the path's radiance now (the compaction added
+      // it); what comes after is the light its bounce found.
+      if (world_guide_ && depth >= 2 && world_depth_[i] == depth - 1)
+        world_vertices_[i * static_cast<std::size_t>(settings_.max_bounces) + (depth - 2)]
+            .radiance_before = p.radiance;
       const Ray ray = rays_[j];
       const Hit& hit = hits_[j];
       shadow_rays_[j] = inactive_ray();
@@ -392,9 +421,16 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       PixelGuide guide;
       // A borrowed lobe is the lending pixel's product of incident light and its BSDF for its
       // own view direction: it carries over to a vertex whose reflection is mostly diffuse
-      // (view-independent), not to a glossy one seen from elsewhere.
-      const bool guided = settings_.guide_secondary && lobes.p_specular <= 0.5f &&
-                          borrow_guide(borrow_from[j % kBorrowRing], sp, guide);
+      // (view-independent), not to a glossy one seen from elsewhere. The world guide's cells
+      // learn from many view directions, so the same holds for them.
+      const bool diffuse_enough = lobes.p_specular <= 0.5f;
+      const std::uint64_t cell =
+          world_guide_ && diffuse_enough && depth <= world_guide_->settings().max_depth
+              ? world_guide_->cell_of(sp.position, sp.shading_normal)
+              : WorldGuide::kNoCell;
+      const bool guided = (settings_.guide_secondary && diffuse_enough &&
+                           borrow_guide(borrow_from[j % kBorrowRing], sp, guide)) ||
+                          (cell != WorldGuide::kNoCell && world_guide_->guide(cell, guide));
       guided_here += guided;
       // Beyond the first bounce the vertex's sampler competes with the light. The density
       // they weigh each other with: the BSDF's, or at a guided vertex the borrowed guide's
@@ -420,10 +456,16 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       shared::pg_bsdf_sample_t bs;
       glm::vec3 wi_world;
       float mis_pdf = 0.0f;  // the density the hit's MIS weight uses (vertex_pdf's function)
+      // The bounce in the guide's square (the world cell's, where a world cell guides), kept for
+      // the cell's training sample; and the BSDF's density there.
+      shared::float2 square(0.0f, 0.0f);
+      bool in_square = false;
+      float bsdf_pdf = 0.0f;
       if (!guided) {
         bs = shared::pg_bsdf_sample(lobes, wo, u_lobe, v1, v2);
         if (bs.pdf <= 0.0f) continue;
         wi_world = shared::pg_to_world(frame, bs.wi);
+        bsdf_pdf = bs.pdf;
       } else {
         // One-sample MIS over the borrowed mixture, as the sample kernel does (pmm.h): the
         // Gaussian with probability pi (in the lending pixel's square and frame), else the
@@ -431,9 +473,10 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         const float pi = guide.model.pi;
         if (u_lobe < pi) {
           int inside = 0;
-          const shared::float2 u = shared::pg_pmm_sample_square(guide.model, v1, v2, &inside);
+          square = shared::pg_pmm_sample_square(guide.model, v1, v2, &inside);
           if (!inside) continue;
-          wi_world = shared::pg_to_world(guide.frame, shared::pg_square_to_hemisphere(u));
+          in_square = true;
+          wi_world = shared::pg_to_world(guide.frame, shared::pg_square_to_hemisphere(square));
           bs.wi = shared::pg_to_local(frame, wi_world);
         } else {
           const float u = std::min((u_lobe - pi) / (1.0f - pi), 0.99999994f);
@@ -442,13 +485,22 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
           wi_world = shared::pg_to_world(frame, bs.wi);
         }
         if (bs.wi.z <= 0.0f) continue;
-        const float bsdf_pdf = shared::pg_bsdf_pdf(lobes, wo, bs.wi);
-        bs.pdf = guide_density(guide, wi_world, bsdf_pdf);
+        bsdf_pdf = shared::pg_bsdf_pdf(lobes, wo, bs.wi);
+        // guide_density, with the square point the Gaussian drew where it drew one.
+        if (!in_square) {
+          const glm::vec3 l = shared::pg_to_local(guide.frame, wi_world);
+          in_square = l.z > 0.0f;
+          if (in_square) square = shared::pg_hemisphere_to_square(l);
+        }
+        const float gaussian =
+            in_square ? shared::pg_pmm_gaussian_pdf(guide.model, square) * PG_INV_TWO_PI : 0.0f;
+        bs.pdf = guide.model.pi * gaussian + (1.0f - guide.model.pi) * bsdf_pdf;
         if (!(bs.pdf > 0.0f)) continue;
         if (mis_with_bsdf) mis_pdf = bsdf_mis_density(bsdf_pdf);
       }
       if (glm::dot(wi_world, sp.geometric_normal) <= 0.0f) continue;
       const glm::vec3 weight = shared::pg_bsdf_eval(lobes, wo, bs.wi) * (bs.wi.z / bs.pdf);
+      const glm::vec3 throughput_before = p.throughput;
       p.throughput *= weight;
       // Russian roulette and the end of a black path look at the throughput from the camera
       // (measured from y where VPLs are kept: VplPath; times 1, exact, where not).
@@ -465,6 +517,28 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       p.prev_position = sp.position;
       set_ray(rays_[j], origin, wi_world, 0.0f, 1e30f);
       alive_[j] = 1;
+      if (world_guide_ && world_depth_[i] != kNotRecording) {
+        WorldVertex& v =
+            world_vertices_[i * static_cast<std::size_t>(settings_.max_bounces) + (depth - 1)];
+        v.cell = WorldGuide::kNoCell;
+        if (cell != WorldGuide::kNoCell) {
+          // A guided vertex has its bounce in the cell's square already (the cell guided it).
+          if (!guided) {
+            const glm::vec3 l = shared::pg_to_local(WorldGuide::cell_frame(cell), wi_world);
+            in_square = l.z > 0.0f;
+            if (in_square) square = shared::pg_hemisphere_to_square(l);
+          }
+          if (in_square) {
+            v.cell = cell;
+            v.ux = square.x;
+            v.uy = square.y;
+            v.bsdf_pdf = bsdf_pdf;
+            v.density = bs.pdf;
+            v.throughput = throughput_before;
+          }
+        }
+        world_depth_[i] = static_cast<std::uint8_t>(depth);
+      }
     }
     guided_vertices += guided_here;
   });
@@ -585,6 +659,50 @@ void PathTracer::apply_shadow_rays_and_compact(std::size_t count,
   });
   rays_.swap(next_rays_);
   active_.swap(next_active_);
+}
+
+void PathTracer::collect_world_samples() {
+  const std::size_t n = paths_.size();
+  const std::size_t stride = static_cast<std::size_t>(settings_.max_bounces);
+  // Fixed blocks of paths, each into its own vector: the samples' order is the paths' whatever
+  // the thread count (WorldGuide::train sums each cell's samples in that order).
+  constexpr std::size_t kWorldBlock = 8192;
+  const std::size_t blocks = (n + kWorldBlock - 1) / kWorldBlock;
+  const std::size_t first = world_blocks_used_;
+  world_blocks_used_ += blocks;
+  if (world_blocks_.size() < world_blocks_used_) world_blocks_.resize(world_blocks_used_);
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+    std::vector<WorldTrainingSample>& out = world_blocks_[first + b];
+    out.clear();
+    const std::size_t end = std::min(n, (b + 1) * kWorldBlock);
+    for (std::size_t i = b * kWorldBlock; i != end; ++i) {
+      // The records were written over the whole frame and left the cache: load them ahead.
+      constexpr std::size_t kAhead = 16;
+      if (i + kAhead < end) {
+        const int ahead = world_depth_[i + kAhead] == kNotRecording ? 0 : world_depth_[i + kAhead];
+        const char* r = reinterpret_cast<const char*>(&world_vertices_[(i + kAhead) * stride]);
+        for (int line = 0; line < (ahead * static_cast<int>(sizeof(WorldVertex)) + 63) / 64; ++line)
+          __builtin_prefetch(r + 64 * line);
+        __builtin_prefetch(&paths_[i + kAhead]);
+      }
+      const int count = world_depth_[i];
+      if (count == 0 || count == kNotRecording) continue;
+      const glm::vec3 total = paths_[i].radiance;
+      for (int d = 0; d < count; ++d) {
+        const WorldVertex& v = world_vertices_[i * stride + static_cast<std::size_t>(d)];
+        if (v.cell == WorldGuide::kNoCell) continue;
+        // A path recorded at its last vertex before max_bounces reached the next one (the
+        // compaction keeps every path that sampled a bounce), so radiance_before is set.
+        const glm::vec3 after = total - v.radiance_before;
+        glm::vec3 l(0.0f);
+        for (int c = 0; c < 3; ++c)
+          if (v.throughput[c] > 0.0f) l[c] = after[c] / v.throughput[c];
+        const float a = 0.2126f * l.x + 0.7152f * l.y + 0.0722f * l.z;
+        if (!(a >= 0.0f) || !std::isfinite(a)) continue;
+        out.push_back({v.cell, a, v.ux, v.uy, v.bsdf_pdf, v.density});
+      }
+    }
+  });
 }
 
 void PathTracer::gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls,

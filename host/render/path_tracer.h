@@ -14,6 +14,7 @@
 #include "render/lights.h"
 #include "render/surface.h"
 #include "render/vpl_buffer.h"
+#include "render/world_guide.h"
 #include "scene/scene.h"
 #include "shared/rng.h"
 #include "trace/embree_scene.h"
@@ -114,6 +115,18 @@ class PathTracer {
   // settings().surface_prefetch resolved for the scene (render/surface.h, loads_surfaces_ahead):
   // the G-buffer pass follows the same decision.
   bool loads_surfaces_ahead() const { return prefetch_surfaces_; }
+  // Later vertices sample the world-space guide's cells and record their bounces for it
+  // (render/world_guide.h); null: neither. The caller trains the guide between frames.
+  void set_world_guide(const WorldGuide* guide) { world_guide_ = guide; }
+  // The world guide's training samples of the traces since clear_world_samples(), in blocks
+  // of a fixed order (WorldGuide::train).
+  const std::vector<std::vector<WorldTrainingSample>>& world_samples() const {
+    return world_blocks_;
+  }
+  void clear_world_samples() {
+    for (auto& block : world_blocks_) block.clear();
+    world_blocks_used_ = 0;
+  }
 
  private:
   // What every path carries from vertex to vertex (44 bytes: a path touches one cache line).
@@ -195,6 +208,9 @@ class PathTracer {
   // The guide of pixel i (from prefetch_borrowable) if it shows surface point sp
   // (guide_secondary).
   bool borrow_guide(std::size_t i, const SurfacePoint& sp, PixelGuide& guide) const;
+  // The world guide's training samples of this pass: each recorded vertex's bounce with the
+  // radiance its path gathered after it (WorldVertex), into the next blocks of world_blocks_.
+  void collect_world_samples();
   // Pixel estimates (non-finite ones dropped and counted) and the VPLs' radiance.
   void gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite) const;
 
@@ -226,6 +242,25 @@ class PathTracer {
   // Per slot with a shadow segment: what it adds to its path's radiance if unoccluded.
   std::vector<glm::vec3> shadow_contribution_;
   std::vector<BorrowablePixel> borrowable_;  // per pixel, with guide_secondary
+
+  // The world guide (set_world_guide) and what a path records for it at each later vertex that
+  // sampled a bounce: the bounce's training sample without its weight, the path's throughput
+  // on arrival and its radiance once the vertex's own light sample is in (written when the path
+  // reaches the next vertex). The radiance the path gathers after that, divided by the
+  // throughput, is the sample's weight a = L_i f cos / r (with Russian roulette's 1/q).
+  struct WorldVertex {
+    std::uint64_t cell;  // kNoCell: no sample (a glossy vertex, or a direction below the cell)
+    float ux, uy, bsdf_pdf, density;
+    glm::vec3 throughput, radiance_before;
+  };
+  const WorldGuide* world_guide_ = nullptr;
+  std::vector<WorldVertex> world_vertices_;  // [path * max_bounces + depth - 1]
+  std::vector<std::uint8_t> world_depth_;    // per path: vertices recorded (or kNotRecording)
+  static constexpr std::uint8_t kNotRecording = 0xff;
+  // Blocks of kWorldBlock paths of each pass, in order; world_blocks_used_ of them hold this
+  // frame's samples (the vectors keep their memory).
+  std::vector<std::vector<WorldTrainingSample>> world_blocks_;
+  std::size_t world_blocks_used_ = 0;
 };
 
 }  // namespace rtpg

@@ -52,6 +52,11 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
   path_tracer_ =
       std::make_unique<PathTracer>(scene, *tracer_, *triangles_, *lights_, settings.path_tracer);
   sampler_ = std::make_unique<BsdfFirstBounce>();
+  if (settings.world_guide) {
+    world_guide_ = std::make_unique<WorldGuide>(scene.bounds_min(), scene.bounds_max(),
+                                                settings.world_guide_settings);
+    path_tracer_->set_world_guide(world_guide_.get());
+  }
 }
 
 Renderer::~Renderer() = default;
@@ -206,6 +211,16 @@ FrameStats Renderer::render_frame(int index) {
     t = Clock::now();
     sampler_->end_frame(gbuffer, vpls_, frame_at);
     stats.time_ms["guiding_end"] = ms_since(t);
+  }
+  if (world_guide_) {
+    // After the frame's last sample, as the first-bounce sampler's training: every sample of
+    // the frame drew from one set of cells.
+    t = Clock::now();
+    world_guide_->train(path_tracer_->world_samples());
+    path_tracer_->clear_world_samples();
+    stats.time_ms["world_train"] = ms_since(t);
+    stats.extra["world_cells"] = static_cast<double>(world_guide_->cell_count());
+    stats.extra["world_samples"] = static_cast<double>(world_guide_->samples_last_frame());
   }
   stats.time_ms["trace"] = times.trace_ms;
   stats.time_ms["shade"] = times.shade_ms;

@@ -16,6 +16,7 @@
 #include "render/lights.h"
 #include "render/path_tracer.h"
 #include "render/surface.h"
+#include "render/world_guide.h"
 #include "rtpg/errors.h"
 #include "scene/scene.h"
 #include "trace/embree_scene.h"
@@ -30,6 +31,10 @@ struct RenderSettings {
   std::string camera_path;  // "" = static camera
   int camera_frame = -1;    // >= 0: the camera stays at this frame of the path (references)
   PathTracerSettings path_tracer;
+  // Later vertices guided by the world-space guide (render/world_guide.h), trained at the end
+  // of every frame from its later vertices' bounces.
+  bool world_guide = false;
+  WorldGuideSettings world_guide_settings;
 };
 
 struct FrameStats {
@@ -87,6 +92,7 @@ class Renderer {
   std::unique_ptr<TriangleTable> triangles_;  // built with the BVH, from the same positions
   std::unique_ptr<Lights> lights_;
   std::unique_ptr<PathTracer> path_tracer_;
+  std::unique_ptr<WorldGuide> world_guide_;  // with settings_.world_guide
   // The frame's G-buffer is gbuffers_[current_gbuffer_]; the second is allocated only for a
   // sampler that reads G-buffers in place (FirstBounceSampler::reads_gbuffers_in_place), and
   // then the frames alternate between the two.

@@ -22,4 +22,14 @@ inline void resize_emitters(Scene& scene, float size, float emission) {
   }
 }
 
+// Every mesh turned by `rotation` about `centre` (positions, normals and tangents; the camera
+// and the lights that are not meshes stay): a scene whose walls are no longer axis-aligned.
+inline void rotate_meshes(Scene& scene, const glm::mat3& rotation, const glm::vec3& centre) {
+  for (Mesh& mesh : scene.meshes) {
+    for (glm::vec3& v : mesh.positions) v = centre + rotation * (v - centre);
+    for (glm::vec3& n : mesh.normals) n = rotation * n;
+    for (glm::vec4& t : mesh.tangents) t = glm::vec4(rotation * glm::vec3(t), t.w);
+  }
+}
+
 }  // namespace rtpg::test

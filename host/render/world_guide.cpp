@@ -1,0 +1,193 @@
+#include "render/world_guide.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+namespace rtpg {
+namespace {
+
+constexpr int kAxisBits = 20;
+constexpr std::uint64_t kAxisMask = (std::uint64_t{1} << kAxisBits) - 1;
+
+// The normal's dominant axis and its sign: 0..5 = +x, -x, +y, -y, +z, -z.
+std::uint64_t normal_bin(const glm::vec3& n) {
+  const glm::vec3 a = glm::abs(n);
+  if (a.x >= a.y && a.x >= a.z) return n.x >= 0.0f ? 0 : 1;
+  if (a.y >= a.z) return n.y >= 0.0f ? 2 : 3;
+  return n.z >= 0.0f ? 4 : 5;
+}
+
+std::uint64_t mix(std::uint64_t x) {  // splitmix64's finaliser
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ull;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+}  // namespace
+
+WorldGuide::WorldGuide(const glm::vec3& bounds_min, const glm::vec3& bounds_max,
+                       const WorldGuideSettings& settings)
+    : settings_(settings) {
+  const glm::vec3 extent = bounds_max - bounds_min;
+  const float longest = std::max(extent.x, std::max(extent.y, extent.z));
+  const float cell =
+      longest > 0.0f ? longest / static_cast<float>(std::max(settings.resolution, 1)) : 1.0f;
+  inverse_cell_ = 1.0f / cell;
+  // Half a cell of margin: points on the bounds' faces stay inside.
+  origin_ = bounds_min - glm::vec3(0.5f * cell);
+  slots_.resize(std::size_t{1} << 12);
+  states_.resize(slots_.size());
+  mask_ = slots_.size() - 1;
+}
+
+std::uint64_t WorldGuide::cell_of(const glm::vec3& position, const glm::vec3& normal) const {
+  const glm::vec3 g = (position - origin_) * inverse_cell_;
+  if (!(g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f)) return kNoCell;
+  const float limit = static_cast<float>(kAxisMask);
+  if (!(g.x < limit && g.y < limit && g.z < limit)) return kNoCell;
+  const auto x = static_cast<std::uint64_t>(g.x), y = static_cast<std::uint64_t>(g.y),
+             z = static_cast<std::uint64_t>(g.z);
+  return x | (y << kAxisBits) | (z << (2 * kAxisBits)) | (normal_bin(normal) << (3 * kAxisBits));
+}
+
+shared::pg_frame WorldGuide::cell_frame(std::uint64_t cell) {
+  const std::uint64_t bin = cell >> (3 * kAxisBits);
+  glm::vec3 axis(0.0f);
+  axis[static_cast<int>(bin / 2)] = bin % 2 == 0 ? 1.0f : -1.0f;
+  return shared::pg_frame_from_normal(axis);
+}
+
+std::size_t WorldGuide::home(std::uint64_t cell) const {
+  // The position alone: a position's cells (one per normal bin) share their first slot.
+  const std::uint64_t position_bits = cell & ((std::uint64_t{1} << (3 * kAxisBits)) - 1);
+  return static_cast<std::size_t>(mix(position_bits)) & mask_;
+}
+
+std::size_t WorldGuide::find(std::uint64_t cell) const {
+  for (std::size_t s = home(cell);; s = (s + 1) & mask_) {
+    if (slots_[s].cell == cell) return s;
+    if (slots_[s].cell == kNoCell) return slots_.size();
+  }
+}
+
+std::size_t WorldGuide::find_or_insert(std::uint64_t cell) {
+  // Linear probing stays short while at most half the slots are used.
+  if (2 * (used_ + 1) > slots_.size()) {
+    if (slots_.size() >= (std::size_t{2} << settings_.max_cells_log2)) return slots_.size();
+    grow();
+  }
+  for (std::size_t s = home(cell);; s = (s + 1) & mask_) {
+    if (slots_[s].cell == cell) return s;
+    if (slots_[s].cell == kNoCell) {
+      slots_[s].cell = cell;
+      states_[s] = shared::pg_pmm_initial_state();
+      ++used_;
+      return s;
+    }
+  }
+}
+
+void WorldGuide::grow() {
+  std::vector<Slot> old_slots(slots_.size() * 2);
+  std::vector<shared::pg_pmm_state> old_states(old_slots.size());
+  old_slots.swap(slots_);
+  old_states.swap(states_);
+  mask_ = slots_.size() - 1;
+  for (std::size_t o = 0; o < old_slots.size(); ++o) {
+    if (old_slots[o].cell == kNoCell) continue;
+    std::size_t s = home(old_slots[o].cell);
+    while (slots_[s].cell != kNoCell) s = (s + 1) & mask_;
+    slots_[s] = old_slots[o];
+    states_[s] = old_states[o];
+  }
+}
+
+bool WorldGuide::guide(std::uint64_t cell, PixelGuide& out) const {
+  const std::size_t s = find(cell);
+  if (s == slots_.size() || !slots_[s].model.valid) return false;
+  out.model = slots_[s].model;
+  out.frame = cell_frame(cell);
+  return true;
+}
+
+void WorldGuide::prefetch(const glm::vec3& position) const {
+  const std::uint64_t cell = cell_of(position, glm::vec3(0.0f, 0.0f, 1.0f));
+  if (cell != kNoCell) __builtin_prefetch(&slots_[home(cell)]);
+}
+
+void WorldGuide::find_slots(const std::vector<std::vector<WorldTrainingSample>>& blocks) {
+  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+    const std::vector<WorldTrainingSample>& block = blocks[b];
+    for (std::size_t k = 0; k < block.size(); ++k)
+      slot_of_[block_offset_[b] + k] = static_cast<std::uint32_t>(find(block[k].cell));
+  });
+}
+
+void WorldGuide::train(const std::vector<std::vector<WorldTrainingSample>>& blocks) {
+  block_offset_.resize(blocks.size() + 1);
+  block_offset_[0] = 0;
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    block_offset_[b + 1] = block_offset_[b] + blocks[b].size();
+  const std::size_t total = block_offset_.back();
+  samples_last_ = total;
+  if (total == 0) return;
+  const auto sample_at = [&](std::size_t k) -> const WorldTrainingSample& {
+    const std::size_t b =
+        static_cast<std::size_t>(std::upper_bound(block_offset_.begin(), block_offset_.end(), k) -
+                                 block_offset_.begin() - 1);
+    return blocks[b][k - block_offset_[b]];
+  };
+  slot_of_.resize(total);
+  find_slots(blocks);
+  // Cells seen for the first time are made in the samples' order (serially: the table's layout
+  // is then the same on every run); if the table grew, every slot moved.
+  const std::size_t slots_before = slots_.size();
+  bool made = false;
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    for (std::size_t k = 0; k < blocks[b].size(); ++k)
+      if (slot_of_[block_offset_[b] + k] == slots_before) {
+        const std::size_t s = find_or_insert(blocks[b][k].cell);
+        made = true;
+        if (slots_.size() == slots_before && s != slots_.size())
+          slot_of_[block_offset_[b] + k] = static_cast<std::uint32_t>(s);
+      }
+  if (made && slots_.size() != slots_before) find_slots(blocks);
+  // The samples' indices grouped by slot, in their order within each slot.
+  const std::size_t slot_count = slots_.size();
+  slot_begin_.assign(slot_count + 1, 0);
+  for (std::size_t k = 0; k < total; ++k)
+    if (slot_of_[k] < slot_count) ++slot_begin_[slot_of_[k] + 1];
+  for (std::size_t s = 0; s < slot_count; ++s) slot_begin_[s + 1] += slot_begin_[s];
+  by_slot_.resize(slot_begin_[slot_count]);
+  {
+    std::vector<std::uint32_t> next(slot_begin_.begin(), slot_begin_.end() - 1);
+    for (std::size_t k = 0; k < total; ++k)
+      if (slot_of_[k] < slot_count) by_slot_[next[slot_of_[k]]++] = static_cast<std::uint32_t>(k);
+  }
+  const pg_kernel_settings& p = settings_.em;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, slot_count, 1024), [&](const auto& range) {
+    std::vector<shared::float4> packed;
+    std::vector<float> densities;
+    for (std::size_t s = range.begin(); s != range.end(); ++s) {
+      const std::size_t n = slot_begin_[s + 1] - slot_begin_[s];
+      if (n == 0) continue;
+      packed.resize(n);
+      densities.resize(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        const WorldTrainingSample& sample = sample_at(by_slot_[slot_begin_[s] + k]);
+        packed[k] = shared::float4(sample.a, sample.ux, sample.uy, sample.bsdf_pdf);
+        densities[k] = sample.density;
+      }
+      int updated = 0;
+      states_[s] = shared::pg_pmm_train(states_[s], packed.data(), densities.data(),
+                                        static_cast<int>(n), p, static_cast<float>(n), 1, &updated);
+      slots_[s].model = shared::pg_pmm_model_from_state(states_[s], p);
+    }
+  });
+}
+
+}  // namespace rtpg

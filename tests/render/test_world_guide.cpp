@@ -1,0 +1,144 @@
+// The world-space guide of later path vertices (host/render/world_guide.h): its cells, its
+// training from samples, its table's growth and its determinism. Whole-image unbiasedness with
+// it is checked in test_guiding_image.cpp (GuidingImage.UnbiasedWithTheWorldGuide*).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <tbb/global_control.h>
+
+#include "render/world_guide.h"
+#include "rtpg/guiding_settings.h"
+#include "shared/rng.h"
+
+namespace rtpg {
+namespace {
+
+WorldGuideSettings settings_for_test(int resolution = 10) {
+  WorldGuideSettings s;
+  s.resolution = resolution;
+  s.em = to_kernel_settings(GuidingSettings{});
+  return s;
+}
+
+TEST(WorldGuide, CellsSeparatePositionsAndNormalAxes) {
+  const WorldGuide guide(glm::vec3(0.0f), glm::vec3(10.0f), settings_for_test(10));
+  const glm::vec3 up(0.0f, 1.0f, 0.0f);
+  const std::uint64_t a = guide.cell_of(glm::vec3(2.1f, 3.1f, 4.1f), up);
+  EXPECT_EQ(
+      a, guide.cell_of(glm::vec3(2.4f, 3.4f, 4.4f), glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f))));
+  EXPECT_NE(a, guide.cell_of(glm::vec3(3.1f, 3.1f, 4.1f), up));  // the next cell along x
+  EXPECT_NE(a, guide.cell_of(glm::vec3(2.1f, 3.1f, 4.1f), -up));
+  EXPECT_NE(a, guide.cell_of(glm::vec3(2.1f, 3.1f, 4.1f), glm::vec3(1.0f, 0.0f, 0.0f)));
+  EXPECT_EQ(WorldGuide::kNoCell, guide.cell_of(glm::vec3(-5.0f, 3.0f, 4.0f), up));
+  // The bounds' faces themselves are inside.
+  EXPECT_NE(WorldGuide::kNoCell, guide.cell_of(glm::vec3(10.0f, 10.0f, 10.0f), up));
+  EXPECT_NE(WorldGuide::kNoCell, guide.cell_of(glm::vec3(0.0f), up));
+  // A cell's frame is its normal axis.
+  const glm::vec3 normals[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const glm::vec3& n : normals) {
+    const shared::pg_frame f = WorldGuide::cell_frame(guide.cell_of(glm::vec3(5.0f), n));
+    EXPECT_NEAR(glm::dot(f.n, n), 1.0f, 1e-6f);
+    EXPECT_NEAR(glm::dot(f.t, f.n), 0.0f, 1e-6f);
+    EXPECT_NEAR(glm::dot(f.b, f.n), 0.0f, 1e-6f);
+  }
+}
+
+// Samples of one cell drawn uniformly over the square, weighted by a bump around u0 (the light
+// arriving from one direction): after a few frames the cell's Gaussian sits on the bump.
+TEST(WorldGuide, LearnsWhereTheLightComesFrom) {
+  WorldGuide guide(glm::vec3(0.0f), glm::vec3(1.0f), settings_for_test(4));
+  const std::uint64_t cell = guide.cell_of(glm::vec3(0.5f), glm::vec3(0.0f, 0.0f, 1.0f));
+  PixelGuide g;
+  EXPECT_FALSE(guide.guide(cell, g)) << "no model before training";
+  const float u0x = 0.7f, u0y = 0.3f, width = 0.05f;
+  shared::pg_rng rng = shared::pg_rng_make(1u, 2u, 3u, 4u, 0u);
+  for (int frame = 0; frame < 20; ++frame) {
+    std::vector<std::vector<WorldTrainingSample>> blocks(1);
+    for (int k = 0; k < 400; ++k) {
+      const float ux = shared::pg_rng_next(&rng), uy = shared::pg_rng_next(&rng);
+      const float d2 = (ux - u0x) * (ux - u0x) + (uy - u0y) * (uy - u0y);
+      const float a = std::exp(-0.5f * d2 / (width * width));
+      blocks[0].push_back({cell, a, ux, uy, 1.0f / 3.14159265f, 1.0f / 3.14159265f});
+    }
+    guide.train(blocks);
+  }
+  ASSERT_TRUE(guide.guide(cell, g));
+  EXPECT_NEAR(g.model.mx, u0x, 0.02f);
+  EXPECT_NEAR(g.model.my, u0y, 0.02f);
+  EXPECT_LT(g.model.l11, 3.0f * width);
+  EXPECT_GT(g.model.pi, 0.0f);
+  EXPECT_NEAR(glm::dot(g.frame.n, glm::vec3(0.0f, 0.0f, 1.0f)), 1.0f, 1e-6f);
+  EXPECT_EQ(guide.cell_count(), 1u);
+  EXPECT_EQ(guide.samples_last_frame(), 400u);
+}
+
+std::vector<std::vector<WorldTrainingSample>> many_cells(const WorldGuide& guide, int cells,
+                                                         int per_cell, std::uint32_t seed) {
+  std::vector<std::vector<WorldTrainingSample>> blocks(3);
+  shared::pg_rng rng = shared::pg_rng_make(seed, 0u, 0u, 0u, 0u);
+  for (int k = 0; k < per_cell; ++k)
+    for (int c = 0; c < cells; ++c) {
+      const glm::vec3 p(static_cast<float>(c % 50) + 0.5f, static_cast<float>(c / 50) + 0.5f, 0.5f);
+      const float ux = shared::pg_rng_next(&rng), uy = shared::pg_rng_next(&rng);
+      blocks[static_cast<std::size_t>(c) % 3].push_back(
+          {guide.cell_of(p, glm::vec3(0.0f, 0.0f, 1.0f)), 1.0f + ux, ux, uy, 0.3f, 0.3f});
+    }
+  return blocks;
+}
+
+// The table starts at 4096 slots and doubles at half full: 5,000 cells make it grow twice
+// during one frame's training, and every cell keeps its model.
+TEST(WorldGuide, TheTableGrowsAndKeepsEveryCell) {
+  WorldGuide guide(glm::vec3(0.0f), glm::vec3(100.0f), settings_for_test(100));
+  const int cells = 5000;
+  for (int frame = 0; frame < 2; ++frame) guide.train(many_cells(guide, cells, 4, frame + 1u));
+  EXPECT_EQ(guide.cell_count(), static_cast<std::size_t>(cells));
+  int with_model = 0;
+  for (int c = 0; c < cells; ++c) {
+    PixelGuide g;
+    const glm::vec3 p(static_cast<float>(c % 50) + 0.5f, static_cast<float>(c / 50) + 0.5f, 0.5f);
+    with_model += guide.guide(guide.cell_of(p, glm::vec3(0.0f, 0.0f, 1.0f)), g);
+  }
+  EXPECT_EQ(with_model, cells);
+}
+
+// At most 2^max_cells_log2 cells: samples of cells beyond that are dropped, nothing else.
+TEST(WorldGuide, AFullTableDropsNewCells) {
+  WorldGuideSettings s = settings_for_test(100);
+  s.max_cells_log2 = 11;  // 2,048 cells: the table may grow once, to 4,096 slots... then stops
+  WorldGuide guide(glm::vec3(0.0f), glm::vec3(100.0f), s);
+  guide.train(many_cells(guide, 5000, 2, 7u));
+  EXPECT_LE(guide.cell_count(), std::size_t{2048});
+  EXPECT_GT(guide.cell_count(), std::size_t{1000});
+  guide.train(many_cells(guide, 5000, 2, 8u));
+  EXPECT_LE(guide.cell_count(), std::size_t{2048});
+}
+
+// Training sums each cell's samples in the blocks' order, so one thread and many give the same
+// models to the bit.
+TEST(WorldGuide, TrainsTheSameWhateverTheThreadCount) {
+  const auto train = [](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                              static_cast<std::size_t>(threads));
+    WorldGuide guide(glm::vec3(0.0f), glm::vec3(100.0f), settings_for_test(100));
+    for (int frame = 0; frame < 3; ++frame) guide.train(many_cells(guide, 3000, 6, frame + 1u));
+    std::vector<float> models;
+    for (int c = 0; c < 3000; ++c) {
+      PixelGuide g;
+      const glm::vec3 p(static_cast<float>(c % 50) + 0.5f, static_cast<float>(c / 50) + 0.5f, 0.5f);
+      if (guide.guide(guide.cell_of(p, glm::vec3(0.0f, 0.0f, 1.0f)), g))
+        models.insert(models.end(),
+                      {g.model.pi, g.model.mx, g.model.my, g.model.l11, g.model.l21, g.model.l22});
+    }
+    return models;
+  };
+  const std::vector<float> one = train(1), many = train(4);
+  ASSERT_EQ(one.size(), 3000u * 6u);
+  EXPECT_EQ(one, many);
+}
+
+}  // namespace
+}  // namespace rtpg
