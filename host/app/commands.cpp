@@ -228,8 +228,8 @@ int run_render(const RenderCommand& command) {
   settings.world_guide = command.guide_vertices == "world";
   settings.world_guide_settings.resolution = command.world_guide_resolution;
   settings.world_guide_settings.record_every = command.world_guide_record_every;
-  if (command.world_guide_max_depth > 0)
-    settings.world_guide_settings.max_depth = command.world_guide_max_depth;
+  settings.world_guide_settings.max_depth =
+      command.world_guide_max_depth > 0 ? command.world_guide_max_depth : 1 << 30;
   settings.world_guide_settings.em = to_kernel_settings(command.guiding_settings);
   settings.path_tracer.first_bounce_mis =
       command.first_bounce_mis == "bsdf" ? FirstBounceMis::bsdf : FirstBounceMis::mixture;

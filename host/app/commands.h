@@ -38,7 +38,7 @@ struct RenderCommand {
                                            // or "world" (the world-space guide's
                                            // cells, render/world_guide.h)
   int world_guide_resolution = 32;         // --world-guide-resolution
-  int world_guide_max_depth = 0;           // --world-guide-max-depth (0: every vertex)
+  int world_guide_max_depth = 2;           // --world-guide-max-depth (0: every vertex)
   int world_guide_record_every = 1;        // --world-guide-record-every
   std::string share_randoms = "none";      // --share-randoms: SharedRandoms by name
                                            // (host/render/path_tracer.h)

@@ -22,7 +22,7 @@ namespace rtpg {
 struct WorldGuideSettings {
   int resolution = 32;      // cells along the scene's longest extent
   int max_cells_log2 = 20;  // at most 2^n cells (the table doubles as cells are made)
-  int max_depth = 1 << 30;  // the deepest path vertex guided and trained (y is 1)
+  int max_depth = 2;        // the deepest path vertex guided and trained (y is 1)
   int record_every = 1;     // one path in n records its vertices for training (all sample)
   pg_kernel_settings em{};  // the mixture's EM settings (the pixels', to_kernel_settings)
 };

@@ -43,7 +43,8 @@ struct RunShape {
   std::string camera_path;
   bool guide_secondary = false;  // later vertices borrow their pixel's mixture
   bool world_guide = false;      // later vertices sample the world-space guide's cells
-  bool pi_learning = false;      // the variance-aware mixing weight (GuidingSettings)
+  int world_max_depth = WorldGuideSettings{}.max_depth;  // the deepest vertex it guides
+  bool pi_learning = false;  // the variance-aware mixing weight (GuidingSettings)
   FirstBounceMis first_bounce_mis = FirstBounceMis::bsdf;  // PathTracerSettings
   bool direct_light_in_vpls = true;                        // PathTracerSettings
   HostTransfer transfer = HostTransfer::automatic;         // the guided first bounce's
@@ -77,6 +78,7 @@ TileSeries run(const Scene& scene, Method method, int size, int frames, ClRuntim
   settings.path_tracer.guide_secondary = guided && shape.guide_secondary;
   settings.world_guide = guided && shape.world_guide;
   settings.world_guide_settings.em = to_kernel_settings(GuidingSettings{});
+  settings.world_guide_settings.max_depth = shape.world_max_depth;
   settings.path_tracer.first_bounce_mis = shape.first_bounce_mis;
   settings.path_tracer.direct_light_in_vpls = shape.direct_light_in_vpls;
   settings.jitter = false;  // both methods estimate the same integral per pixel
@@ -269,6 +271,7 @@ TEST(GuidingImage, UnbiasedWithTheWorldGuideOnATurnedBox) {
 TEST(GuidingImage, UnbiasedWithTheWorldGuideOnCornellIndirect) {
   RunShape shape;
   shape.world_guide = true;
+  shape.world_max_depth = 8;  // every vertex, beyond the default's two
   expect_same_means("cornell-indirect.json", 640, 0.015, shape);
 }
 
