@@ -1,6 +1,7 @@
 #include "render/world_guide.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -26,6 +27,19 @@ std::uint64_t mix(std::uint64_t x) {  // splitmix64's finaliser
   x *= 0x94d049bb133111ebull;
   return x ^ (x >> 31);
 }
+
+// The six normal bins' hemisphere frames, made once (every guided vertex asks for one).
+std::array<shared::pg_frame, 6> make_cell_frames() {
+  std::array<shared::pg_frame, 6> frames;
+  for (int bin = 0; bin < 6; ++bin) {
+    glm::vec3 axis(0.0f);
+    axis[bin / 2] = bin % 2 == 0 ? 1.0f : -1.0f;
+    frames[static_cast<std::size_t>(bin)] = shared::pg_frame_from_normal(axis);
+  }
+  return frames;
+}
+
+const std::array<shared::pg_frame, 6> kCellFrames = make_cell_frames();
 
 }  // namespace
 
@@ -55,10 +69,7 @@ std::uint64_t WorldGuide::cell_of(const glm::vec3& position, const glm::vec3& no
 }
 
 shared::pg_frame WorldGuide::cell_frame(std::uint64_t cell) {
-  const std::uint64_t bin = cell >> (3 * kAxisBits);
-  glm::vec3 axis(0.0f);
-  axis[static_cast<int>(bin / 2)] = bin % 2 == 0 ? 1.0f : -1.0f;
-  return shared::pg_frame_from_normal(axis);
+  return kCellFrames[cell >> (3 * kAxisBits)];
 }
 
 std::size_t WorldGuide::home(std::uint64_t cell) const {
@@ -135,12 +146,6 @@ void WorldGuide::train(const std::vector<std::vector<WorldTrainingSample>>& bloc
   const std::size_t total = block_offset_.back();
   samples_last_ = total;
   if (total == 0) return;
-  const auto sample_at = [&](std::size_t k) -> const WorldTrainingSample& {
-    const std::size_t b =
-        static_cast<std::size_t>(std::upper_bound(block_offset_.begin(), block_offset_.end(), k) -
-                                 block_offset_.begin() - 1);
-    return blocks[b][k - block_offset_[b]];
-  };
   slot_of_.resize(total);
   find_slots(blocks);
   // Cells seen for the first time are made in the samples' order (serially: the table's layout
@@ -156,34 +161,33 @@ void WorldGuide::train(const std::vector<std::vector<WorldTrainingSample>>& bloc
           slot_of_[block_offset_[b] + k] = static_cast<std::uint32_t>(s);
       }
   if (made && slots_.size() != slots_before) find_slots(blocks);
-  // The samples' indices grouped by slot, in their order within each slot.
+  // The samples grouped by slot, in their order within each slot (a counting sort that moves
+  // what the E-step reads, so that each cell then reads its samples in one run).
   const std::size_t slot_count = slots_.size();
   slot_begin_.assign(slot_count + 1, 0);
   for (std::size_t k = 0; k < total; ++k)
     if (slot_of_[k] < slot_count) ++slot_begin_[slot_of_[k] + 1];
   for (std::size_t s = 0; s < slot_count; ++s) slot_begin_[s + 1] += slot_begin_[s];
-  by_slot_.resize(slot_begin_[slot_count]);
-  {
-    std::vector<std::uint32_t> next(slot_begin_.begin(), slot_begin_.end() - 1);
-    for (std::size_t k = 0; k < total; ++k)
-      if (slot_of_[k] < slot_count) by_slot_[next[slot_of_[k]]++] = static_cast<std::uint32_t>(k);
+  sorted_packed_.resize(slot_begin_[slot_count]);
+  sorted_density_.resize(slot_begin_[slot_count]);
+  next_.assign(slot_begin_.begin(), slot_begin_.end() - 1);
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const std::uint32_t* slot = &slot_of_[block_offset_[b]];
+    for (const WorldTrainingSample& sample : blocks[b]) {
+      const std::uint32_t s = *slot++;
+      if (s >= slot_count) continue;
+      const std::uint32_t at = next_[s]++;
+      sorted_packed_[at] = shared::float4(sample.a, sample.ux, sample.uy, sample.bsdf_pdf);
+      sorted_density_[at] = sample.density;
+    }
   }
   const pg_kernel_settings& p = settings_.em;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, slot_count, 1024), [&](const auto& range) {
-    std::vector<shared::float4> packed;
-    std::vector<float> densities;
     for (std::size_t s = range.begin(); s != range.end(); ++s) {
-      const std::size_t n = slot_begin_[s + 1] - slot_begin_[s];
+      const std::size_t begin = slot_begin_[s], n = slot_begin_[s + 1] - begin;
       if (n == 0) continue;
-      packed.resize(n);
-      densities.resize(n);
-      for (std::size_t k = 0; k < n; ++k) {
-        const WorldTrainingSample& sample = sample_at(by_slot_[slot_begin_[s] + k]);
-        packed[k] = shared::float4(sample.a, sample.ux, sample.uy, sample.bsdf_pdf);
-        densities[k] = sample.density;
-      }
       int updated = 0;
-      states_[s] = shared::pg_pmm_train(states_[s], packed.data(), densities.data(),
+      states_[s] = shared::pg_pmm_train(states_[s], &sorted_packed_[begin], &sorted_density_[begin],
                                         static_cast<int>(n), p, static_cast<float>(n), 1, &updated);
       slots_[s].model = shared::pg_pmm_model_from_state(states_[s], p);
     }

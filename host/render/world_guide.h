@@ -83,10 +83,13 @@ class WorldGuide {
   std::vector<Slot> slots_;
   std::vector<shared::pg_pmm_state> states_;  // per slot
   std::size_t mask_ = 0, used_ = 0, samples_last_ = 0;
-  // Training's scratch, kept from frame to frame: the samples' slots and block offsets, and
-  // the samples' indices grouped by slot (a counting sort) with each slot's first index.
-  std::vector<std::uint32_t> slot_of_, by_slot_, slot_begin_;
+  // Training's scratch, kept from frame to frame: the samples' slots and block offsets, each
+  // slot's first sample in the samples grouped by slot (a counting sort), and those samples as
+  // pg_pmm_train reads them (weight, square point, BSDF density; the density drawn with).
+  std::vector<std::uint32_t> slot_of_, slot_begin_, next_;
   std::vector<std::size_t> block_offset_;
+  std::vector<shared::float4> sorted_packed_;
+  std::vector<float> sorted_density_;
 };
 
 }  // namespace rtpg
