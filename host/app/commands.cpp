@@ -231,6 +231,13 @@ int run_render(const RenderCommand& command) {
   settings.world_guide_settings.max_depth =
       command.world_guide_max_depth > 0 ? command.world_guide_max_depth : 1 << 30;
   settings.world_guide_settings.em = to_kernel_settings(command.guiding_settings);
+  if (command.world_guide_pi_max >= 0.0f) {
+    if (command.world_guide_pi_max < settings.world_guide_settings.em.pi_min)
+      throw InputError("--world-guide-pi-max",
+                       fmt::format("{} is below --pg-pi-min ({})", command.world_guide_pi_max,
+                                   settings.world_guide_settings.em.pi_min));
+    settings.world_guide_settings.em.pi_max = command.world_guide_pi_max;
+  }
   settings.path_tracer.first_bounce_mis =
       command.first_bounce_mis == "bsdf" ? FirstBounceMis::bsdf : FirstBounceMis::mixture;
   settings.path_tracer.shared_randoms = parse_shared_randoms(command.share_randoms);

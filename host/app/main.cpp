@@ -55,6 +55,10 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
                   "the world guide (1: the first bounce's hit; 0: every vertex)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
+  cmd->add_option("--world-guide-pi-max", r.world_guide_pi_max,
+                  "With --guide-vertices world: the cells' largest mixing weight (default: "
+                  "--pg-pi-max's)")
+      ->check(CLI::Range(0.0f, 1.0f));
   cmd->add_option("--world-guide-record-every", r.world_guide_record_every,
                   "With --guide-vertices world: one path in n (chosen afresh every frame) records "
                   "its vertices to train the world guide")
