@@ -151,7 +151,10 @@ void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
   hits_.resize(n);
   alive_.assign(n, 0);
   if (world_guide_) {
-    world_vertices_.resize(n * static_cast<std::size_t>(std::max(settings_.max_bounces, 1)));
+    // One record per path for each depth the guide covers.
+    world_stride_ = static_cast<std::size_t>(
+        std::max(1, std::min(settings_.max_bounces, world_guide_->settings().max_depth)));
+    world_vertices_.resize(n * world_stride_);
     world_depth_.resize(n);
     // The paths that record for training: one in record_every, chosen afresh every sample by
     // a hash of the pixel (the others still sample the guide).
@@ -332,6 +335,8 @@ void PathTracer::add_found_light(PathState& p, std::uint32_t i, int depth, const
 
 void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays) {
   const bool nee = next_event_on_;
+  // The world guide's vertices at this depth: sampled from it, and recorded to train it.
+  const bool world_here = world_guide_ && depth <= world_guide_->settings().max_depth;
   std::atomic<std::uint64_t> guided_vertices{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
     std::uint64_t guided_here = 0;
@@ -347,7 +352,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       if (settings_.guide_secondary && j + kPrefetchAhead < range.end())
         borrow_from[(j + kPrefetchAhead) % kBorrowRing] = prefetch_borrowable(j + kPrefetchAhead);
       if (j + kPathPrefetchAhead < range.end()) prefetch_path(active_[j + kPathPrefetchAhead]);
-      if (world_guide_ && j + kPrefetchAhead < range.end() && hits_[j + kPrefetchAhead].valid()) {
+      if (world_here && j + kPrefetchAhead < range.end() && hits_[j + kPrefetchAhead].valid()) {
         const Ray& ahead = rays_[j + kPrefetchAhead];
         world_guide_->prefetch(ahead.origin + ahead.direction * hits_[j + kPrefetchAhead].t);
       }
@@ -358,8 +363,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       // The previous vertex's light sample is in the path's radiance now (the compaction added
       // it); what comes after is the light its bounce found.
       if (world_guide_ && depth >= 2 && world_depth_[i] == depth - 1)
-        world_vertices_[i * static_cast<std::size_t>(settings_.max_bounces) + (depth - 2)]
-            .radiance_before = p.radiance;
+        world_vertices_[i * world_stride_ + (depth - 2)].radiance_before = p.radiance;
       const Ray ray = rays_[j];
       const Hit& hit = hits_[j];
       shadow_rays_[j] = inactive_ray();
@@ -424,10 +428,9 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       // (view-independent), not to a glossy one seen from elsewhere. The world guide's cells
       // learn from many view directions, so the same holds for them.
       const bool diffuse_enough = lobes.p_specular <= 0.5f;
-      const std::uint64_t cell =
-          world_guide_ && diffuse_enough && depth <= world_guide_->settings().max_depth
-              ? world_guide_->cell_of(sp.position, sp.shading_normal)
-              : WorldGuide::kNoCell;
+      const std::uint64_t cell = world_here && diffuse_enough
+                                     ? world_guide_->cell_of(sp.position, sp.shading_normal)
+                                     : WorldGuide::kNoCell;
       const bool guided = (settings_.guide_secondary && diffuse_enough &&
                            borrow_guide(borrow_from[j % kBorrowRing], sp, guide)) ||
                           (cell != WorldGuide::kNoCell && world_guide_->guide(cell, guide));
@@ -517,9 +520,8 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       p.prev_position = sp.position;
       set_ray(rays_[j], origin, wi_world, 0.0f, 1e30f);
       alive_[j] = 1;
-      if (world_guide_ && world_depth_[i] != kNotRecording) {
-        WorldVertex& v =
-            world_vertices_[i * static_cast<std::size_t>(settings_.max_bounces) + (depth - 1)];
+      if (world_here && world_depth_[i] != kNotRecording) {
+        WorldVertex& v = world_vertices_[i * world_stride_ + (depth - 1)];
         v.cell = WorldGuide::kNoCell;
         if (cell != WorldGuide::kNoCell) {
           // A guided vertex has its bounce in the cell's square already (the cell guided it).
@@ -663,7 +665,7 @@ void PathTracer::apply_shadow_rays_and_compact(std::size_t count,
 
 void PathTracer::collect_world_samples() {
   const std::size_t n = paths_.size();
-  const std::size_t stride = static_cast<std::size_t>(settings_.max_bounces);
+  const std::size_t stride = world_stride_;
   // Fixed blocks of paths, each into its own vector: the samples' order is the paths' whatever
   // the thread count (WorldGuide::train sums each cell's samples in that order).
   constexpr std::size_t kWorldBlock = 8192;

@@ -254,7 +254,8 @@ class PathTracer {
     glm::vec3 throughput, radiance_before;
   };
   const WorldGuide* world_guide_ = nullptr;
-  std::vector<WorldVertex> world_vertices_;  // [path * max_bounces + depth - 1]
+  std::vector<WorldVertex> world_vertices_;  // [path * world_stride_ + depth - 1]
+  std::size_t world_stride_ = 1;             // the depths recorded: min(max_depth, max_bounces)
   std::vector<std::uint8_t> world_depth_;    // per path: vertices recorded (or kNotRecording)
   static constexpr std::uint8_t kNotRecording = 0xff;
   // Blocks of kWorldBlock paths of each pass, in order; world_blocks_used_ of them hold this
