@@ -228,6 +228,7 @@ int run_render(const RenderCommand& command) {
   settings.world_guide = command.guide_vertices == "world";
   settings.world_guide_settings.resolution = command.world_guide_resolution;
   settings.world_guide_settings.record_every = command.world_guide_record_every;
+  settings.world_guide_settings.min_guiding_pi = command.world_guide_min_pi;
   settings.world_guide_settings.max_depth =
       command.world_guide_max_depth > 0 ? command.world_guide_max_depth : 1 << 30;
   settings.world_guide_settings.em = to_kernel_settings(command.guiding_settings);

@@ -40,6 +40,7 @@ struct RenderCommand {
   int world_guide_resolution = 32;         // --world-guide-resolution
   int world_guide_max_depth = 2;           // --world-guide-max-depth (0: every vertex)
   int world_guide_record_every = 1;        // --world-guide-record-every
+  float world_guide_min_pi = 0.0f;         // --world-guide-min-pi
   float world_guide_pi_max = -1.0f;        // --world-guide-pi-max (< 0: the pixels' --pg-pi-max)
   std::string share_randoms = "none";      // --share-randoms: SharedRandoms by name
                                            // (host/render/path_tracer.h)

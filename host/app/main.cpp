@@ -59,6 +59,11 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
                   "With --guide-vertices world: the cells' largest mixing weight (default: "
                   "--pg-pi-max's)")
       ->check(CLI::Range(0.0f, 1.0f));
+  cmd->add_option("--world-guide-min-pi", r.world_guide_min_pi,
+                  "With --guide-vertices world: a cell guides only where its mixing weight is "
+                  "above this (0: every cell with a model)")
+      ->check(CLI::Range(0.0f, 1.0f))
+      ->capture_default_str();
   cmd->add_option("--world-guide-record-every", r.world_guide_record_every,
                   "With --guide-vertices world: one path in n (chosen afresh every frame) records "
                   "its vertices to train the world guide")

@@ -221,6 +221,8 @@ FrameStats Renderer::render_frame(int index) {
     stats.time_ms["world_train"] = ms_since(t);
     stats.extra["world_cells"] = static_cast<double>(world_guide_->cell_count());
     stats.extra["world_samples"] = static_cast<double>(world_guide_->samples_last_frame());
+    stats.extra["world_mean_pi"] = world_guide_->mean_pi();
+    stats.extra["world_at_pi_min"] = world_guide_->fraction_at_pi_min();
   }
   stats.time_ms["trace"] = times.trace_ms;
   stats.time_ms["shade"] = times.shade_ms;

@@ -12,12 +12,27 @@ namespace {
 constexpr int kAxisBits = 20;
 constexpr std::uint64_t kAxisMask = (std::uint64_t{1} << kAxisBits) - 1;
 
-// The normal's dominant axis and its sign: 0..5 = +x, -x, +y, -y, +z, -z.
+// The normal's dominant axis and its sign: 0..5 = +x, -x, +y, -y, +z, -z. Selects, not branches:
+// a bounce lands on any wall, so a branch here would go either way at random.
 std::uint64_t normal_bin(const glm::vec3& n) {
-  const glm::vec3 a = glm::abs(n);
-  if (a.x >= a.y && a.x >= a.z) return n.x >= 0.0f ? 0 : 1;
-  if (a.y >= a.z) return n.y >= 0.0f ? 2 : 3;
-  return n.z >= 0.0f ? 4 : 5;
+  const float ax = std::fabs(n.x), ay = std::fabs(n.y), az = std::fabs(n.z);
+  const bool x_major = ax >= ay && ax >= az, y_major = !x_major && ay >= az;
+  const float major = x_major ? n.x : (y_major ? n.y : n.z);
+  const std::uint64_t axis = x_major ? 0u : (y_major ? 1u : 2u);
+  return 2u * axis + (major < 0.0f ? 1u : 0u);
+}
+
+// A grid position's bits (0 <= g < 2^20 on each axis, checked by the caller): through 32-bit
+// integers, as a float's conversion to a 64-bit unsigned one takes a branch and two conversions
+// on the x86-64 baseline.
+std::uint64_t position_bits(const glm::vec3& g) {
+  const auto x =
+      static_cast<std::uint64_t>(static_cast<std::uint32_t>(static_cast<std::int32_t>(g.x)));
+  const auto y =
+      static_cast<std::uint64_t>(static_cast<std::uint32_t>(static_cast<std::int32_t>(g.y)));
+  const auto z =
+      static_cast<std::uint64_t>(static_cast<std::uint32_t>(static_cast<std::int32_t>(g.z)));
+  return x | (y << kAxisBits) | (z << (2 * kAxisBits));
 }
 
 std::uint64_t mix(std::uint64_t x) {  // splitmix64's finaliser
@@ -63,9 +78,7 @@ std::uint64_t WorldGuide::cell_of(const glm::vec3& position, const glm::vec3& no
   if (!(g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f)) return kNoCell;
   const float limit = static_cast<float>(kAxisMask);
   if (!(g.x < limit && g.y < limit && g.z < limit)) return kNoCell;
-  const auto x = static_cast<std::uint64_t>(g.x), y = static_cast<std::uint64_t>(g.y),
-             z = static_cast<std::uint64_t>(g.z);
-  return x | (y << kAxisBits) | (z << (2 * kAxisBits)) | (normal_bin(normal) << (3 * kAxisBits));
+  return position_bits(g) | (normal_bin(normal) << (3 * kAxisBits));
 }
 
 shared::pg_frame WorldGuide::cell_frame(std::uint64_t cell) {
@@ -119,15 +132,19 @@ void WorldGuide::grow() {
 
 bool WorldGuide::guide(std::uint64_t cell, PixelGuide& out) const {
   const std::size_t s = find(cell);
-  if (s == slots_.size() || !slots_[s].model.valid) return false;
+  if (s == slots_.size() || !slots_[s].model.valid ||
+      !(slots_[s].model.pi > settings_.min_guiding_pi))
+    return false;
   out.model = slots_[s].model;
   out.frame = cell_frame(cell);
   return true;
 }
 
 void WorldGuide::prefetch(const glm::vec3& position) const {
-  const std::uint64_t cell = cell_of(position, glm::vec3(0.0f, 0.0f, 1.0f));
-  if (cell != kNoCell) __builtin_prefetch(&slots_[home(cell)]);
+  const glm::vec3 g = (position - origin_) * inverse_cell_;
+  const float limit = static_cast<float>(kAxisMask);
+  if (g.x >= 0.0f && g.y >= 0.0f && g.z >= 0.0f && g.x < limit && g.y < limit && g.z < limit)
+    __builtin_prefetch(&slots_[home(position_bits(g))]);
 }
 
 void WorldGuide::find_slots(const std::vector<std::vector<WorldTrainingSample>>& blocks) {
@@ -192,6 +209,16 @@ void WorldGuide::train(const std::vector<std::vector<WorldTrainingSample>>& bloc
       slots_[s].model = shared::pg_pmm_model_from_state(states_[s], p);
     }
   });
+  double pi_sum = 0.0;
+  std::size_t with_model = 0, at_min = 0;
+  for (const Slot& slot : slots_) {
+    if (slot.cell == kNoCell || !slot.model.valid) continue;
+    ++with_model;
+    pi_sum += slot.model.pi;
+    at_min += slot.model.pi <= p.pi_min;
+  }
+  mean_pi_ = with_model ? pi_sum / static_cast<double>(with_model) : 0.0;
+  at_pi_min_ = with_model ? static_cast<double>(at_min) / static_cast<double>(with_model) : 0.0;
 }
 
 }  // namespace rtpg

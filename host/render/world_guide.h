@@ -24,6 +24,9 @@ struct WorldGuideSettings {
   int max_cells_log2 = 20;  // at most 2^n cells (the table doubles as cells are made)
   int max_depth = 2;        // the deepest path vertex guided and trained (y is 1)
   int record_every = 1;     // one path in n records its vertices for training (all sample)
+  // A cell guides only once its lobe's mixing weight exceeds this: a lobe at the lower clamp
+  // explains little of what the cell saw, and its vertices pay for the guided sampling anyway.
+  float min_guiding_pi = 0.0f;
   pg_kernel_settings em{};  // the mixture's EM settings (the pixels', to_kernel_settings)
 };
 
@@ -62,6 +65,10 @@ class WorldGuide {
   const WorldGuideSettings& settings() const { return settings_; }
   std::size_t cell_count() const { return used_; }
   std::size_t samples_last_frame() const { return samples_last_; }
+  // Over the cells with a model after the last train(): their mean mixing weight, and the
+  // fraction at the lower clamp (pi_min: the lobe explains little of what the cell saw).
+  double mean_pi() const { return mean_pi_; }
+  double fraction_at_pi_min() const { return at_pi_min_; }
 
  private:
   // What a lookup reads, apart from the EM state only training reads: 40 bytes a slot, so that
@@ -83,6 +90,7 @@ class WorldGuide {
   std::vector<Slot> slots_;
   std::vector<shared::pg_pmm_state> states_;  // per slot
   std::size_t mask_ = 0, used_ = 0, samples_last_ = 0;
+  double mean_pi_ = 0.0, at_pi_min_ = 0.0;
   // Training's scratch, kept from frame to frame: the samples' slots and block offsets, each
   // slot's first sample in the samples grouped by slot (a counting sort), and those samples as
   // pg_pmm_train reads them (weight, square point, BSDF density; the density drawn with).
