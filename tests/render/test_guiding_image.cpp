@@ -289,8 +289,6 @@ TEST(GuidingImage, UnbiasedWithLaterVerticesGuidedAlongCameraPathAtTwoSpp) {
   expect_same_means("cornell-box.json", 120, 0.0015, RunShape{2, "pan", true});
 }
 
-// Four samples per frame along the camera path: reprojection, a model shared by the frame's
-// samples and next-event MIS against it, together.
 // The variance-aware mixing weight (--pg-pi-learning 1) changes only the densities the first
 // bounce samples with, and next-event MIS weighs against the same ones.
 TEST(GuidingImage, UnbiasedWithLearnedMixingWeightAlongCameraPathAtTwoSpp) {
@@ -345,6 +343,8 @@ TEST(GuidingImage, UnbiasedWithThePackedGBufferAlongCameraPathAtTwoSpp) {
   expect_same_means("cornell-box.json", 120, 0.0015, shape);
 }
 
+// Four samples per frame along the camera path: reprojection, a model shared by the frame's
+// samples and next-event MIS against it, together.
 TEST(GuidingImage, UnbiasedAlongCameraPathAtFourSpp) {
   expect_same_means("cornell-box.json", 60, 0.0015, RunShape{4, "pan"});
 }
