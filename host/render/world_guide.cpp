@@ -148,10 +148,16 @@ void WorldGuide::prefetch(const glm::vec3& position) const {
 }
 
 void WorldGuide::find_slots(const std::vector<std::vector<WorldTrainingSample>>& blocks) {
+  misses_.assign(blocks.size(), 0);
   tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
     const std::vector<WorldTrainingSample>& block = blocks[b];
-    for (std::size_t k = 0; k < block.size(); ++k)
-      slot_of_[block_offset_[b] + k] = static_cast<std::uint32_t>(find(block[k].cell));
+    std::size_t missed = 0;
+    for (std::size_t k = 0; k < block.size(); ++k) {
+      const std::size_t s = find(block[k].cell);
+      slot_of_[block_offset_[b] + k] = static_cast<std::uint32_t>(s);
+      missed += s == slots_.size();
+    }
+    misses_[b] = missed;
   });
 }
 
@@ -169,7 +175,8 @@ void WorldGuide::train(const std::vector<std::vector<WorldTrainingSample>>& bloc
   // is then the same on every run); if the table grew, every slot moved.
   const std::size_t slots_before = slots_.size();
   bool made = false;
-  for (std::size_t b = 0; b < blocks.size(); ++b)
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    if (misses_[b] == 0) continue;
     for (std::size_t k = 0; k < blocks[b].size(); ++k)
       if (slot_of_[block_offset_[b] + k] == slots_before) {
         const std::size_t s = find_or_insert(blocks[b][k].cell);
@@ -177,27 +184,52 @@ void WorldGuide::train(const std::vector<std::vector<WorldTrainingSample>>& bloc
         if (slots_.size() == slots_before && s != slots_.size())
           slot_of_[block_offset_[b] + k] = static_cast<std::uint32_t>(s);
       }
+  }
   if (made && slots_.size() != slots_before) find_slots(blocks);
   // The samples grouped by slot, in their order within each slot (a counting sort that moves
-  // what the E-step reads, so that each cell then reads its samples in one run).
+  // what the E-step reads, so that each cell then reads its samples in one run). Groups of
+  // consecutive blocks count and move their samples in parallel, each from its own offsets:
+  // a slot's samples are group 0's in order, then group 1's, ..., the paths' order whatever
+  // the number of groups.
   const std::size_t slot_count = slots_.size();
-  slot_begin_.assign(slot_count + 1, 0);
-  for (std::size_t k = 0; k < total; ++k)
-    if (slot_of_[k] < slot_count) ++slot_begin_[slot_of_[k] + 1];
-  for (std::size_t s = 0; s < slot_count; ++s) slot_begin_[s + 1] += slot_begin_[s];
-  sorted_packed_.resize(slot_begin_[slot_count]);
-  sorted_density_.resize(slot_begin_[slot_count]);
-  next_.assign(slot_begin_.begin(), slot_begin_.end() - 1);
-  for (std::size_t b = 0; b < blocks.size(); ++b) {
-    const std::uint32_t* slot = &slot_of_[block_offset_[b]];
-    for (const WorldTrainingSample& sample : blocks[b]) {
-      const std::uint32_t s = *slot++;
-      if (s >= slot_count) continue;
-      const std::uint32_t at = next_[s]++;
-      sorted_packed_[at] = shared::float4(sample.a, sample.ux, sample.uy, sample.bsdf_pdf);
-      sorted_density_[at] = sample.density;
+  const std::size_t groups = std::min<std::size_t>(blocks.size(), 8);
+  const auto group_blocks = [&](std::size_t g) {
+    return std::make_pair(g * blocks.size() / groups, (g + 1) * blocks.size() / groups);
+  };
+  group_next_.assign(groups * slot_count, 0);
+  tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t g) {
+    std::uint32_t* count = &group_next_[g * slot_count];
+    const auto [first, last] = group_blocks(g);
+    for (std::size_t k = block_offset_[first]; k < block_offset_[last]; ++k)
+      if (slot_of_[k] < slot_count) ++count[slot_of_[k]];
+  });
+  slot_begin_.resize(slot_count + 1);
+  std::uint32_t at = 0;
+  for (std::size_t s = 0; s < slot_count; ++s) {
+    slot_begin_[s] = at;
+    for (std::size_t g = 0; g < groups; ++g) {
+      const std::uint32_t n = group_next_[g * slot_count + s];
+      group_next_[g * slot_count + s] = at;
+      at += n;
     }
   }
+  slot_begin_[slot_count] = at;
+  sorted_packed_.resize(at);
+  sorted_density_.resize(at);
+  tbb::parallel_for(std::size_t{0}, groups, [&](std::size_t g) {
+    std::uint32_t* next = &group_next_[g * slot_count];
+    const auto [first, last] = group_blocks(g);
+    for (std::size_t b = first; b < last; ++b) {
+      const std::uint32_t* slot = &slot_of_[block_offset_[b]];
+      for (const WorldTrainingSample& sample : blocks[b]) {
+        const std::uint32_t s = *slot++;
+        if (s >= slot_count) continue;
+        const std::uint32_t to = next[s]++;
+        sorted_packed_[to] = shared::float4(sample.a, sample.ux, sample.uy, sample.bsdf_pdf);
+        sorted_density_[to] = sample.density;
+      }
+    }
+  });
   const pg_kernel_settings& p = settings_.em;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, slot_count, 1024), [&](const auto& range) {
     for (std::size_t s = range.begin(); s != range.end(); ++s) {

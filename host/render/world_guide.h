@@ -94,8 +94,9 @@ class WorldGuide {
   // Training's scratch, kept from frame to frame: the samples' slots and block offsets, each
   // slot's first sample in the samples grouped by slot (a counting sort), and those samples as
   // pg_pmm_train reads them (weight, square point, BSDF density; the density drawn with).
-  std::vector<std::uint32_t> slot_of_, slot_begin_, next_;
-  std::vector<std::size_t> block_offset_;
+  std::vector<std::uint32_t> slot_of_, slot_begin_;
+  std::vector<std::uint32_t> group_next_;  // per group of blocks and slot: count, then next place
+  std::vector<std::size_t> block_offset_, misses_;  // misses_: per block, samples without a slot
   std::vector<shared::float4> sorted_packed_;
   std::vector<float> sorted_density_;
 };
