@@ -151,9 +151,10 @@ void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
   hits_.resize(n);
   alive_.assign(n, 0);
   if (world_guide_) {
-    // One record per path for each depth the guide covers.
-    world_stride_ = static_cast<std::size_t>(
-        std::max(1, std::min(settings_.max_bounces, world_guide_->settings().max_depth)));
+    // One record per path for each depth the guide covers (at most 254: world_depth_ counts them
+    // in a byte beside kNotRecording).
+    world_depths_ = std::min({settings_.max_bounces, world_guide_->settings().max_depth, 254});
+    world_stride_ = static_cast<std::size_t>(std::max(1, world_depths_));
     world_vertices_.resize(n * world_stride_);
     world_depth_.resize(n);
     // The paths that record for training: one in record_every, chosen afresh every sample by
@@ -336,7 +337,7 @@ void PathTracer::add_found_light(PathState& p, std::uint32_t i, int depth, const
 void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays) {
   const bool nee = next_event_on_;
   // The world guide's vertices at this depth: sampled from it, and recorded to train it.
-  const bool world_here = world_guide_ && depth <= world_guide_->settings().max_depth;
+  const bool world_here = world_guide_ && depth <= world_depths_;
   std::atomic<std::uint64_t> guided_vertices{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
     std::uint64_t guided_here = 0;

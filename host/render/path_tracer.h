@@ -255,7 +255,8 @@ class PathTracer {
   };
   const WorldGuide* world_guide_ = nullptr;
   std::vector<WorldVertex> world_vertices_;  // [path * world_stride_ + depth - 1]
-  std::size_t world_stride_ = 1;             // the depths recorded: min(max_depth, max_bounces)
+  int world_depths_ = 0;                     // the depths the guide covers (prepare)
+  std::size_t world_stride_ = 1;             // records per path: max(1, world_depths_)
   std::vector<std::uint8_t> world_depth_;    // per path: vertices recorded (or kNotRecording)
   static constexpr std::uint8_t kNotRecording = 0xff;
   // Blocks of kWorldBlock paths of each pass, in order; world_blocks_used_ of them hold this

@@ -24,8 +24,9 @@ struct WorldGuideSettings {
   int max_cells_log2 = 20;  // at most 2^n cells (the table doubles as cells are made)
   int max_depth = 2;        // the deepest path vertex guided and trained (y is 1)
   int record_every = 1;     // one path in n records its vertices for training (all sample)
-  // A cell guides only once its lobe's mixing weight exceeds this: a lobe at the lower clamp
-  // explains little of what the cell saw, and its vertices pay for the guided sampling anyway.
+  // A cell guides only where its lobe's mixing weight exceeds this (0: every cell with a model;
+  // 0.06 and 0.1, which leave out the cells at the lower clamp, gained neither error nor time:
+  // docs/guiding.md, "A world-space guide for later vertices").
   float min_guiding_pi = 0.0f;
   pg_kernel_settings em{};  // the mixture's EM settings (the pixels', to_kernel_settings)
 };
