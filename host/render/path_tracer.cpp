@@ -71,13 +71,21 @@ bool usable_vpl_density(float pdf) {
 // Density of a borrowed guide's mixture at world direction w (bsdf_pdf: the vertex's own BSDF
 // density there): the Gaussian of the lending pixel in that pixel's frame, mixed with the
 // vertex's BSDF.
+// The same, given the direction's point in the guide's square (in_square false: the direction
+// lies below the guide's hemisphere, where the Gaussian has no density).
+float guide_density_at(const PixelGuide& guide, bool in_square, const shared::float2& square,
+                       float bsdf_pdf) {
+  const float gaussian =
+      in_square ? shared::pg_pmm_gaussian_pdf(guide.model, square) * PG_INV_TWO_PI : 0.0f;
+  return guide.model.pi * gaussian + (1.0f - guide.model.pi) * bsdf_pdf;
+}
+
 float guide_density(const PixelGuide& guide, const glm::vec3& w, float bsdf_pdf) {
   const glm::vec3 l = shared::pg_to_local(guide.frame, w);
-  float gaussian = 0.0f;
-  if (l.z > 0.0f)
-    gaussian = shared::pg_pmm_gaussian_pdf(guide.model, shared::pg_hemisphere_to_square(l)) *
-               PG_INV_TWO_PI;
-  return guide.model.pi * gaussian + (1.0f - guide.model.pi) * bsdf_pdf;
+  const bool in_square = l.z > 0.0f;
+  return guide_density_at(
+      guide, in_square, in_square ? shared::pg_hemisphere_to_square(l) : shared::float2(0.0f, 0.0f),
+      bsdf_pdf);
 }
 
 Ray inactive_ray() {
@@ -496,9 +504,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
           in_square = l.z > 0.0f;
           if (in_square) square = shared::pg_hemisphere_to_square(l);
         }
-        const float gaussian =
-            in_square ? shared::pg_pmm_gaussian_pdf(guide.model, square) * PG_INV_TWO_PI : 0.0f;
-        bs.pdf = guide.model.pi * gaussian + (1.0f - guide.model.pi) * bsdf_pdf;
+        bs.pdf = guide_density_at(guide, in_square, square, bsdf_pdf);
         if (!(bs.pdf > 0.0f)) continue;
         if (mis_with_bsdf) mis_pdf = bsdf_mis_density(bsdf_pdf);
       }
