@@ -10,10 +10,16 @@ on stdout and everything in OUT/results.json.
 Run from the repository's root (the scenes and bench/suite are read from there), with RTPG_BINARY
 the bundle's rtpg and the bundle's environment (LD_LIBRARY_PATH, OCL_ICD_VENDORS, RTPG_DEVICE):
     RTPG_BINARY=DIR/bin/rtpg python3 tools/gpu_equal_time.py --out OUT [--scenes ...] [--res WxH]
-        [--frames 32] [--repeats 3] [--ref-spp 1024]
+        [--frames 32] [--repeats 3] [--ref-spp 1024] [--pg-args "ARGS"] [--references-only]
+--pg-args adds rtpg arguments to the guided runs alone (a variant of guiding against the same path
+tracing, say "--guide-vertices world"). --references-only makes the references in OUT/references
+and stops: references take minutes of host time, which a CPU machine can spend instead of the GPU
+machine's lease (tools/gpu_equal_time.sh copies them there; they are keyed by the renderer's
+sources, so they are found only for the same sources).
 """
 import argparse
 import json
+import shlex
 import statistics
 import sys
 from pathlib import Path
@@ -30,15 +36,24 @@ def main():
     parser.add_argument("--frames", type=int, default=32)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--ref-spp", type=int, default=1024)
+    parser.add_argument("--pg-args", default="", help="more rtpg arguments for the guided runs only")
+    parser.add_argument("--references-only", action="store_true")
     args = parser.parse_args()
     references = runner.ReferenceCache(args.out / "references")
+    if args.references_only:
+        for scene in args.scenes:
+            print(scene, references.get(scene, args.res, args.ref_spp), flush=True)
+        return
+    pg_extra = shlex.split(args.pg_args)
     results = {"settings": {"res": args.res, "frames": args.frames, "repeats": args.repeats,
-                            "ref_spp": args.ref_spp, "machine": runner.machine_info()}, "scenes": {}}
+                            "ref_spp": args.ref_spp, "pg_args": pg_extra, "machine": runner.machine_info()},
+               "scenes": {}}
     print("| scene | PT time | PG time / PT | accumulated relMSE PG / PT at PT's time "
           "| PG's time to PT's final error |\n|---|---|---|---|---|", flush=True)
     for scene in args.scenes:
         reference = references.get(scene, args.res, args.ref_spp)
-        curves = equal_time.runs(scene, args.res, args.frames, args.repeats, args.out / scene, reference)
+        curves = equal_time.runs(scene, args.res, args.frames, args.repeats, args.out / scene, reference,
+                                 pg_extra=pg_extra)
         figures = equal_time.figures_of(curves)
         pg_time = statistics.median(r["time_ms"][-1] for r in curves["pmm"]["runs"])
         at_budget = figures["relmse_at_pt_budget"]

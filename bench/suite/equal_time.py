@@ -121,18 +121,20 @@ def figures(pt_runs, pg_runs):
             "time_ratio_pg_pt": NOT_REACHED if pg_time == NOT_REACHED else pg_time / budget}
 
 
-def runs(scene, res, frames, repeats, out, reference, extra=()):
+def runs(scene, res, frames, repeats, out, reference, extra=(), pg_extra=()):
     """The curves of `repeats` runs of each method (`rtpg render --accumulate --reference`, seeds
     100, 101, ...), PT and PG alternating run by run, so that a machine whose speed drifts slows
     both alike rather than one method's block of runs: {method: {"runs": [{"time_ms": cumulative
     frame totals, "relmse": accumulated relMSE per frame}]}}. Frame 0 also builds the OpenCL
     programs (from the disk cache) and compiles work-group functions, a one-time start-up cost, so
-    its time is replaced by the median frame's. `extra`: more rtpg arguments for both methods."""
+    its time is replaced by the median frame's. `extra`: more rtpg arguments for both methods;
+    `pg_extra`: for the guided runs only (a variant of guiding against the same path tracing)."""
     curves = {method: {"runs": []} for method in runner.METHODS}
     for r in range(repeats):
         for method in runner.METHODS:
             stats, _ = runner.render(scene, res, frames, method, out, f"{method}-r{r}", reference=reference,
-                                     extra=["--accumulate", "--seed", 100 + r, *extra])
+                                     extra=["--accumulate", "--seed", 100 + r, *extra,
+                                            *(pg_extra if method == "pmm" else ())])
             ms = [f["time_ms"]["total"] for f in stats["frames"]]
             ms[0] = statistics.median(ms[1:]) if len(ms) > 1 else ms[0]
             curves[method]["runs"].append({"time_ms": list(itertools.accumulate(ms)),

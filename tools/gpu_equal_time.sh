@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# Equal time on a GPU machine inside one short lease: PT against PG (tools/gpu_equal_time.py),
+# optionally against a variant of guiding too, then the OpenCL test binaries on the GPU. Run on
+# the GPU machine from the repository's root. What it needs travels with the working tree:
+#   BUNDLE  (default build/gpu.tar.xz): the renderer's bundle as a tar.xz of one folder `gpub`,
+#           `bash tools/gpu_bundle.sh build/gpub --renderer && tar -cJf build/gpu.tar.xz -C build gpub`;
+#   REFS    (default build/gpu-et-refs): references made on the CPU machine beforehand,
+#           `python3 tools/gpu_equal_time.py --out build/gpu-et --references-only --scenes ...`
+#           then REFS=build/gpu-et/references (any missing one is rendered there);
+#   ASSETS  (optional): an asset root for the scenes that read ../shared/scenes (RTPG_ASSET_ROOT;
+#           a copy of ../shared/scenes/cornell-box for cornell-glossy, say; Sponza's 122 MB do not
+#           fit the lease's transfer).
+# SCENES (default: the Cornell box, the sunlit room, cornell-indirect), RES (960x540), FRAMES
+# (32), REPEATS (5); VARIANT: rtpg arguments for a second guided run against the same path
+# tracing (empty: none); TESTS: the test binaries run at the end (the OpenCL ones by default).
+# OUT gets machine.txt, et.md (and variant.md), et.tgz (every run's stats, no images) and
+# tests.tgz. docs/guiding.md, "Equal time on a GPU", has the first run.
+set -u
+out=${OUT:?OUT must name the folder for the results}
+bundle=${BUNDLE:-build/gpu.tar.xz} refs=${REFS:-build/gpu-et-refs}
+b=/tmp/rtpg-bundle
+[ -d $b/gpub ] || { mkdir -p $b && tar -xJf "$bundle" -C $b; } || exit 2
+g=$b/gpub
+mkdir -p "$out/vendors"
+cp /etc/OpenCL/vendors/*.icd "$out/vendors/" 2>/dev/null
+nv=$(ldconfig -p 2>/dev/null | awk '$1 == "libnvidia-opencl.so.1" {print $NF; exit}')
+[ -n "$nv" ] || nv=$(find /usr/lib /usr/lib64 /usr/local/nvidia -name libnvidia-opencl.so.1 2>/dev/null | head -n 1)
+[ -n "$nv" ] && [ ! -e "$out/vendors/nvidia.icd" ] && echo "$nv" > "$out/vendors/nvidia.icd"
+export OCL_ICD_VENDORS=$out/vendors RTPG_DEVICE=${RTPG_DEVICE:-gpu} RTPG_CACHE_DIR=/tmp/rtpg-cache
+export LD_LIBRARY_PATH=$g/lib PYTHONUNBUFFERED=1 RTPG_BINARY=$g/bin/rtpg
+[ -n "${ASSETS:-}" ] && export RTPG_ASSET_ROOT=$PWD/$ASSETS
+{ nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv; nproc
+  grep -m1 'model name' /proc/cpuinfo; "$g/bin/rtpg" devices; } > "$out/machine.txt" 2>&1
+cat "$out/machine.txt"
+scenes=${SCENES:-cornell-box sunlit-room cornell-indirect}
+common=(--res "${RES:-960x540}" --frames "${FRAMES:-32}" --repeats "${REPEATS:-5}")
+mkdir -p /tmp/et/references
+[ -d "$refs" ] && cp "$refs"/* /tmp/et/references/
+echo "== path tracing against the default guiding"
+timeout "${T1:-300}" python3 tools/gpu_equal_time.py --out /tmp/et --scenes $scenes "${common[@]}" | tee "$out/et.md"
+if [ -n "${VARIANT:-}" ]; then
+  mkdir -p /tmp/etv && ln -sfn /tmp/et/references /tmp/etv/references
+  echo "== path tracing against guiding with: $VARIANT"
+  timeout "${T2:-180}" python3 tools/gpu_equal_time.py --out /tmp/etv --scenes $scenes "${common[@]}" \
+    --pg-args "$VARIANT" | tee "$out/variant.md"
+fi
+rm -rf /tmp/et/references /tmp/etv/references
+tar -czf "$out/et.tgz" --exclude='*.exr' -C /tmp et $([ -d /tmp/etv ] && echo etv)
+echo "== tests at $SECONDS s"
+# The test binaries read the scenes at the path they were built in.
+built_in=$(cat "$g/source_dir")
+[ -e "$built_in" ] || { mkdir -p "$(dirname "$built_in")" && ln -s "$PWD" "$built_in"; }
+mkdir -p /tmp/et-tests
+for t in ${TESTS:-test_guiding_kernels test_image_kernels test_svgf test_work_groups test_cl_runtime test_pmm_stress test_gbuffer_packer}; do
+  echo "$t"
+done | xargs -P 8 -I{} sh -c 'timeout 100 "$0/bin/{}" --gtest_color=no > /tmp/et-tests/{}.log 2>&1
+  echo "== {}: exit $?, $(grep -E "^\[  PASSED  \]|^\[  FAILED  \] [0-9]" /tmp/et-tests/{}.log | tr "\n" " ")"' "$g"
+grep -h -E '^\[  FAILED  \] [A-Za-z]' /tmp/et-tests/*.log | sort -u
+tar -czf "$out/tests.tgz" -C /tmp et-tests
+echo "done at $SECONDS s"
