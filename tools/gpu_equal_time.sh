@@ -4,20 +4,22 @@
 # the GPU machine from the repository's root. What it needs travels with the working tree:
 #   BUNDLE  (default build/gpu.tar.xz): the renderer's bundle as a tar.xz of one folder `gpub`,
 #           `bash tools/gpu_bundle.sh build/gpub --renderer && tar -cJf build/gpu.tar.xz -C build gpub`;
-#   REFS    (default build/gpu-et-refs): references made on the CPU machine beforehand,
+#   REFS    (default build/gpu-et/references): references made on the CPU machine beforehand,
 #           `python3 tools/gpu_equal_time.py --out build/gpu-et --references-only --scenes ...`
-#           then REFS=build/gpu-et/references (any missing one is rendered there);
+#           with the same RES (any missing one is rendered there, on the lease's time);
 #   ASSETS  (optional): an asset root for the scenes that read ../shared/scenes (RTPG_ASSET_ROOT;
 #           a copy of ../shared/scenes/cornell-box for cornell-glossy, say; Sponza's 122 MB do not
 #           fit the lease's transfer).
 # SCENES (default: the Cornell box, the sunlit room, cornell-indirect), RES (960x540), FRAMES
 # (32), REPEATS (5); VARIANT: rtpg arguments for a second guided run against the same path
-# tracing (empty: none); TESTS: the test binaries run at the end (the OpenCL ones by default).
+# tracing (empty: none); TESTS: the test binaries run at the end (the OpenCL ones by default);
+# T1, T2 (300, 180 s): the time each table may take, so that the tests and results still come
+# back inside the lease's call.
 # OUT gets machine.txt, et.md (and variant.md), et.tgz (every run's stats, no images) and
 # tests.tgz. docs/guiding.md, "Equal time on a GPU", has the first run.
 set -u
 out=${OUT:?OUT must name the folder for the results}
-bundle=${BUNDLE:-build/gpu.tar.xz} refs=${REFS:-build/gpu-et-refs}
+bundle=${BUNDLE:-build/gpu.tar.xz} refs=${REFS:-build/gpu-et/references}
 b=/tmp/rtpg-bundle
 [ -d $b/gpub ] || { mkdir -p $b && tar -xJf "$bundle" -C $b; } || exit 2
 g=$b/gpub
