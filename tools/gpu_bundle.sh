@@ -6,7 +6,9 @@
 # libraries they need beyond libc and libstdc++ (the ocl-icd loader, Google Benchmark, TBB), and
 # tools/gpu_bundle_run.sh as DIR/run.sh. There: `bash DIR/run.sh [OUT]` (docs/design.md,
 # "Floating point on other devices").
-# With --renderer the bundle also holds rtpg, every test binary and bench_frame / bench_svgf,
+# With --renderer the bundle also holds rtpg, every test binary and bench_frame / bench_svgf /
+# bench_gbuffer_packer (the host's share of the G-buffer's trip on a GPU machine: docs/guiding.md,
+# "Equal time on a GPU"),
 # with Embree, assimp and OpenImageIO; the ~200 libraries OpenImageIO links for formats rtpg
 # never reads (video, OpenVDB, DICOM, ...) are replaced by load-time stand-ins
 # (tools/gpu_stub_libs.py) so that the bundle stays small enough to travel. Then run.sh also
@@ -35,7 +37,8 @@ $(cd "$tree" && pwd)/bench/bench_guiding_kernels"
 [ "$renderer" = 1 ] && binaries="$binaries
 $(cd "$tree" && pwd)/rtpg
 $(cd "$tree" && pwd)/bench/bench_frame
-$(cd "$tree" && pwd)/bench/bench_svgf"
+$(cd "$tree" && pwd)/bench/bench_svgf
+$(cd "$tree" && pwd)/bench/bench_gbuffer_packer"
 # Libraries that travel: the C and C++ runtimes are the machine's; these are carried; with
 # --renderer any other is a stand-in, else it means the binary does not fit.
 system='^(libc|libm|libstdc\+\+|libgcc_s|ld-linux.*|libpthread|libdl|librt)\.so'
