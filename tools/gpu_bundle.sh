@@ -72,6 +72,7 @@ if [ "$renderer" = 1 ]; then
   python3 tools/gpu_stub_libs.py "$dir/lib" --carried "$dir"/bin/* "$dir"/lib/* --stub "${stubs[@]}"
 fi
 cp tools/gpu_bundle_run.sh "$dir/run.sh"
+cp tools/gpu_opencl_vendors.sh "$dir/opencl_vendors.sh"
 cp tools/gpu_frames_summary.py "$dir/"
 pwd > "$dir/source_dir"
 echo "gpu_bundle: $(ls "$dir/bin" | wc -l) binaries, $(du -sh "$dir" | cut -f1) in $dir"

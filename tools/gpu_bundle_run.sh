@@ -24,13 +24,8 @@ export LD_LIBRARY_PATH="$dir/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 # The carried ICD loader reads the system's vendor files; a driver whose OpenCL library is
 # installed without one (NVIDIA's in a container) gets one in a folder of its own.
 if [ -z "${OCL_ICD_VENDORS:-}" ]; then
-  vendors="$out/vendors"
-  mkdir -p "$vendors"
-  cp /etc/OpenCL/vendors/*.icd "$vendors/" 2>/dev/null || true
-  nvidia=$(ldconfig -p 2>/dev/null | awk '$1 == "libnvidia-opencl.so.1" {print $NF; exit}')
-  [ -n "$nvidia" ] || nvidia=$(find /usr/lib /usr/lib64 /usr/local/nvidia -name libnvidia-opencl.so.1 2>/dev/null | head -n 1)
-  [ -n "$nvidia" ] && [ ! -e "$vendors/nvidia.icd" ] && echo "$nvidia" > "$vendors/nvidia.icd"
-  export OCL_ICD_VENDORS="$vendors"
+  . "$dir/opencl_vendors.sh"
+  opencl_vendors "$out/vendors"
 fi
 { ls "$OCL_ICD_VENDORS"; cat "$OCL_ICD_VENDORS"/*.icd; } > "$out/devices.log" 2>&1
 failed=0

@@ -2,8 +2,9 @@
 # Equal time on a GPU machine inside one short lease: PT against PG (tools/gpu_equal_time.py),
 # optionally against a variant of guiding too, then the OpenCL test binaries on the GPU. Run on
 # the GPU machine from the repository's root. What it needs travels with the working tree:
-#   BUNDLE  (default build/gpu.tar.xz): the renderer's bundle as a tar.xz of one folder `gpub`,
-#           `bash tools/gpu_bundle.sh build/gpub --renderer && tar -cJf build/gpu.tar.xz -C build gpub`;
+#   BUNDLE  (default build/gpu.tar.xz): the renderer's bundle, with its opencl_vendors.sh, as a
+#           tar.xz of one folder `gpub`: `bash tools/gpu_bundle.sh build/gpub --renderer &&
+#           tar -cJf build/gpu.tar.xz -C build gpub`;
 #   REFS    (default build/gpu-et/references): references made on the CPU machine beforehand,
 #           `python3 tools/gpu_equal_time.py --out build/gpu-et --references-only --scenes ...`
 #           with the same RES (any missing one is rendered there, on the lease's time);
@@ -23,12 +24,9 @@ bundle=${BUNDLE:-build/gpu.tar.xz} refs=${REFS:-build/gpu-et/references}
 b=/tmp/rtpg-bundle
 [ -d $b/gpub ] || { mkdir -p $b && tar -xJf "$bundle" -C $b; } || exit 2
 g=$b/gpub
-mkdir -p "$out/vendors"
-cp /etc/OpenCL/vendors/*.icd "$out/vendors/" 2>/dev/null
-nv=$(ldconfig -p 2>/dev/null | awk '$1 == "libnvidia-opencl.so.1" {print $NF; exit}')
-[ -n "$nv" ] || nv=$(find /usr/lib /usr/lib64 /usr/local/nvidia -name libnvidia-opencl.so.1 2>/dev/null | head -n 1)
-[ -n "$nv" ] && [ ! -e "$out/vendors/nvidia.icd" ] && echo "$nv" > "$out/vendors/nvidia.icd"
-export OCL_ICD_VENDORS=$out/vendors RTPG_DEVICE=${RTPG_DEVICE:-gpu} RTPG_CACHE_DIR=/tmp/rtpg-cache
+. "$g/opencl_vendors.sh"
+opencl_vendors "$out/vendors"
+export RTPG_DEVICE=${RTPG_DEVICE:-gpu} RTPG_CACHE_DIR=/tmp/rtpg-cache
 export LD_LIBRARY_PATH=$g/lib PYTHONUNBUFFERED=1 RTPG_BINARY=$g/bin/rtpg
 [ -n "${ASSETS:-}" ] && export RTPG_ASSET_ROOT=$PWD/$ASSETS
 { nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv; nproc
