@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <thread>
 #include <filesystem>
 #include <memory>
 #include <numeric>
@@ -11,6 +10,7 @@
 #include <unistd.h>
 
 #include <fmt/format.h>
+#include <tbb/global_control.h>
 #include <nlohmann/json.hpp>
 
 #include "rtpg/cl_runtime.h"
@@ -421,7 +421,8 @@ int run_render(const RenderCommand& command) {
         {"camera_frame", settings.camera_frame},
         {"frame_count", command.frames},
         {"device", cl.info().device_name},
-        {"threads", static_cast<int>(std::thread::hardware_concurrency())},
+        {"threads",
+         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)},
         {"bvh_build_ms", renderer.tracer().build_seconds() * 1e3},
         {"frames", frames}};
     write_text_atomically(command.stats_json, stats.dump(2) + "\n");
@@ -500,6 +501,8 @@ int run_reference(const ReferenceCommand& command) {
                                   {"spp", command.spp},
                                   {"seconds", seconds},
                                   {"samples_per_second", samples_per_second},
+                                  {"threads", tbb::global_control::active_value(
+                                                  tbb::global_control::max_allowed_parallelism)},
                                   {"nonfinite_samples", nonfinite}};
     write_text_atomically(command.stats_json, stats.dump(2) + "\n");
   }

@@ -15,6 +15,7 @@ struct CommonArguments {
   std::string scene;       // "" = the built-in default scene
   std::string asset_root;  // "" = RTPG_ASSET_ROOT or ../shared/scenes
   std::string device;      // "" = RTPG_DEVICE or a GPU, else the CPU
+  int threads = 0;         // host worker threads; 0 = one per core (TBB's default)
   bool quiet = false;
 };
 

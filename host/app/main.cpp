@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 
 #include "app/commands.h"
 #include "rtpg/cl_error.h"
@@ -22,6 +24,11 @@ void add_common(CLI::App* cmd, rtpg::CommonArguments& common, bool scene_require
   cmd->add_option("--device", common.device,
                   "OpenCL device: gpu, cpu, P:D or part of its name (default: $RTPG_DEVICE, else a "
                   "GPU, else the CPU)");
+  cmd->add_option("--threads", common.threads,
+                  "Host threads for tracing and shading (0: one per core); OpenCL devices on "
+                  "the CPU keep their own (PoCL: POCL_MAX_PTHREAD_COUNT)")
+      ->check(CLI::Range(0, 4096))
+      ->capture_default_str();
   cmd->add_flag("-q,--quiet", common.quiet, "Print nothing but errors");
 }
 
@@ -234,6 +241,14 @@ int main(int argc, char** argv) {
   }
 
   try {
+    // The host's thread pool for the whole run (TBB: every parallel loop of the renderer).
+    const int threads = *render_cmd      ? render.common.threads
+                        : *reference_cmd ? reference.common.threads
+                                         : 0;
+    std::unique_ptr<tbb::global_control> thread_limit;
+    if (threads > 0)
+      thread_limit = std::make_unique<tbb::global_control>(
+          tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
     if (*render_cmd) {
       if (!parse_resolution(render_res, render.settings.width, render.settings.height))
         throw rtpg::InputError("--res", "expected WxH, got '" + render_res + "'");

@@ -503,6 +503,24 @@ TEST_F(Cli, StatisticsCarryRelMseAgainstReference) {
   }
 }
 
+TEST_F(Cli, ThreadsChangeNothingButTheThreadCount) {
+  // Every parallel loop of the frame sums in an order that does not depend on the threads
+  // (docs/design.md), so one host thread renders the same image, guided and along a camera path,
+  // as every core does; the statistics say how many there were.
+  const std::string common =
+      "render --res 37x21 --frames 3 --spp 2 --seed 9 --camera-path pan -q --stats-json ";
+  RunResult r = run_rtpg(dir(), common + "all.json -o all.exr");
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  r = run_rtpg(dir(), common + "one.json -o one.exr --threads 1");
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  EXPECT_EQ(read_exr(dir() / "one.exr").pixels, read_exr(dir() / "all.exr").pixels);
+  const nlohmann::json one = nlohmann::json::parse(read_file(dir() / "one.json"));
+  EXPECT_EQ(one["threads"].get<int>(), 1);
+  r = run_rtpg(dir(), "render --res 8x8 -q --threads -2");
+  EXPECT_EQ(r.exit_code, 2) << describe(r);
+  EXPECT_NE(r.err.find("--threads"), std::string::npos) << describe(r);
+}
+
 TEST_F(Cli, SavesTheRequestedFramesBesideTheOutput) {
   const RunResult r =
       run_rtpg(dir(), "render --res 16x16 --frames 3 --seed 5 -q --save-frames 2,0 -o out.exr");
