@@ -249,7 +249,8 @@ int run_render(const RenderCommand& command) {
   if (command.guiding == "pmm") {
     auto sampler = std::make_unique<GuidedFirstBounce>(
         cl, command.settings.width, command.settings.height, command.guiding_settings,
-        parse_host_transfer(command.host_transfer), parse_train_overlap(command.train_overlap));
+        parse_host_transfer(command.host_transfer), parse_overlap(command.train_overlap),
+        parse_overlap(command.sample_overlap));
     guided = sampler.get();
     renderer.set_first_bounce_sampler(std::move(sampler));
   }

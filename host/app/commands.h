@@ -47,9 +47,10 @@ struct RenderCommand {
                                            // (host/render/path_tracer.h)
   GuidingSettings guiding_settings;
   std::string train_memory = "auto";
-  std::string host_transfer = "auto";  // parse_host_transfer (host/render/guided_first_bounce.h)
-  std::string train_overlap = "auto";  // parse_train_overlap (host/render/guided_first_bounce.h)
-  std::string denoise = "off";         // "off" or "svgf" (docs/denoising.md)
+  std::string host_transfer = "auto";   // parse_host_transfer (host/render/guided_first_bounce.h)
+  std::string train_overlap = "auto";   // parse_overlap (host/render/guided_first_bounce.h)
+  std::string sample_overlap = "auto";  // parse_overlap (host/render/guided_first_bounce.h)
+  std::string denoise = "off";          // "off" or "svgf" (docs/denoising.md)
   SvgfSettings svgf_settings;
   std::string noisy_output;  // with --denoise: the unfiltered last frame; "" = none
 };

@@ -209,12 +209,17 @@ Guider::Launch Guider::launch_of(int lanes, bool pixel_kernel) const {
   return l;
 }
 
-double Guider::run(cl::Kernel& kernel, const Launch& launch) {
+void Guider::run(cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local, Wait wait,
+                 double* ms) {
   cl::Event done;
-  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, launch.global, launch.local, nullptr,
-                                        &done);
+  runtime_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, global, local, nullptr, &done);
+  if (wait == Wait::later) {
+    runtime_.queue().flush();  // so that it starts now, not at the next blocking call
+    pending_.emplace_back(done, ms);
+    return;
+  }
   done.wait();
-  return ClRuntime::event_ms(done);
+  *ms = ClRuntime::event_ms(done);
 }
 
 std::array<double, 4> Guider::sum_count_records(const cl::Buffer& records, std::size_t groups) {
@@ -229,7 +234,8 @@ std::array<double, 4> Guider::sum_count_records(const cl::Buffer& records, std::
   return sum;
 }
 
-void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out) {
+void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out,
+                            Wait wait) {
 #define RTPG_CHECK(name, type, bytes) check_buffer(packed.name, bytes, "packed." #name);
   PG_PACKED_GBUFFER_CHANNELS(RTPG_CHECK)
 #undef RTPG_CHECK
@@ -249,16 +255,12 @@ void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuff
     // One work-item a pixel in groups of up to 64 (any size works: the kernel checks its bound).
     const std::size_t group = std::min<std::size_t>(
         64, unpack_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
-    cl::Event done;
-    runtime_.queue().enqueueNDRangeKernel(unpack_, cl::NullRange,
-                                          cl::NDRange((n + group - 1) / group * group),
-                                          cl::NDRange(group), nullptr, &done);
-    done.wait();
-    times_.unpack_ms = ClRuntime::event_ms(done);
+    run(unpack_, cl::NDRange((n + group - 1) / group * group), cl::NDRange(group), wait,
+        &times_.unpack_ms);
   });
 }
 
-void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous) {
+void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous, Wait wait) {
   check_gbuffer(current, "current");
   check_gbuffer(previous, "previous");
   const State &from = state_[current_], &to = state_[1 - current_];
@@ -266,13 +268,15 @@ void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previo
     KernelArgs(reproject_) << current << previous << from.state0 << from.state1 << to.state0
                            << to.state1 << static_cast<cl_uint>(width_)
                            << static_cast<cl_uint>(height_) << kernel_settings_;
-    times_.reproject_ms = run(reproject_, launch_of(1, /*pixel_kernel=*/true));
+    const Launch launch = launch_of(1, /*pixel_kernel=*/true);
+    run(reproject_, launch.global, launch.local, wait, &times_.reproject_ms);
   });
   current_ = 1 - current_;
 }
 
 void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint32_t frame,
-                    std::uint32_t sample_index, const GuiderSamples& out, SampleOutputs outputs) {
+                    std::uint32_t sample_index, const GuiderSamples& out, SampleOutputs outputs,
+                    Wait wait) {
   check_gbuffer(current, "current");
 #define RTPG_CHECK(name, type, bytes) check_buffer(out.name, bytes, "samples." #name);
   PG_SAMPLE_CHANNELS(RTPG_CHECK)
@@ -285,12 +289,12 @@ void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint3
                         << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame)
                         << static_cast<cl_uint>(sample_index) << write_mixture << kernel_settings_
                         << cl::Local(sample_launch_.group_items * PG_COUNT_RECORD_BYTES);
-    times_.sample_ms = run(sample_, sample_launch_);
+    run(sample_, sample_launch_.global, sample_launch_.local, wait, &times_.sample_ms);
   });
 }
 
 void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::uint32_t seed,
-                   std::uint32_t frame, TrainWait wait) {
+                   std::uint32_t frame, Wait wait) {
   wait_for_training();  // its time is recorded before this one's
   check_gbuffer(current, "current");
 #define RTPG_CHECK(name, type, bytes) check_buffer(vpls.name, bytes, "vpls." #name);
@@ -308,8 +312,8 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
          << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame) << kernel_settings_;
     if (train_lanes_ == 1) args << cl::Local(tile) << cl::Local(tile);
     args << cl::Local(train_launch_.group_items * PG_COUNT_RECORD_BYTES);
-    if (wait == TrainWait::finish) {
-      times_.train_ms = run(train_, train_launch_);
+    if (wait == Wait::finish) {
+      run(train_, train_launch_.global, train_launch_.local, wait, &times_.train_ms);
       return;
     }
     runtime_.queue().enqueueNDRangeKernel(train_, cl::NullRange, train_launch_.global,
@@ -326,6 +330,17 @@ void Guider::wait_for_training() {
     train_done_.wait();
     times_.train_ms = ClRuntime::event_ms(train_done_);
   });
+}
+
+void Guider::wait_for_kernels() {
+  wait_for_training();
+  translate_cl_errors([&] {
+    for (auto& [done, ms] : pending_) {
+      done.wait();
+      *ms = ClRuntime::event_ms(done);
+    }
+  });
+  pending_.clear();
 }
 
 void Guider::read_state(std::vector<float>& state) {

@@ -83,6 +83,16 @@ class FirstBounceSampler {
                       std::map<std::string, double>& extra) {}
   // One direction for every surface pixel of the G-buffer (others get density 0).
   virtual FirstBounceSamples sample(const GBuffer& gbuffer, const SampleCoordinates& at) = 0;
+  // True when the samples come from a device that works beside the host and the sampler splits
+  // sample() in two: start_sample() enqueues it and returns at once, finish_sample() waits and
+  // returns what sample() would have. In between the path tracer makes the primary hit's light
+  // samples and traces their shadow rays, which do not depend on the first bounce
+  // (docs/guiding.md, "Sampling overlapped with the primary hit's light samples"). The host
+  // must not read anything of the sampler in between; begin_frame() may likewise return before
+  // the device is done with it. Samplers that do not split never have these two called.
+  virtual bool samples_beside_the_host() const { return false; }
+  virtual void start_sample(const GBuffer& gbuffer, const SampleCoordinates& at) {}
+  virtual FirstBounceSamples finish_sample() { return {}; }
   // True when sample() draws bsdf_first_bounce_sample() for every pixel (BsdfFirstBounce):
   // the renderer then leaves sample() out and the path tracer draws the same directions at
   // the primary hit, in the pass that already has each pixel's frame and lobes, instead of a

@@ -90,26 +90,30 @@ void GuidedFirstBounce::copy_to_device(const Host& host, const Device& device, s
   bytes_ += bytes;
 }
 
-TrainOverlap parse_train_overlap(const std::string& name) {
-  if (name == "auto") return TrainOverlap::automatic;
-  if (name == "on") return TrainOverlap::on;
-  if (name == "off") return TrainOverlap::off;
-  throw GuiderError("train overlap '" + name + "' is none of auto, on, off");
+Overlap parse_overlap(const std::string& name) {
+  if (name == "auto") return Overlap::automatic;
+  if (name == "on") return Overlap::on;
+  if (name == "off") return Overlap::off;
+  throw GuiderError("overlap '" + name + "' is none of auto, on, off");
 }
 
 GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
                                      const GuidingSettings& settings, HostTransfer transfer,
-                                     TrainOverlap overlap)
+                                     Overlap train_overlap, Overlap sample_overlap)
     : runtime_(runtime),
       guider_(std::make_unique<Guider>(runtime, width, height, settings)),
       pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
   transfer_ = resolve_host_transfer(transfer, runtime.info().host_unified_memory);
   zero_copy_ = transfer_ == HostTransfer::in_place;
-  // automatic: only where the device has cores of its own to train on while the host works; on
-  // PoCL's CPU device the kernel and the host share the cores and overlapping saved nothing
-  // (docs/guiding.md, "Training overlapped with the next frame's host work").
-  overlap_ = overlap == TrainOverlap::on ||
-             (overlap == TrainOverlap::automatic && !runtime.info().host_unified_memory);
+  // automatic: only where the device has cores of its own to work on while the host works; on
+  // PoCL's CPU device the kernels and the host share the cores (docs/guiding.md, "Training
+  // overlapped with the next frame's host work", "Sampling overlapped with the primary hit's
+  // light samples").
+  const auto resolve = [&](Overlap o) {
+    return o == Overlap::on || (o == Overlap::automatic && !runtime.info().host_unified_memory);
+  };
+  overlap_ = resolve(train_overlap);
+  sample_overlap_ = resolve(sample_overlap);
   packed_ = transfer_ == HostTransfer::packed;
   if (transfer_ == HostTransfer::pinned || packed_)
     upload_staging_ = std::make_unique<PinnedStaging>(
@@ -186,11 +190,16 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   // and the host memory it read in place, are free once it is done. Its figures (train,
   // trained_fraction) are reported with this frame's.
   train_wait_ms_ = 0.0;
-  if (guider_->training_pending()) {
-    finish_training();
-  } else {
+  if (!guider_->training_pending()) {
     trained_fraction_ = 0.0;
+  } else if (!sample_overlap_) {
+    finish_training();
+  } else if (upload_staging_) {
+    // The training goes on (finish_sample waits for it; the queue runs reproject after it), but
+    // the staging is the G-buffer's next: the VPLs' copy must have left it.
+    translate_cl_errors([&] { vpls_staged_.wait(); });
   }
+  const Guider::Wait wait = sample_overlap_ ? Guider::Wait::later : Guider::Wait::finish;
   auto t = Clock::now();
   previous_gbuffer_ = current_gbuffer_;
   if (zero_copy_) {
@@ -208,17 +217,17 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
     if (packed_) {
       upload_staging_->begin();
       stage_packed_gbuffer(*upload_staging_, g, packed_gbuffer_);
-      translate_cl_errors([&] { runtime_.queue().finish(); });
+      if (!sample_overlap_) translate_cl_errors([&] { runtime_.queue().finish(); });
       bytes_ += kPackedGBufferBytes * g.pixel_count();
     } else {
-      copy_to_device(g, current_gbuffer_, kGBufferBytes * g.pixel_count());
+      copy_to_device(g, current_gbuffer_, kGBufferBytes * g.pixel_count(), !sample_overlap_);
     }
     copied_from_ = &g;
   }
   upload_ms_ = ms_since(t);
-  if (packed_) guider_->unpack_gbuffer(packed_gbuffer_, current_gbuffer_);
+  if (packed_) guider_->unpack_gbuffer(packed_gbuffer_, current_gbuffer_, wait);
   if (have_previous_) {
-    guider_->reproject(current_gbuffer_, previous_gbuffer_);
+    guider_->reproject(current_gbuffer_, previous_gbuffer_, wait);
   } else {
     guider_->reset();
   }
@@ -232,13 +241,50 @@ void GuidedFirstBounce::expect_queries(const HostQueries& queries) {
 }
 
 FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoordinates& at) {
+  if (sample_overlap_) {
+    start_sample(g, at);
+    return finish_sample();
+  }
   unmap_samples();  // the kernel overwrites them
-  const SampleOutputs outputs =
-      host_reads_mixture_ ? SampleOutputs::directions_and_mixture : SampleOutputs::directions;
+  const SampleOutputs outputs = sample_outputs();
   guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_, outputs);
   sample_ms_ += guider_->last_times().sample_ms;
-  const std::size_t n = g.pixel_count();
   const auto t = Clock::now();
+  enqueue_sample_transfer(outputs);
+  translate_cl_errors([&] { runtime_.queue().finish(); });
+  readback_ms_ += ms_since(t);
+  // The path tracer reads the directions as the kernel wrote them (no copy); the statistics
+  // of this frame's models wait for end_frame (count_models).
+  return FirstBounceSamples{view_.direction_pdf, view_.strategy};
+}
+
+SampleOutputs GuidedFirstBounce::sample_outputs() const {
+  return host_reads_mixture_ ? SampleOutputs::directions_and_mixture : SampleOutputs::directions;
+}
+
+void GuidedFirstBounce::start_sample(const GBuffer& g, const SampleCoordinates& at) {
+  unmap_samples();  // the kernel overwrites them
+  const SampleOutputs outputs = sample_outputs();
+  guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_, outputs,
+                  Guider::Wait::later);
+  enqueue_sample_transfer(outputs);
+  translate_cl_errors([&] { runtime_.queue().flush(); });
+}
+
+FirstBounceSamples GuidedFirstBounce::finish_sample() {
+  const auto t = Clock::now();
+  // Last frame's training first (it ran before everything this frame enqueued), then the
+  // upload, reproject, sample and the samples' way back (readback: the whole wait).
+  if (guider_->training_pending()) finish_training();
+  translate_cl_errors([&] { runtime_.queue().finish(); });
+  guider_->wait_for_kernels();
+  readback_ms_ += ms_since(t);
+  sample_ms_ += guider_->last_times().sample_ms;
+  return FirstBounceSamples{view_.direction_pdf, view_.strategy};
+}
+
+void GuidedFirstBounce::enqueue_sample_transfer(SampleOutputs outputs) {
+  const std::size_t n = pixels_;
   if (zero_copy_) {
     translate_cl_errors([&] {
       cl::CommandQueue& q = runtime_.queue();
@@ -252,23 +298,17 @@ FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoord
         view_.mixture_b = static_cast<const glm::vec2*>(map(samples_.mixture_b, 8));
       }
       mapped_ = true;
-      q.finish();
     });
-  } else {
-    enqueue_download(runtime_.queue(), samples_, staged_, outputs);
-    translate_cl_errors([&] { runtime_.queue().finish(); });
-    bytes_ += sample_bytes_per_pixel(outputs) * n;
-    if (host_reads_mixture_) {
-      view_.mixture_a = staged_.mixture_a.data();
-      view_.mixture_b = staged_.mixture_b.data();
-    }
-    view_.direction_pdf = staged_.direction_pdf.data();
-    view_.strategy = staged_.strategy.data();
+    return;
   }
-  readback_ms_ += ms_since(t);
-  // The path tracer reads the directions as the kernel wrote them (no copy); the statistics
-  // of this frame's models wait for end_frame (count_models).
-  return FirstBounceSamples{view_.direction_pdf, view_.strategy};
+  enqueue_download(runtime_.queue(), samples_, staged_, outputs);
+  bytes_ += sample_bytes_per_pixel(outputs) * n;
+  if (host_reads_mixture_) {
+    view_.mixture_a = staged_.mixture_a.data();
+    view_.mixture_b = staged_.mixture_b.data();
+  }
+  view_.direction_pdf = staged_.direction_pdf.data();
+  view_.strategy = staged_.strategy.data();
 }
 
 void GuidedFirstBounce::count_models() {
@@ -320,6 +360,9 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
     device_vpls = wrap_host_vpls(runtime_.context(), vpls);  // released when train is done
   } else {
     copy_to_device(vpls, device_vpls, kVplBytes * g.pixel_count(), /*wait=*/!overlap_);
+    if (overlap_ && upload_staging_)
+      translate_cl_errors(
+          [&] { runtime_.queue().enqueueMarkerWithWaitList(nullptr, &vpls_staged_); });
   }
   upload_ms_ += ms_since(t);
   if (overlap_) {
@@ -327,7 +370,7 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
     // waits: the renderer writes the other G-buffer next frame (in place) and rewrites the VPLs
     // only after the next sample(), and begin_frame waits before staging anything.
     pending_vpls_ = device_vpls;
-    guider_->train(current_gbuffer_, device_vpls, at.seed, at.frame, Guider::TrainWait::later);
+    guider_->train(current_gbuffer_, device_vpls, at.seed, at.frame, Guider::Wait::later);
     return;
   }
   guider_->train(current_gbuffer_, device_vpls, at.seed, at.frame);
@@ -353,6 +396,7 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   extra["row_work_groups"] = guider_->row_work_groups() ? 1.0 : 0.0;
   extra["zero_copy"] = zero_copy_ ? 1.0 : 0.0;
   extra["train_overlap"] = overlap_ ? 1.0 : 0.0;
+  extra["sample_overlap"] = sample_overlap_ ? 1.0 : 0.0;
   // HostTransfer as a number: 1 in place, 2 pinned, 3 pageable, 4 packed.
   extra["host_transfer"] = static_cast<double>(static_cast<int>(transfer_));
   extra["host_device_bytes_per_pixel"] =

@@ -17,14 +17,17 @@ namespace rtpg {
 class ClRuntime;
 class PinnedStaging;
 
-// Whether end_frame waits for training (off) or leaves it running on the device while the host
-// makes the next frame's camera rays and G-buffer (on); the next begin_frame waits for it
-// (docs/guiding.md, "Training overlapped with the next frame, on a GPU"). automatic: on where
-// the device has memory of its own (not DeviceInfo::host_unified_memory), off where its kernels
-// share the host's cores (PoCL), where overlapping saved nothing.
-enum class TrainOverlap { automatic, on, off };
-// "auto", "on", "off" (the CLI's --train-overlap); throws GuiderError else.
-TrainOverlap parse_train_overlap(const std::string& name);
+// What the device does beside the host (docs/guiding.md): automatic is on where the device has
+// memory of its own (not DeviceInfo::host_unified_memory), off where its kernels share the host's
+// cores (PoCL). Training: end_frame leaves it running while the host makes the next frame's
+// camera rays and G-buffer, and the next frame waits for it ("Training overlapped with the next
+// frame, on a GPU"; on PoCL it saved nothing). Sampling: begin_frame and start_sample leave the
+// G-buffer's upload, reproject and sample running while the path tracer makes the primary hit's
+// light samples, and finish_sample waits ("Sampling overlapped with the primary hit's light
+// samples").
+enum class Overlap { automatic, on, off };
+// "auto", "on", "off" (the CLI's --train-overlap and --sample-overlap); throws GuiderError else.
+Overlap parse_overlap(const std::string& name);
 
 class GuidedFirstBounce final : public FirstBounceSampler {
  public:
@@ -33,11 +36,15 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   // resolve_host_transfer (host/render/host_transfer.h).
   GuidedFirstBounce(ClRuntime& runtime, int width, int height, const GuidingSettings& settings,
                     HostTransfer transfer = HostTransfer::automatic,
-                    TrainOverlap overlap = TrainOverlap::automatic);
+                    Overlap train_overlap = Overlap::automatic,
+                    Overlap sample_overlap = Overlap::automatic);
   ~GuidedFirstBounce() override;
 
   void begin_frame(const GBuffer& gbuffer, const SampleCoordinates& at) override;
   FirstBounceSamples sample(const GBuffer& gbuffer, const SampleCoordinates& at) override;
+  bool samples_beside_the_host() const override { return sample_overlap_; }
+  void start_sample(const GBuffer& gbuffer, const SampleCoordinates& at) override;
+  FirstBounceSamples finish_sample() override;
   float pdf(const GBuffer& gbuffer, std::size_t i, const shared::pg_lobes& lobes,
             const glm::vec3& wo, const glm::vec3& wi) const override;
   bool pixel_guide(const GBuffer& gbuffer, std::size_t i, PixelGuide& out) const override;
@@ -49,7 +56,8 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   // and nothing of it is copied or mapped; the statistics come from the kernels' counts.
   void expect_queries(const HostQueries& queries) override;
   HostTransfer host_transfer() const { return transfer_; }  // automatic resolved
-  bool overlaps_training() const { return overlap_; }       // TrainOverlap resolved
+  bool overlaps_training() const { return overlap_; }       // Overlap resolved
+  bool overlaps_sampling() const { return sample_overlap_; }
   // This frame's G-buffer on the device where begin_frame copied g there (not in place): the
   // denoiser reads it instead of copying it again (SvgfDenoiser::denoise). Valid until the next
   // begin_frame; nullptr for any other G-buffer.
@@ -90,9 +98,17 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   int owned_current_ = 0;
   bool have_previous_ = false;
   bool training_ = true;
-  // TrainOverlap resolved. While training runs past end_frame, pending_vpls_ holds the VPL
-  // buffers it reads (in place: the wrapper of the host's vector).
+  // The training's Overlap resolved. While training runs past end_frame, pending_vpls_ holds
+  // the VPL buffers it reads (in place: the wrapper of the host's vector), and vpls_staged_
+  // completes once their copy has left the upload staging (pinned or packed).
   bool overlap_ = false;
+  cl::Event vpls_staged_;
+  // The sampling's Overlap resolved: begin_frame and start_sample enqueue without waiting.
+  bool sample_overlap_ = false;
+  // What the sample kernel writes: the mixture too where the host reads it (expect_queries).
+  SampleOutputs sample_outputs() const;
+  // Enqueues the samples' way to the host: mapped in place, or copied into the staging.
+  void enqueue_sample_transfer(SampleOutputs outputs);
   GuiderVpls owned_vpls_, pending_vpls_;
   double train_wait_ms_ = 0.0;  // how long begin_frame waited for the overlapped training
   GuiderSamples samples_;

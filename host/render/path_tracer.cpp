@@ -106,7 +106,7 @@ PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer,
   prefetch_surfaces_ = rtpg::loads_surfaces_ahead(settings_.surface_prefetch, scene);
 }
 
-void PathTracer::trace(const GBuffer& g, const FirstBounceSamples* first,
+void PathTracer::trace(const GBuffer& g, const FirstBounceSource& first,
                        const FirstBounceSampler& sampler, const SampleCoordinates& at,
                        std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite,
                        RayCounts& rays, PassTimes& times) {
@@ -116,10 +116,23 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSamples* first,
   at_ = at;
   prepare(n, vpls);
   auto start = Clock::now();
-  if (settings_.guide_secondary) collect_borrowable(g, sampler);
-  start_paths(g, first, sampler, at, vpls);
-  times.shade_ms += ms_since(start);
-  run_shadow_rays(n, rays, times);
+  if (first.await) {
+    // The primary hit's light samples and their shadow rays while the device makes the first
+    // bounce's directions (FirstBounceSampler::start_sample), then the first bounce.
+    start_paths(g, nullptr, sampler, at, vpls, StartPart::next_event);
+    times.shade_ms += ms_since(start);
+    run_shadow_rays(n, rays, times);
+    const FirstBounceSamples samples = first.await();
+    start = Clock::now();
+    if (settings_.guide_secondary) collect_borrowable(g, sampler);
+    start_paths(g, &samples, sampler, at, vpls, StartPart::first_bounce);
+    times.shade_ms += ms_since(start);
+  } else {
+    if (settings_.guide_secondary) collect_borrowable(g, sampler);
+    start_paths(g, first.ready, sampler, at, vpls);
+    times.shade_ms += ms_since(start);
+    run_shadow_rays(n, rays, times);
+  }
   start = Clock::now();
   apply_shadow_rays_and_compact(n, nullptr);
   times.compact_ms += ms_since(start);
@@ -211,7 +224,9 @@ shared::pg_rng PathTracer::second_vertex_stream(std::uint32_t i, shared::pg_rng&
 
 void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                              const FirstBounceSampler& sampler, const SampleCoordinates& at,
-                             VplBuffer* vpls) {
+                             VplBuffer* vpls, StartPart part) {
+  const bool starts = part != StartPart::first_bounce;  // emission and next-event estimation
+  const bool bounces = part != StartPart::next_event;   // the first bounce
   // A sampler of the BSDF has the BSDF's density already (its samples' own).
   const bool mis_with_bsdf =
       settings_.first_bounce_mis == FirstBounceMis::bsdf && !sampler.samples_the_bsdf();
@@ -223,29 +238,30 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
         std::uint32_t path_starts[kGrain], first_starts[kGrain];
         for (std::size_t chunk = range.begin(); chunk < range.end(); chunk += kGrain) {
           const std::size_t chunk_end = std::min(range.end(), chunk + kGrain);
-          make_stream_starts({at.seed, at.frame, at.sample, PG_RNG_STREAM_PATH}, chunk,
-                             chunk_end - chunk, path_starts);
-          if (!first)
+          if (starts)
+            make_stream_starts({at.seed, at.frame, at.sample, PG_RNG_STREAM_PATH}, chunk,
+                               chunk_end - chunk, path_starts);
+          if (bounces && !first)
             make_stream_starts(
                 {first_at.seed, first_at.frame, first_at.sample, PG_RNG_STREAM_FIRST_BOUNCE}, chunk,
                 chunk_end - chunk, first_starts);
           for (std::size_t i = chunk; i != chunk_end; ++i) {
             PathState& p = paths_[i];
-            p.throughput = glm::vec3(0.0f);
-            if (vpls) {
-              // Measured from y (VplPath): x0's emission is the pixel's own.
-              p.radiance = glm::vec3(0.0f);
-              vpl_paths_[i] = VplPath{glm::vec3(0.0f), glm::vec3(g.emission[i]), 0.0f};
-            } else {
-              p.radiance = glm::vec3(g.emission[i]);
+            if (starts) {
+              p.throughput = glm::vec3(0.0f);
+              if (vpls) {
+                // Measured from y (VplPath): x0's emission is the pixel's own.
+                p.radiance = glm::vec3(0.0f);
+                vpl_paths_[i] = VplPath{glm::vec3(0.0f), glm::vec3(g.emission[i]), 0.0f};
+              } else {
+                p.radiance = glm::vec3(g.emission[i]);
+              }
+              shadow_rays_[i] = inactive_ray();
+              has_shadow_[i] = 0;
+              rays_[i] = inactive_ray();
+              alive_[i] = 0;
             }
-            shadow_rays_[i] = inactive_ray();
-            has_shadow_[i] = 0;
-            rays_[i] = inactive_ray();
-            alive_[i] = 0;
             if (!g.has_surface(i)) continue;
-            shared::pg_rng rng;
-            rng.state = path_starts[i - chunk];
             const glm::vec3 x0(g.position_depth[i]);
             const glm::vec3 ng(g.geometric_normal[i]);
             const shared::pg_frame frame = gbuffer_frame(g, i);
@@ -253,35 +269,42 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
             const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
             const glm::vec3 origin = offset_ray_origin(x0, ng, g.geometric_normal[i].w);
 
-            // Next-event estimation draws three numbers: the sample's own, or sample 0's where the
-            // frame's samples share the primary vertex (SharedRandoms); either way the sample's
-            // own stream moves past them, so that sample 0 draws as the renderer does.
-            const bool shared_nee = settings_.shared_randoms == SharedRandoms::primary_vertex ||
-                                    settings_.shared_randoms == SharedRandoms::second_vertex;
-            shared::pg_rng nee_rng =
-                shared_nee ? shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
-                                                 0u, PG_RNG_STREAM_PATH)
-                           : rng;
-            const float u_sel = shared::pg_rng_next(&nee_rng), u1 = shared::pg_rng_next(&nee_rng),
-                        u2 = shared::pg_rng_next(&nee_rng);
-            if (shared_nee) {
-              for (int k = 0; k < kNextEventDraws; ++k) shared::pg_rng_next(&rng);
-            } else {
-              rng = nee_rng;
+            if (starts) {
+              shared::pg_rng rng;
+              rng.state = path_starts[i - chunk];
+              // Next-event estimation draws three numbers: the sample's own, or sample 0's where
+              // the frame's samples share the primary vertex (SharedRandoms); either way the
+              // sample's own stream moves past them, so that sample 0 draws as the renderer does.
+              const bool shared_nee = settings_.shared_randoms == SharedRandoms::primary_vertex ||
+                                      settings_.shared_randoms == SharedRandoms::second_vertex;
+              shared::pg_rng nee_rng =
+                  shared_nee ? shared::pg_rng_make(at.seed, static_cast<shared::uint>(i), at.frame,
+                                                   0u, PG_RNG_STREAM_PATH)
+                             : rng;
+              const float u_sel = shared::pg_rng_next(&nee_rng), u1 = shared::pg_rng_next(&nee_rng),
+                          u2 = shared::pg_rng_next(&nee_rng);
+              if (shared_nee) {
+                for (int k = 0; k < kNextEventDraws; ++k) shared::pg_rng_next(&rng);
+              } else {
+                rng = nee_rng;
+              }
+              // The first bounce's own sampler competes with the light here: the MIS weights use
+              // its density (the guided mixture), or the BSDF's where first_bounce_mis says so.
+              const auto first_bounce_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
+                return mis_with_bsdf ? bsdf_mis_density(shared::pg_bsdf_pdf(lobes, wo, wi))
+                                     : sampler.pdf(g, i, lobes, wo, wi);
+              };
+              // next_event writes the shadow ray in place only where it returns true.
+              glm::vec3 c;
+              if (next_event_on_ && next_event(x0, ng, frame, wo, lobes, origin, u_sel, u1, u2,
+                                               first_bounce_pdf, c, shadow_rays_[i])) {
+                shadow_contribution_[i] = c;
+                has_shadow_[i] = 1;
+              }
+              // The first bounce draws nothing from this stream: the path goes on from here.
+              p.rng = rng.state;
             }
-            // The first bounce's own sampler competes with the light here: the MIS weights use
-            // its density (the guided mixture), or the BSDF's where first_bounce_mis says so.
-            const auto first_bounce_pdf = [&](const glm::vec3&, const glm::vec3& wi) {
-              return mis_with_bsdf ? bsdf_mis_density(shared::pg_bsdf_pdf(lobes, wo, wi))
-                                   : sampler.pdf(g, i, lobes, wo, wi);
-            };
-            // next_event writes the shadow ray in place only where it returns true.
-            glm::vec3 c;
-            if (next_event_on_ && next_event(x0, ng, frame, wo, lobes, origin, u_sel, u1, u2,
-                                             first_bounce_pdf, c, shadow_rays_[i])) {
-              shadow_contribution_[i] = c;
-              has_shadow_[i] = 1;
-            }
+            if (!bounces) continue;
 
             FirstBounceSample fs;
             if (first) {
@@ -323,7 +346,6 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                 alive_[i] = 1;
               }
             }
-            p.rng = rng.state;
           }
         }
       });

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -101,12 +102,20 @@ class PathTracer {
   PathTracer(const Scene& scene, const EmbreeScene& tracer, const TriangleTable& triangles,
              const Lights& lights, PathTracerSettings settings);
 
-  // One path per surface pixel of the G-buffer, starting with `first` (from `sampler`), or
-  // with bsdf_first_bounce_sample() drawn at the primary hit where first is null (a sampler
-  // that samples_the_bsdf()).
+  // Where a pass's first-bounce directions come from: `ready` (from the sampler's sample()), or
+  // `await`, called once after the primary hit's next-event estimation and its shadow rays,
+  // which returns them (a sampler that samples_beside_the_host(): its finish_sample()); neither:
+  // bsdf_first_bounce_sample() drawn at the primary hit (a sampler that samples_the_bsdf()).
+  struct FirstBounceSource {
+    const FirstBounceSamples* ready = nullptr;
+    std::function<FirstBounceSamples()> await;
+    bool from_sampler() const { return ready != nullptr || static_cast<bool>(await); }
+  };
+  // One path per surface pixel of the G-buffer, starting with the directions of `first` (from
+  // `sampler`).
   // radiance[i] receives the estimate of pixel i (primary emission included); a non-finite
   // estimate is replaced by zero and counted. vpls (optional) receives the first-bounce hits.
-  void trace(const GBuffer& gbuffer, const FirstBounceSamples* first,
+  void trace(const GBuffer& gbuffer, const FirstBounceSource& first,
              const FirstBounceSampler& sampler, const SampleCoordinates& at,
              std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite,
              RayCounts& rays, PassTimes& times);
@@ -152,9 +161,13 @@ class PathTracer {
 
   // The steps of trace(), in order.
   void prepare(std::size_t n, VplBuffer* vpls);
-  // At the primary hit x0 of every pixel: emission, next-event estimation, the first bounce.
+  // At the primary hit x0 of every pixel: emission, next-event estimation, the first bounce
+  // (null `first`: the BSDF's, drawn here), in one pass over the pixels or in two (`part`): the
+  // second pass reads what the first left in each path (its stream past the light sample).
+  enum class StartPart { whole, next_event, first_bounce };
   void start_paths(const GBuffer& g, const FirstBounceSamples* first,
-                   const FirstBounceSampler& sampler, const SampleCoordinates& at, VplBuffer* vpls);
+                   const FirstBounceSampler& sampler, const SampleCoordinates& at, VplBuffer* vpls,
+                   StartPart part = StartPart::whole);
   // The hits of the m live paths at path vertex `depth`: emission found by the bounce (MIS),
   // the VPL at depth 1, next-event estimation, BSDF sampling and Russian roulette.
   void shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays);

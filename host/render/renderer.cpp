@@ -182,15 +182,31 @@ FrameStats Renderer::render_frame(int index) {
                          static_cast<std::uint32_t>(s)};
     const bool inline_bsdf = sampler_->samples_the_bsdf();
     FirstBounceSamples first;
+    PathTracer::FirstBounceSource source;
     if (!inline_bsdf) {
+      const SampleCoordinates first_at =
+          first_bounce_coordinates(at, settings_.path_tracer.shared_randoms);
       t = Clock::now();
-      first = sampler_->sample(gbuffer,
-                               first_bounce_coordinates(at, settings_.path_tracer.shared_randoms));
+      // The primary hit's light samples can be made while a device samples, unless their MIS
+      // weight asks the sampler for its density (FirstBounceMis::mixture).
+      if (sampler_->samples_beside_the_host() &&
+          settings_.path_tracer.first_bounce_mis == FirstBounceMis::bsdf) {
+        sampler_->start_sample(gbuffer, first_at);
+        source.await = [&] {
+          const auto wait = Clock::now();
+          const FirstBounceSamples samples = sampler_->finish_sample();
+          stats.time_ms["first_bounce"] += ms_since(wait);
+          return samples;
+        };
+      } else {
+        first = sampler_->sample(gbuffer, first_at);
+        source.ready = &first;
+      }
       stats.time_ms["first_bounce"] += ms_since(t);
     }
     const bool keep_vpls = s == 0 && sampler_->wants_vpls();
-    path_tracer_->trace(gbuffer, inline_bsdf ? nullptr : &first, *sampler_, at, pass_,
-                        keep_vpls ? &vpls_ : nullptr, stats.nonfinite_samples, rays, times);
+    path_tracer_->trace(gbuffer, source, *sampler_, at, pass_, keep_vpls ? &vpls_ : nullptr,
+                        stats.nonfinite_samples, rays, times);
     t = Clock::now();
     const float weight = 1.0f / static_cast<float>(settings_.spp);
     // The first sample starts the sum from zero here, in parallel, instead of a serial fill of

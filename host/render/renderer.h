@@ -101,7 +101,7 @@ class Renderer {
   VplBuffer vpls_;
   // Declared after the buffers it may read, so that it is destroyed before them: a guided
   // sampler can leave the last frame's training running on the device, reading the G-buffer and
-  // the VPLs in place, and its destructor waits for it (GuidedFirstBounce, TrainOverlap).
+  // the VPLs in place, and its destructor waits for it (GuidedFirstBounce, Overlap).
   std::unique_ptr<FirstBounceSampler> sampler_;
   std::vector<glm::vec3> image_, pass_;
   std::vector<Ray> camera_rays_;

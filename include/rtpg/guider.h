@@ -223,27 +223,34 @@ class Guider {
   bool row_work_groups() const { return pixel_rows_; }
 
   void reset();  // every pixel back to the initial state (k = 0: BSDF sampling)
+
+  // How a kernel call returns. Wait::finish (the default): when the kernel is done, its time in
+  // last_times(). Wait::later: once it is enqueued and the queue flushed, so that a device with
+  // cores of its own runs it while the host goes on; wait_for_training() (train) and
+  // wait_for_kernels() (every kernel) wait for it and record its time. The guider's calls share
+  // one in-order queue, so whatever it enqueues later sees what an earlier kernel wrote (the
+  // trained state for reproject, sample, read_state and count_trained; the reprojected state for
+  // sample), and the caller must leave every buffer a pending kernel reads or writes (and host
+  // memory they wrap) untouched until it has waited.
+  enum class Wait { finish, later };
   // Writes out's channels from a G-buffer the host packed (PG_PACKED_GBUFFER_CHANNELS;
   // kernels/shared/gbuffer_packing.h packs): for a device with memory of its own, where the
   // packed form halves what crosses the bus. out must be made with KernelAccess::read_write.
-  void unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out);
+  void unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out,
+                      Wait wait = Wait::finish);
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
-  void reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous);
+  void reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous,
+                 Wait wait = Wait::finish);
   void sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint32_t frame,
               std::uint32_t sample_index, const GuiderSamples& out,
-              SampleOutputs outputs = SampleOutputs::directions_and_mixture);
-  // With TrainWait::finish (the default) train() returns when the kernel is done and its time
-  // is in last_times(). With TrainWait::later it returns once the kernel is enqueued (and the
-  // queue flushed): on a device with cores of its own it runs while the host goes on, and
-  // wait_for_training() waits for it and records its time. Everything the guider enqueues after
-  // it waits for it (one in-order queue), so the state that reproject, sample, read_state and
-  // count_trained see is the trained one either way; the caller must leave the G-buffer and the
-  // VPLs it read (and host memory they wrap) untouched until then.
-  enum class TrainWait { finish, later };
+              SampleOutputs outputs = SampleOutputs::directions_and_mixture,
+              Wait wait = Wait::finish);
   void train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::uint32_t seed,
-             std::uint32_t frame, TrainWait wait = TrainWait::finish);
-  // Waits for a train() enqueued with TrainWait::later (none pending: returns at once).
+             std::uint32_t frame, Wait wait = Wait::finish);
+  // Waits for a train() enqueued with Wait::later (none pending: returns at once).
   void wait_for_training();
+  // Waits for every kernel enqueued with Wait::later, train() included, and records their times.
+  void wait_for_kernels();
   bool training_pending() const { return train_pending_; }
 
   // The state, PG_STATE_FLOATS_PER_PIXEL floats per pixel (state0 then state1;
@@ -274,8 +281,10 @@ class Guider {
     std::size_t groups = 0, group_items = 0;
   };
   Launch launch_of(int lanes, bool pixel_kernel) const;
-  // Launches, waits, returns profiled ms.
-  double run(cl::Kernel& kernel, const Launch& launch);
+  // Launches; with Wait::finish waits and writes the profiled ms into *ms, with Wait::later
+  // leaves that to wait_for_kernels().
+  void run(cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local, Wait wait,
+           double* ms);
   // Reads a kernel's count records (one float4 per work-group) and sums each component.
   std::array<double, 4> sum_count_records(const cl::Buffer& records, std::size_t groups);
 
@@ -303,8 +312,10 @@ class Guider {
   int current_ = 0;  // index of the buffers holding this frame's state
   cl::Kernel reproject_, sample_, train_;
   cl::Kernel unpack_;     // built at the first unpack_gbuffer()
-  cl::Event train_done_;  // the last train() enqueued with TrainWait::later
+  cl::Event train_done_;  // the last train() enqueued with Wait::later
   bool train_pending_ = false;
+  // The other kernels enqueued with Wait::later, and where each one's time goes (in times_).
+  std::vector<std::pair<cl::Event, double*>> pending_;
   GuiderTimes times_;
 };
 

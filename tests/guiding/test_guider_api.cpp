@@ -186,6 +186,47 @@ TEST(GuiderApi, CreateResetReprojectSampleTrainAndStateRoundTrip) {
   EXPECT_GE(guider.last_times().train_ms, 0.0);
 }
 
+// Kernels enqueued with Wait::later compute what they compute waited for: a second guider
+// given the same state, G-buffer and frames, its reproject and sample enqueued one after the
+// other without waiting, ends with the same samples and state to the bit once wait_for_kernels()
+// returns, which has then recorded both kernels' times.
+TEST(GuiderApi, KernelsLeftRunningComputeTheSame) {
+  rtpg::ClRuntime rt;
+  const bool small = rt.info().platform_name.find("Oclgrind") != std::string::npos;
+  const int w = small ? 11 : 37, h = small ? 7 : 23;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  const rtpg::GuiderGBuffer g = floor_gbuffer(rt, w, h);
+  std::mt19937 gen(3);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  // Lobes of random centres and widths, pi 0.3, k 4 (the state layout of the test above).
+  std::vector<float> lobe(8 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float s0 = 1.0f, pi = 0.3f, var = 0.002f + 0.01f * u(gen);
+    const float mx = 0.3f + 0.4f * u(gen), my = 0.3f + 0.4f * u(gen);
+    const float v[8] = {
+        s0 / pi,      s0,  mx * s0, my * s0, s0 * (var + mx * mx), s0 * (var + my * my),
+        mx * my * s0, 4.0f};
+    std::memcpy(&lobe[8 * i], v, sizeof v);
+  }
+  std::vector<float> d[2], state[2];
+  for (int later = 0; later < 2; ++later) {
+    rtpg::Guider guider(rt, w, h);
+    guider.write_state(lobe);
+    const rtpg::GuiderSamples samples = rtpg::make_guider_samples(rt.context(), w, h);
+    const rtpg::Guider::Wait wait = later ? rtpg::Guider::Wait::later : rtpg::Guider::Wait::finish;
+    guider.reproject(g, g, wait);
+    guider.sample(g, 7u, 1u, 0u, samples, rtpg::SampleOutputs::directions, wait);
+    guider.wait_for_kernels();
+    EXPECT_GT(guider.last_times().reproject_ms, 0.0);
+    EXPECT_GT(guider.last_times().sample_ms, 0.0);
+    d[later].resize(4 * n);
+    rt.queue().enqueueReadBuffer(samples.direction_pdf, CL_TRUE, 0, n * 16, d[later].data());
+    guider.read_state(state[later]);
+  }
+  EXPECT_EQ(std::memcmp(d[0].data(), d[1].data(), n * 16), 0);
+  EXPECT_EQ(state[0], state[1]);
+}
+
 // The host distribution (include/rtpg/guiding_distribution.h) is the device sampler's: for every
 // direction the sample kernel drew, its density is the kernel's, and its own samples carry
 // their own density.

@@ -398,9 +398,8 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
     Renderer renderer(scene, settings);
     // Training waited for, so that every frame reads the count records of its own training
     // (TrainingOverlappedGivesTheSameImage checks the overlapped order).
-    auto guided =
-        std::make_unique<GuidedFirstBounce>(cl, settings.width, settings.height, GuidingSettings{},
-                                            cases[t].transfer, TrainOverlap::off);
+    auto guided = std::make_unique<GuidedFirstBounce>(
+        cl, settings.width, settings.height, GuidingSettings{}, cases[t].transfer, Overlap::off);
     GuidedFirstBounce* sampler = guided.get();
     const HostTransfer used = guided->host_transfer();
     used_by[t] = used;
@@ -460,7 +459,7 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
 }
 
 // Training left running on the device while the host makes the next frame's camera rays and
-// G-buffer (TrainOverlap::on, the default where the device has memory of its own) changes only
+// G-buffer (Overlap::on, the default where the device has memory of its own) changes only
 // when the host waits for it: with every host transfer, along a moving camera at 2 spp and an odd
 // size, the image and the trained state are those of training waited for, to the bit, and each
 // frame reports the previous frame's training (its trained share, its kernel time, the wait).
@@ -477,9 +476,9 @@ TEST(GuidingImage, TrainingOverlappedGivesTheSameImage) {
     std::vector<FrameStats> stats[2];
     for (int overlapped = 0; overlapped < 2; ++overlapped) {
       Renderer renderer(scene, settings);
-      auto guided = std::make_unique<GuidedFirstBounce>(
-          cl, settings.width, settings.height, GuidingSettings{}, transfer,
-          overlapped ? TrainOverlap::on : TrainOverlap::off);
+      auto guided = std::make_unique<GuidedFirstBounce>(cl, settings.width, settings.height,
+                                                        GuidingSettings{}, transfer,
+                                                        overlapped ? Overlap::on : Overlap::off);
       GuidedFirstBounce* sampler = guided.get();
       EXPECT_EQ(sampler->overlaps_training(), overlapped == 1);
       renderer.set_first_bounce_sampler(std::move(guided));
@@ -512,11 +511,83 @@ TEST(GuidingImage, TrainingOverlappedGivesTheSameImage) {
                   waited.extra.at("host_device_bytes_per_pixel"));
     }
   }
-  EXPECT_THROW(parse_train_overlap("sometimes"), GuiderError);
-  EXPECT_EQ(parse_train_overlap("auto"), TrainOverlap::automatic);
+  EXPECT_THROW(parse_overlap("sometimes"), GuiderError);
+  EXPECT_EQ(parse_overlap("auto"), Overlap::automatic);
 }
 
-// A renderer destroyed right after a frame whose training it left running (TrainOverlap::on)
+// The G-buffer's upload, reproject and sample left running on the device while the host makes
+// the primary hit's light samples (Overlap::on for sampling, the default where the device has
+// memory of its own) change nothing but the order of the work: with every host transfer, with
+// the training waited for and overlapped, along a moving camera at 2 spp and an odd size, the
+// image, the state and the statistics are those of sampling waited for, to the bit. So they are
+// where the host reads the mixture (later vertices borrowing it) and where next-event
+// estimation needs its density (FirstBounceMis::mixture: the renderer then calls sample()).
+TEST(GuidingImage, SamplingOverlappedGivesTheSameImage) {
+  ClRuntime cl;
+  const Scene scene = load_scene(scene_file("cornell-box.json"));
+  constexpr int kFrames = 4;
+  struct Case {
+    HostTransfer transfer;
+    Overlap training;
+    bool borrow, mixture_mis;
+  };
+  const Case cases[] = {
+      {HostTransfer::in_place, Overlap::off, false, false},
+      {HostTransfer::in_place, Overlap::on, false, false},
+      {HostTransfer::pinned, Overlap::on, false, false},
+      {HostTransfer::pageable, Overlap::off, false, false},
+      {HostTransfer::packed, Overlap::on, false, false},
+      {HostTransfer::packed, Overlap::off, true, false},
+      {HostTransfer::in_place, Overlap::on, false, true},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(host_transfer_name(c.transfer)) +
+                 (c.training == Overlap::on ? ", training overlapped" : "") +
+                 (c.borrow ? ", later vertices borrow" : "") +
+                 (c.mixture_mis ? ", mixture MIS" : ""));
+    RenderSettings settings = odd_size_along_camera_path(scene);
+    settings.path_tracer.guide_secondary = c.borrow;
+    if (c.mixture_mis) settings.path_tracer.first_bounce_mis = FirstBounceMis::mixture;
+    std::vector<glm::vec3> image[2];
+    std::vector<float> state[2];
+    std::vector<FrameStats> stats[2];
+    for (int overlapped = 0; overlapped < 2; ++overlapped) {
+      Renderer renderer(scene, settings);
+      auto guided = std::make_unique<GuidedFirstBounce>(cl, settings.width, settings.height,
+                                                        GuidingSettings{}, c.transfer, c.training,
+                                                        overlapped ? Overlap::on : Overlap::off);
+      GuidedFirstBounce* sampler = guided.get();
+      EXPECT_EQ(sampler->samples_beside_the_host(), overlapped == 1);
+      renderer.set_first_bounce_sampler(std::move(guided));
+      for (int f = 0; f < kFrames; ++f) stats[overlapped].push_back(renderer.render_frame(f));
+      image[overlapped] = renderer.image();
+      sampler->guider().wait_for_training();
+      sampler->guider().read_state(state[overlapped]);
+    }
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < image[0].size(); ++i) differ += image[0][i] != image[1][i];
+    EXPECT_EQ(differ, 0u) << "of " << image[0].size() << " pixels";
+    EXPECT_EQ(state[0], state[1]);
+    for (int f = 0; f < kFrames; ++f) {
+      SCOPED_TRACE("frame " + std::to_string(f));
+      const FrameStats &waited = stats[0][f], &overlapped = stats[1][f];
+      EXPECT_EQ(waited.extra.at("sample_overlap"), 0.0);
+      EXPECT_EQ(overlapped.extra.at("sample_overlap"), 1.0);
+      for (const char* name :
+           {"guided_fraction", "trained_fraction", "mean_pi", "host_device_bytes_per_pixel"})
+        EXPECT_EQ(overlapped.extra.at(name), waited.extra.at(name)) << name;
+      EXPECT_EQ(overlapped.shadow_rays, waited.shadow_rays);
+      EXPECT_EQ(overlapped.secondary_rays, waited.secondary_rays);
+      // Every kernel's time is recorded, whenever the host waited for it.
+      EXPECT_EQ(overlapped.time_ms.at("reproject") > 0.0, f > 0);
+      EXPECT_GT(overlapped.time_ms.at("sample"), 0.0);
+      EXPECT_EQ(overlapped.time_ms.at("train") > 0.0, c.training == Overlap::off || f > 0);
+    }
+  }
+  EXPECT_EQ(parse_overlap("off"), Overlap::off);
+}
+
+// A renderer destroyed right after a frame whose training it left running (Overlap::on)
 // waits for that training before its host buffers go: read in place, the train kernel reads the
 // renderer's VPL and G-buffer memory, which large images allocate by mmap and free by munmap.
 TEST(GuidingImage, RendererDestroyedWhileTrainingRuns) {
@@ -528,8 +599,8 @@ TEST(GuidingImage, RendererDestroyedWhileTrainingRuns) {
   for (HostTransfer transfer : {HostTransfer::in_place, HostTransfer::pageable}) {
     for (int run = 0; run < 8; ++run) {
       Renderer renderer(scene, settings);
-      auto guided = std::make_unique<GuidedFirstBounce>(
-          cl, settings.width, settings.height, GuidingSettings{}, transfer, TrainOverlap::on);
+      auto guided = std::make_unique<GuidedFirstBounce>(cl, settings.width, settings.height,
+                                                        GuidingSettings{}, transfer, Overlap::on);
       GuidedFirstBounce* sampler = guided.get();
       renderer.set_first_bounce_sampler(std::move(guided));
       renderer.render_frame(0);
