@@ -188,7 +188,8 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   bytes_ = 0;
   // Last frame's training, left running by end_frame: the staging the G-buffer goes up through,
   // and the host memory it read in place, are free once it is done. Its figures (train,
-  // trained_fraction) are reported with this frame's.
+  // trained_fraction) are reported with this frame's. With the sampling overlapped it is
+  // finish_sample that waits for it, and here only its VPLs' copy out of the staging.
   train_wait_ms_ = 0.0;
   if (!guider_->training_pending()) {
     trained_fraction_ = 0.0;
@@ -366,9 +367,11 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   }
   upload_ms_ += ms_since(t);
   if (overlap_) {
-    // Nothing touches the VPLs, their staging or this G-buffer before the next begin_frame
-    // waits: the renderer writes the other G-buffer next frame (in place) and rewrites the VPLs
-    // only after the next sample(), and begin_frame waits before staging anything.
+    // Nothing touches the VPLs, their staging or this G-buffer before the next frame waits for
+    // the training: the renderer writes the other G-buffer next frame (in place) and rewrites
+    // the VPLs only after the next sample() or finish_sample(); begin_frame waits for the
+    // training (or, with the sampling overlapped, for the VPLs' copy, vpls_staged_) before it
+    // stages the G-buffer.
     pending_vpls_ = device_vpls;
     guider_->train(current_gbuffer_, device_vpls, at.seed, at.frame, Guider::Wait::later);
     return;

@@ -109,7 +109,6 @@ class PathTracer {
   struct FirstBounceSource {
     const FirstBounceSamples* ready = nullptr;
     std::function<FirstBounceSamples()> await;
-    bool from_sampler() const { return ready != nullptr || static_cast<bool>(await); }
   };
   // One path per surface pixel of the G-buffer, starting with the directions of `first` (from
   // `sampler`).
