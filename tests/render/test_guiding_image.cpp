@@ -358,6 +358,13 @@ TEST(GuidingImage, RejectsAFivePercentPdfError) {
 }
 
 // The transfer tests' frames: 37x23 at 2 spp along the scene's first camera path.
+// Pixels whose values differ in any bit between two images of the same size.
+std::size_t pixels_that_differ(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
+  return differ;
+}
+
 RenderSettings odd_size_along_camera_path(const Scene& scene) {
   RenderSettings settings;
   settings.width = 37;
@@ -450,11 +457,9 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
   for (int t = 1; t < kCases; ++t) {
     ASSERT_EQ(images[0].size(), images[t].size());
     if (used_by[t] == HostTransfer::packed) continue;
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < images[0].size(); ++i) differ += images[0][i] != images[t][i];
-    EXPECT_EQ(differ, 0u) << host_transfer_name(cases[t].transfer)
-                          << (cases[t].mixture ? ", mixture read" : "") << ": of "
-                          << images[0].size() << " pixels";
+    EXPECT_EQ(pixels_that_differ(images[0], images[t]), 0u)
+        << host_transfer_name(cases[t].transfer) << (cases[t].mixture ? ", mixture read" : "")
+        << ": of " << images[0].size() << " pixels";
   }
 }
 
@@ -487,9 +492,7 @@ TEST(GuidingImage, TrainingOverlappedGivesTheSameImage) {
       image[overlapped] = renderer.image();
       sampler->guider().read_state(state[overlapped]);  // after the last frame's training
     }
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < image[0].size(); ++i) differ += image[0][i] != image[1][i];
-    EXPECT_EQ(differ, 0u) << "of " << image[0].size() << " pixels";
+    EXPECT_EQ(pixels_that_differ(image[0], image[1]), 0u) << "of " << image[0].size() << " pixels";
     EXPECT_EQ(state[0], state[1]);
     for (int f = 0; f < kFrames; ++f) {
       SCOPED_TRACE("frame " + std::to_string(f));
@@ -564,9 +567,7 @@ TEST(GuidingImage, SamplingOverlappedGivesTheSameImage) {
       sampler->guider().wait_for_training();
       sampler->guider().read_state(state[overlapped]);
     }
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < image[0].size(); ++i) differ += image[0][i] != image[1][i];
-    EXPECT_EQ(differ, 0u) << "of " << image[0].size() << " pixels";
+    EXPECT_EQ(pixels_that_differ(image[0], image[1]), 0u) << "of " << image[0].size() << " pixels";
     EXPECT_EQ(state[0], state[1]);
     for (int f = 0; f < kFrames; ++f) {
       SCOPED_TRACE("frame " + std::to_string(f));
