@@ -9,8 +9,9 @@
 # scenes at the path they were built in, linked to SOURCE, default the working directory), then
 # rtpg renders FRAMES frames (default 24) of SCENES at RESOLUTIONS path-traced and guided with each
 # host transfer, and with SVGF, into OUT/frames/*.json (--stats-json; RUNS names them: off,
-# off-svgf, each --host-transfer alone or with -svgf, and overlap-on / overlap-off: the default
-# transfer with --train-overlap on / off) with their table in OUT/frames.md
+# off-svgf, each --host-transfer alone or with -svgf, overlap-on / overlap-off: the default
+# transfer with --train-overlap on / off, and sample-overlap-on / sample-overlap-off: with
+# --sample-overlap on / off) with their table in OUT/frames.md
 # (gpu_frames_summary.py; ROUNDS repeats them, interleaved, into ...-RUN-rN.json), and
 # bench_svgf and bench_frame run on the Cornell box (not with NO_BENCH). TESTS narrows the tests
 # there too.
@@ -74,6 +75,7 @@ if [ -n "${RENDER:-}" ]; then
           off) set -- --guiding off ;;
           off-svgf) set -- --guiding off --denoise svgf ;;
           overlap-on|overlap-off) set -- --train-overlap "${name#overlap-}" ;;
+          sample-overlap-on|sample-overlap-off) set -- --sample-overlap "${name#sample-overlap-}" ;;
           *-svgf) set -- --host-transfer "${name%-svgf}" --denoise svgf ;;
           *) set -- --host-transfer "$name" ;;
         esac
