@@ -11,6 +11,8 @@ namespace {
 
 static_assert(sizeof(pg_kernel_settings) == 24 * 4,
               "pg_kernel_settings: 24 plain 4-byte fields, no padding");
+static_assert(sizeof(pg_gbuffer_cameras) == 31 * 4,
+              "pg_gbuffer_cameras must hold only 4-byte fields (include/rtpg/guiding_layout.h)");
 static_assert(sizeof(shared::pg_pmm_state) == 4 * PG_STATE_FLOATS_PER_PIXEL,
               "the state's floats per pixel");
 
@@ -235,11 +237,15 @@ std::array<double, 4> Guider::sum_count_records(const cl::Buffer& records, std::
 }
 
 void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out,
-                            Wait wait) {
+                            const pg_gbuffer_cameras& cameras, Wait wait) {
 #define RTPG_CHECK(name, type, bytes) check_buffer(packed.name, bytes, "packed." #name);
   PG_PACKED_GBUFFER_CHANNELS(RTPG_CHECK)
 #undef RTPG_CHECK
   check_gbuffer(out, "unpacked");
+  if (cameras.width != width_ || cameras.height != height_)
+    throw GuiderError("unpack_gbuffer: the cameras' image is " + std::to_string(cameras.width) +
+                      "x" + std::to_string(cameras.height) + ", the guider's " +
+                      std::to_string(width_) + "x" + std::to_string(height_));
   translate_cl_errors([&] {
     if (out.position_depth.getInfo<CL_MEM_FLAGS>() & CL_MEM_READ_ONLY)
       throw GuiderError(
@@ -251,7 +257,7 @@ void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuff
 #define RTPG_ARG(name, type, bytes) args << packed.name;
     PG_PACKED_GBUFFER_CHANNELS(RTPG_ARG)
 #undef RTPG_ARG
-    args << out << static_cast<cl_uint>(n);
+    args << out << static_cast<cl_uint>(n) << cameras;
     // One work-item a pixel in groups of up to 64 (any size works: the kernel checks its bound).
     const std::size_t group = std::min<std::size_t>(
         64, unpack_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));

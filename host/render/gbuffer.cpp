@@ -27,4 +27,19 @@ shared::pg_frame gbuffer_frame(const GBuffer& g, std::size_t i) {
   return shared::pg_frame_from_normal(glm::vec3(g.shading_normal[i]));
 }
 
+namespace {
+
+pg_pinhole_camera pinhole(const CameraFrame& c) {
+  return pg_pinhole_camera{c.position.x, c.position.y, c.position.z,     c.right.x, c.right.y,
+                           c.right.z,    c.up.x,       c.up.y,           c.up.z,    c.forward.x,
+                           c.forward.y,  c.forward.z,  c.tan_half_fov_y, c.aspect};
+}
+
+}  // namespace
+
+pg_gbuffer_cameras gbuffer_cameras(const GBuffer& g) {
+  return pg_gbuffer_cameras{pinhole(g.camera), pinhole(g.previous_camera), g.width, g.height,
+                            g.camera_moved ? 1 : 0};
+}
+
 }  // namespace rtpg

@@ -25,6 +25,10 @@ struct GBuffer {
                                             // (SurfacePoint::offset_distance)
   std::vector<glm::vec4> emission;          // rgb emitted towards the camera (or sky radiance)
   CameraFrame camera;                       // the camera the primary rays came from
+  // Last frame's camera, which the motion vectors point into, and whether the camera moved
+  // (where it did not, every motion vector is zero whatever the jitter).
+  CameraFrame previous_camera;
+  bool camera_moved = false;
 
   void resize(int w, int h);  // every pixel sky
   std::size_t pixel_count() const {
@@ -39,5 +43,8 @@ struct GBuffer {
 // distribution of that pixel lives in).
 shared::pg_material gbuffer_material(const GBuffer& g, std::size_t i);
 shared::pg_frame gbuffer_frame(const GBuffer& g, std::size_t i);
+// The G-buffer's two cameras and size as the kernels take them (include/rtpg/guiding_layout.h,
+// "Cameras"): what a packed G-buffer's depths, view directions and motion follow from.
+pg_gbuffer_cameras gbuffer_cameras(const GBuffer& g);
 
 }  // namespace rtpg

@@ -20,11 +20,8 @@ bool pack_baseline(const GBuffer& g, std::size_t first, std::size_t last,
   bool all_fit = true;
   for (std::size_t i = first; i < last; ++i) {
     out.surface[i] = shared::pg_pack_gbuffer_surface(g.position_depth[i], g.shading_normal[i]);
-    out.view_material[i] = shared::pg_pack_gbuffer_view_material(g.position_depth[i], g.view_dir[i],
-                                                                 g.base_color_roughness[i]);
-    out.shading[i] =
-        shared::pg_pack_gbuffer_shading(g.metallic_specular[i], g.flags[i], g.material[i]);
-    out.motion[i] = g.motion[i];
+    out.shading[i] = shared::pg_pack_gbuffer_shading(
+        g.base_color_roughness[i], g.metallic_specular[i], g.flags[i], g.material[i]);
     all_fit &= fits(g, i);
   }
   return all_fit;
@@ -88,26 +85,22 @@ RTPG_LANES_VARIANT bool pack_lanes(const GBuffer& g, std::size_t first, std::siz
                                    const PackedGBufferView& out) {
   bool all_fit = true;
   std::size_t i = first;
-  alignas(32) std::uint32_t normal[8], view[8];
+  alignas(32) std::uint32_t normal[8];
   for (; i + 8 <= last; i += 8) {
     __m256 x, y, z;
     load_xyz8(&g.shading_normal[i], x, y, z);
     _mm256_store_si256(reinterpret_cast<__m256i*>(normal), pack_unit_vector8(x, y, z));
-    load_xyz8(&g.view_dir[i], x, y, z);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(view), pack_unit_vector8(x, y, z));
     for (int k = 0; k < 8; ++k) {
       const std::size_t p = i + static_cast<std::size_t>(kLaneOrder[k]);
       const shared::float4& pd = g.position_depth[p];
       out.surface[p] = shared::uint4(shared::as_uint(pd.x), shared::as_uint(pd.y),
                                      shared::as_uint(pd.z), normal[k]);
       const __m128i colour = halves4(g.base_color_roughness[p]);
-      out.view_material[p] = shared::uint4(
-          shared::as_uint(pd.w), view[k], static_cast<std::uint32_t>(_mm_extract_epi32(colour, 0)),
-          static_cast<std::uint32_t>(_mm_extract_epi32(colour, 1)));
-      out.shading[p] = shared::uint2(
+      out.shading[p] = shared::uint4(
+          static_cast<std::uint32_t>(_mm_extract_epi32(colour, 0)),
+          static_cast<std::uint32_t>(_mm_extract_epi32(colour, 1)),
           static_cast<std::uint32_t>(_mm_cvtsi128_si32(halves4(g.metallic_specular[p]))),
           (g.flags[p] & 0xffu) | (g.material[p] << 8));
-      out.motion[p] = g.motion[p];
       all_fit &= fits(g, p);
     }
   }

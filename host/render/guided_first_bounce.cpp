@@ -46,20 +46,16 @@ void stage_channels(PinnedStaging& staging, const VplBuffer& host, const GuiderV
 }
 
 // The host G-buffer packed straight into the staging (render/gbuffer_packer.h), in parallel, and
-// its four channels' copies to the device enqueued. Throws GuiderError where a
-// material id or the flags do not fit in the packed word (nothing is enqueued then).
+// its channels' copies to the device enqueued. Throws GuiderError where a material id or the
+// flags do not fit in the packed word (nothing is enqueued then).
 void stage_packed_gbuffer(PinnedStaging& staging, const GBuffer& g,
                           const GuiderPackedGBuffer& device) {
   const std::size_t n = g.pixel_count();
   auto* surface =
       static_cast<shared::uint4*>(staging.reserve(n * 16, device.surface, "packed surface"));
-  auto* view_material = static_cast<shared::uint4*>(
-      staging.reserve(n * 16, device.view_material, "packed view_material"));
   auto* shading =
-      static_cast<shared::uint2*>(staging.reserve(n * 8, device.shading, "packed shading"));
-  auto* motion =
-      static_cast<shared::float2*>(staging.reserve(n * 8, device.motion, "packed motion"));
-  const PackedGBufferView view{surface, view_material, shading, motion};
+      static_cast<shared::uint4*>(staging.reserve(n * 16, device.shading, "packed shading"));
+  const PackedGBufferView view{surface, shading};
   std::atomic<bool> unpackable{false};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 13),
                     [&](const tbb::blocked_range<std::size_t>& r) {
@@ -70,9 +66,7 @@ void stage_packed_gbuffer(PinnedStaging& staging, const GBuffer& g,
         "packed G-buffer: a material id above " + std::to_string(PG_PACKED_MATERIAL_MAX) +
         " or flags above 255 do not fit in the packed shading word (use --host-transfer pinned)");
   staging.commit(surface, n * 16, device.surface);
-  staging.commit(view_material, n * 16, device.view_material);
-  staging.commit(shading, n * 8, device.shading);
-  staging.commit(motion, n * 8, device.motion);
+  staging.commit(shading, n * 16, device.shading);
 }
 
 }  // namespace
@@ -226,7 +220,7 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
     copied_from_ = &g;
   }
   upload_ms_ = ms_since(t);
-  if (packed_) guider_->unpack_gbuffer(packed_gbuffer_, current_gbuffer_, wait);
+  if (packed_) guider_->unpack_gbuffer(packed_gbuffer_, current_gbuffer_, gbuffer_cameras(g), wait);
   if (have_previous_) {
     guider_->reproject(current_gbuffer_, previous_gbuffer_, wait);
   } else {

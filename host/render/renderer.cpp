@@ -92,6 +92,7 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
   GBuffer& g = gbuffers_[current_gbuffer_];
   const std::size_t n = g.pixel_count();
   g.camera = camera;
+  g.previous_camera = previous;
   camera_rays_.resize(n);
   camera_hits_.resize(n);
 
@@ -110,6 +111,7 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
   // jitter.
   const bool static_camera =
       frame == 0 || settings_.camera_path.empty() || settings_.camera_frame >= 0;
+  g.camera_moved = !static_camera;
   const bool load_surfaces_ahead = path_tracer_->loads_surfaces_ahead();
   tbb::parallel_for(tbb::blocked_range<int>(0, h, rows_per_task), [&](const auto& rows) {
     const std::size_t rows_end = static_cast<std::size_t>(rows.end()) * static_cast<std::size_t>(w);

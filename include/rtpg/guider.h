@@ -234,10 +234,12 @@ class Guider {
   // memory they wrap) untouched until it has waited.
   enum class Wait { finish, later };
   // Writes out's channels from a G-buffer the host packed (PG_PACKED_GBUFFER_CHANNELS;
-  // kernels/shared/gbuffer_packing.h packs): for a device with memory of its own, where the
-  // packed form halves what crosses the bus. out must be made with KernelAccess::read_write.
+  // kernels/shared/gbuffer_packing.h packs) and the frame's cameras, from which the depth, the
+  // view direction and the motion vector follow (pg_gbuffer_cameras, whose width and height
+  // must be the guider's): for a device with memory of its own, where the packed form sends a
+  // third of the layout's bytes. out must be made with KernelAccess::read_write.
   void unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out,
-                      Wait wait = Wait::finish);
+                      const pg_gbuffer_cameras& cameras, Wait wait = Wait::finish);
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
   void reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous,
                  Wait wait = Wait::finish);

@@ -31,20 +31,19 @@
   X(motion, float2, 8)
 
 /* ---- Packed G-buffer: the G-buffer as it crosses the bus -----------------------------------
- * Where the device has memory of its own, the host packs each pixel into these 48 bytes
+ * Where the device has memory of its own, the host packs each pixel into these 32 bytes
  * (kernels/shared/gbuffer_packing.h, which packs and unpacks them) and the device's
- * unpack_gbuffer kernel writes PG_GBUFFER_CHANNELS from them (rtpg::Guider::unpack_gbuffer).
- * surface        xyz the position's float bits, w the shading normal (octahedral)
- * view_material  x the depth's float bits, y the view direction (octahedral), z base colour r and
- *                g as half floats, w base colour b and roughness as half floats (low half first)
- * shading        x metallic and specular as half floats, y the flags (low 8 bits) and the
- *                material id (the high 24)
- * motion         the motion vector, exact */
+ * unpack_gbuffer kernel writes PG_GBUFFER_CHANNELS from them and the frame's cameras
+ * (pg_gbuffer_cameras below; rtpg::Guider::unpack_gbuffer): the depth, the view direction and
+ * the motion vector are functions of the position and the two pinhole cameras, so they do not
+ * travel.
+ * surface  xyz the position's float bits, w the shading normal (octahedral)
+ * shading  x base colour r and g as half floats, y base colour b and roughness as half floats,
+ *          z metallic and specular as half floats (low half first), w the flags (low 8 bits)
+ *          and the material id (the high 24) */
 #define PG_PACKED_GBUFFER_CHANNELS(X) \
   X(surface, uint4, 16)               \
-  X(view_material, uint4, 16)         \
-  X(shading, uint2, 8)                \
-  X(motion, float2, 8)
+  X(shading, uint4, 16)
 
 /* Pixels guiding skips (paper, section 5: sky, emitters, transmission, roughness near 0). */
 #define PG_GBUF_SKY 1u          /* camera ray escaped: no surface */
@@ -125,6 +124,36 @@
 
 /* At most this many neighbour VPLs train a pixel per frame (the train kernel's array). */
 #define PG_MAX_TRAIN_SAMPLES 32
+
+/* ---- Cameras: what unpack_gbuffer derives a packed G-buffer's depth, view direction and
+ * motion from (kernels/shared/gbuffer_packing.h), passed by value like the settings below.
+ * A pinhole camera: its position, its orthonormal right, up and forward (the view direction),
+ * tan(fov_y / 2) and the image's aspect (width / height); film point (sx, sy) in [0, 1]^2 (top
+ * left (0, 0)) looks along forward + (2 sx - 1) tan_half_fov_y aspect right
+ * + (1 - 2 sy) tan_half_fov_y up (host: rtpg::CameraFrame). */
+#ifdef __cplusplus
+namespace rtpg {
+#endif
+
+typedef struct pg_pinhole_camera {
+  float position_x, position_y, position_z;
+  float right_x, right_y, right_z;
+  float up_x, up_y, up_z;
+  float forward_x, forward_y, forward_z;
+  float tan_half_fov_y;
+  float aspect;
+} pg_pinhole_camera;
+
+typedef struct pg_gbuffer_cameras {
+  pg_pinhole_camera current;  /* the frame's: depth = dot(p - position, forward), view direction */
+  pg_pinhole_camera previous; /* last frame's: where each point was (the motion vector) */
+  int width, height;          /* the image, for the motion vector in pixels */
+  int moved; /* 0: the motion is zero (a static camera; whatever the sub-pixel jitter) */
+} pg_gbuffer_cameras;
+
+#ifdef __cplusplus
+} /* namespace rtpg */
+#endif
 
 /* ---- Kernel settings --------------------------------------------------------------------
  * Every tunable of the guiding kernels, passed by value. Plain 4-byte fields only, so host

@@ -61,7 +61,7 @@ TEST(GBufferPacking, HalvesSaturateInsteadOfOverflowing) {
 }
 
 // Random pixels of every kind of value a renderer writes: what the layout says travels exactly
-// does, the unit vectors come back within the octahedral bound, the material within a half's
+// does, the normal comes back within the octahedral bound, the material within a half's
 // rounding.
 TEST(GBufferPacking, PixelsRoundTripWithinTheirBounds) {
   std::mt19937 gen(5);
@@ -76,8 +76,8 @@ TEST(GBufferPacking, PixelsRoundTripWithinTheirBounds) {
     const float scale = std::pow(10.0f, -4.0f + 8.0f * unit(gen));
     const float4 position_depth(wide(gen) * scale, wide(gen) * scale, wide(gen) * scale,
                                 unit(gen) * 1e4f * scale);
-    const float3 n = random_unit(), v = random_unit();
-    const float4 shading_normal(n.x, n.y, n.z, 0.0f), view_dir(v.x, v.y, v.z, 0.0f);
+    const float3 n = random_unit();
+    const float4 shading_normal(n.x, n.y, n.z, 0.0f);
     const float dark = std::pow(10.0f, -4.0f * unit(gen));
     const float4 bcr(unit(gen) * dark, unit(gen), unit(gen), unit(gen));
     const float4 ms(unit(gen), 0.04f * unit(gen), 0.0f, 0.0f);
@@ -85,20 +85,15 @@ TEST(GBufferPacking, PixelsRoundTripWithinTheirBounds) {
     const uint material = static_cast<uint>(gen() & PG_PACKED_MATERIAL_MAX);
 
     const uint4 surface = pg_pack_gbuffer_surface(position_depth, shading_normal);
-    const uint4 view_material = pg_pack_gbuffer_view_material(position_depth, view_dir, bcr);
-    const uint2 shading = pg_pack_gbuffer_shading(ms, flags, material);
+    const uint4 shading = pg_pack_gbuffer_shading(bcr, ms, flags, material);
 
-    const float4 pd = pg_unpack_gbuffer_position_depth(surface, view_material);
-    ASSERT_EQ(pd, position_depth);
+    ASSERT_EQ(pg_unpack_gbuffer_position(surface), pg_float4_xyz(position_depth));
     ASSERT_EQ(pg_unpack_gbuffer_flags(shading), flags);
     ASSERT_EQ(pg_unpack_gbuffer_material(shading), material);
     const float4 n2 = pg_unpack_gbuffer_shading_normal(surface);
-    const float4 v2 = pg_unpack_gbuffer_view_dir(view_material);
     ASSERT_EQ(n2.w, 0.0f);
-    ASSERT_EQ(v2.w, 0.0f);
     ASSERT_LT(angle_between(pg_float4_xyz(n2), n), PG_OCTAHEDRAL_MAX_ANGLE) << k;
-    ASSERT_LT(angle_between(pg_float4_xyz(v2), v), PG_OCTAHEDRAL_MAX_ANGLE) << k;
-    const float4 bcr2 = pg_unpack_gbuffer_base_color_roughness(view_material);
+    const float4 bcr2 = pg_unpack_gbuffer_base_color_roughness(shading);
     const float4 ms2 = pg_unpack_gbuffer_metallic_specular(shading);
     for (int c = 0; c < 4; ++c) {
       // Relative 2^-11 in the normal range, absolute 2^-25 among the subnormals.
@@ -114,17 +109,19 @@ TEST(GBufferPacking, PixelsRoundTripWithinTheirBounds) {
   }
 }
 
-// The sky's pixels as GBuffer::resize writes them (normal and view +z, everything else 0) come
-// back bit for bit.
+// The sky's pixels as GBuffer::resize writes them (normal +z, everything else 0) come back bit
+// for bit, with depth 0 and no motion whatever the cameras.
 TEST(GBufferPacking, SkyPixelsRoundTripExactly) {
   const float4 zero(0.0f), up(0.0f, 0.0f, 1.0f, 0.0f);
   const uint4 surface = pg_pack_gbuffer_surface(zero, up);
-  const uint4 view_material = pg_pack_gbuffer_view_material(zero, up, zero);
-  const uint2 shading = pg_pack_gbuffer_shading(zero, PG_GBUF_SKY, 0u);
-  EXPECT_EQ(pg_unpack_gbuffer_position_depth(surface, view_material), zero);
+  const uint4 shading = pg_pack_gbuffer_shading(zero, zero, PG_GBUF_SKY, 0u);
+  rtpg::pg_gbuffer_cameras cameras{};
+  cameras.current.position_x = 3.0f;
+  cameras.current.forward_z = -1.0f;
+  cameras.moved = 1;
+  EXPECT_EQ(pg_unpack_gbuffer_position_depth(surface, shading, cameras), zero);
   EXPECT_EQ(pg_unpack_gbuffer_shading_normal(surface), up);
-  EXPECT_EQ(pg_unpack_gbuffer_view_dir(view_material), up);
-  EXPECT_EQ(pg_unpack_gbuffer_base_color_roughness(view_material), zero);
+  EXPECT_EQ(pg_unpack_gbuffer_base_color_roughness(shading), zero);
   EXPECT_EQ(pg_unpack_gbuffer_metallic_specular(shading), zero);
   EXPECT_EQ(pg_unpack_gbuffer_flags(shading), PG_GBUF_SKY);
 }

@@ -1164,77 +1164,124 @@ TEST(GuidingKernels, ReprojectionFollowsAMovingCamera) {
 
 // ---- unpack_gbuffer ------------------------------------------------------------------------
 
+// A pinhole camera at `from` looking at `at` (include/rtpg/guiding_layout.h, "Cameras").
+rtpg::pg_pinhole_camera pinhole(float3 from, float3 at, float tan_half_fov_y, float aspect) {
+  const float3 f = glm::normalize(at - from);
+  const float3 r = glm::normalize(glm::cross(f, float3(0, 1, 0)));
+  const float3 u = glm::cross(r, f);
+  return {from.x, from.y, from.z,         r.x,   r.y, r.z, u.x, u.y, u.z, f.x,
+          f.y,    f.z,    tan_half_fov_y, aspect};
+}
+
 // The device's unpack of a packed G-buffer (kernels/unpack_gbuffer.cl) equals the host's
 // (kernels/shared/gbuffer_packing.h) at odd sizes (the last work-group's padding must write
-// nothing): bit for bit where the unpacking is integer arithmetic and exact float products
-// (positions, depths, halves, flags, material ids, motion), and within 4 units in the last place
-// per component for the unit vectors, whose normalisation uses sqrt and a division (3 and 2.5
-// ulp in OpenCL 1.2). A guided frame then reads these channels as if they had been uploaded.
+// nothing), with the camera moving and still: bit for bit where the unpacking is integer
+// arithmetic and exact float products (positions, halves, flags, material ids, a still camera's
+// zero motion, the sky's depth), within 8 units in the last place per component for the unit
+// vectors (sqrt and a division: 3 and 2.5 ulp in OpenCL 1.2), and within the rounding of their
+// dot products and divisions for the depth and the motion, which a device may compute with fused
+// multiply-adds. A guided frame then reads these channels as if they had been uploaded.
 TEST(GuidingKernels, UnpackGBufferMatchesTheHostUnpack) {
   ClRuntime rt;
   Random r(808);
   const std::vector<std::pair<int, int>> sizes =
       simulated(rt) ? std::vector<std::pair<int, int>>{{13, 9}, {1, 1}, {65, 1}}
                     : std::vector<std::pair<int, int>>{{93, 61}, {1, 1}, {301, 3}, {64, 2}};
-  for (const auto& [w, h] : sizes) {
-    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
-    HostGBuffer g = random_gbuffer(r, w, h);
-    const std::size_t n = g.n();
-    for (std::size_t i = 0; i < n; ++i) {
-      g.motion[i] = float2(r.uniform(-40.0f, 40.0f), r.uniform(-40.0f, 40.0f));
-      g.material[i] = static_cast<std::uint32_t>(r.uniform(0.0f, 1.0f) * PG_PACKED_MATERIAL_MAX);
-      if (i % 7 == 0) g.base_color_roughness[i].x = r.uniform(0.0f, 1e-5f);  // subnormal halves
-    }
-    std::vector<sh::uint4> surface(n), view_material(n);
-    std::vector<sh::uint2> shading(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      surface[i] = sh::pg_pack_gbuffer_surface(g.position_depth[i], g.shading_normal[i]);
-      view_material[i] = sh::pg_pack_gbuffer_view_material(g.position_depth[i], g.view_dir[i],
-                                                           g.base_color_roughness[i]);
-      shading[i] = sh::pg_pack_gbuffer_shading(g.metallic_specular[i], g.flags[i], g.material[i]);
-    }
-    const GuiderPackedGBuffer packed = make_guider_packed_gbuffer(rt.context(), w, h);
-    rt.queue().enqueueWriteBuffer(packed.surface, CL_FALSE, 0, n * 16, surface.data());
-    rt.queue().enqueueWriteBuffer(packed.view_material, CL_FALSE, 0, n * 16, view_material.data());
-    rt.queue().enqueueWriteBuffer(packed.shading, CL_FALSE, 0, n * 8, shading.data());
-    rt.queue().enqueueWriteBuffer(packed.motion, CL_FALSE, 0, n * 8, g.motion.data());
-    const GuiderGBuffer out = make_guider_gbuffer(rt.context(), w, h, 0, KernelAccess::read_write);
-    Guider guider(rt, w, h);
-    guider.unpack_gbuffer(packed, out);
-    EXPECT_GE(guider.last_times().unpack_ms, 0.0);
-    HostGBuffer d(w, h);
+  for (const bool moved : {true, false}) {
+    for (const auto& [w, h] : sizes) {
+      SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + (moved ? " moved" : " still"));
+      HostGBuffer g = random_gbuffer(r, w, h);
+      const std::size_t n = g.n();
+      for (std::size_t i = 0; i < n; ++i) {
+        g.material[i] = static_cast<std::uint32_t>(r.uniform(0.0f, 1.0f) * PG_PACKED_MATERIAL_MAX);
+        if (i % 7 == 0) g.base_color_roughness[i].x = r.uniform(0.0f, 1e-5f);  // subnormal halves
+        if (i % 19 == 3) g.position_depth[i].z = 10.0f;  // behind the cameras: no motion
+      }
+      const float aspect = static_cast<float>(w) / static_cast<float>(h);
+      const rtpg::pg_gbuffer_cameras cameras{
+          pinhole(float3(1.0f, 1.0f, 4.0f), float3(1.0f, 1.0f, 0.0f), 0.6f, aspect),
+          pinhole(float3(1.3f, 0.8f, 4.2f), float3(0.9f, 1.1f, 0.0f), 0.6f, aspect), w, h,
+          moved ? 1 : 0};
+      std::vector<sh::uint4> surface(n), shading(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        surface[i] = sh::pg_pack_gbuffer_surface(g.position_depth[i], g.shading_normal[i]);
+        shading[i] = sh::pg_pack_gbuffer_shading(g.base_color_roughness[i], g.metallic_specular[i],
+                                                 g.flags[i], g.material[i]);
+      }
+      const GuiderPackedGBuffer packed = make_guider_packed_gbuffer(rt.context(), w, h);
+      rt.queue().enqueueWriteBuffer(packed.surface, CL_FALSE, 0, n * 16, surface.data());
+      rt.queue().enqueueWriteBuffer(packed.shading, CL_FALSE, 0, n * 16, shading.data());
+      const GuiderGBuffer out =
+          make_guider_gbuffer(rt.context(), w, h, 0, KernelAccess::read_write);
+      Guider guider(rt, w, h);
+      guider.unpack_gbuffer(packed, out, cameras);
+      EXPECT_GE(guider.last_times().unpack_ms, 0.0);
+      HostGBuffer d(w, h);
 #define RTPG_READ(name, type, bytes) \
   rt.queue().enqueueReadBuffer(out.name, CL_TRUE, 0, n*(bytes), d.name.data());
-    PG_GBUFFER_CHANNELS(RTPG_READ)
+      PG_GBUFFER_CHANNELS(RTPG_READ)
 #undef RTPG_READ
-    const auto same4 = [](float4 a, float4 b) {
-      return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z) &&
-             same_bits(a.w, b.w);
-    };
-    const auto near_unit = [](float4 a, float4 b) {
-      for (int c = 0; c < 4; ++c)
-        if (!(std::fabs(a[c] - b[c]) <= 4.0f * std::numeric_limits<float>::epsilon())) return false;
-      return true;
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-      ASSERT_TRUE(same4(d.position_depth[i],
-                        sh::pg_unpack_gbuffer_position_depth(surface[i], view_material[i])))
-          << i;
-      ASSERT_TRUE(same_bits(d.position_depth[i].w, g.position_depth[i].w)) << i;
-      ASSERT_TRUE(near_unit(d.shading_normal[i], sh::pg_unpack_gbuffer_shading_normal(surface[i])))
-          << i;
-      ASSERT_TRUE(near_unit(d.view_dir[i], sh::pg_unpack_gbuffer_view_dir(view_material[i]))) << i;
-      ASSERT_TRUE(same4(d.base_color_roughness[i],
-                        sh::pg_unpack_gbuffer_base_color_roughness(view_material[i])))
-          << i;
-      ASSERT_TRUE(
-          same4(d.metallic_specular[i], sh::pg_unpack_gbuffer_metallic_specular(shading[i])))
-          << i;
-      ASSERT_EQ(d.flags[i], g.flags[i]) << i;
-      ASSERT_EQ(d.material[i], g.material[i]) << i;
-      ASSERT_TRUE(same_bits(d.motion[i].x, g.motion[i].x) &&
-                  same_bits(d.motion[i].y, g.motion[i].y))
-          << i;
+      const auto same4 = [](float4 a, float4 b) {
+        return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z) &&
+               same_bits(a.w, b.w);
+      };
+      const auto near_unit = [](float4 a, float4 b) {
+        for (int c = 0; c < 4; ++c)
+          if (!(std::fabs(a[c] - b[c]) <= 8.0f * std::numeric_limits<float>::epsilon()))
+            return false;
+        return true;
+      };
+      constexpr float eps = std::numeric_limits<float>::epsilon();
+      std::size_t moving = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const bool sky = (g.flags[i] & PG_GBUF_SKY) != 0u;
+        const float3 p(g.position_depth[i]);
+        const float4 pd = sh::pg_unpack_gbuffer_position_depth(surface[i], shading[i], cameras);
+        ASSERT_TRUE(same_bits(d.position_depth[i].x, p.x) &&
+                    same_bits(d.position_depth[i].y, p.y) && same_bits(d.position_depth[i].z, p.z))
+            << i;
+        // |error| of a dot product of three terms, either way of rounding it.
+        const float3 from_camera = p - sh::pg_camera_position(cameras.current);
+        const float depth_bound =
+            4.0f * eps *
+            glm::dot(glm::abs(from_camera), glm::abs(sh::pg_camera_forward(cameras.current)));
+        if (sky) {
+          ASSERT_EQ(d.position_depth[i].w, 0.0f) << i;
+        } else {
+          ASSERT_NEAR(d.position_depth[i].w, pd.w, depth_bound) << i;
+          ASSERT_TRUE(near_unit(d.view_dir[i], sh::pg_gbuffer_view_dir(cameras.current, p))) << i;
+        }
+        ASSERT_TRUE(
+            near_unit(d.shading_normal[i], sh::pg_unpack_gbuffer_shading_normal(surface[i])))
+            << i;
+        ASSERT_TRUE(same4(d.base_color_roughness[i],
+                          sh::pg_unpack_gbuffer_base_color_roughness(shading[i])))
+            << i;
+        ASSERT_TRUE(
+            same4(d.metallic_specular[i], sh::pg_unpack_gbuffer_metallic_specular(shading[i])))
+            << i;
+        ASSERT_EQ(d.flags[i], g.flags[i]) << i;
+        ASSERT_EQ(d.material[i], g.material[i]) << i;
+        const sh::uint x = static_cast<sh::uint>(i % static_cast<std::size_t>(w)),
+                       y = static_cast<sh::uint>(i / static_cast<std::size_t>(w));
+        const float2 m = sky ? float2(0.0f) : sh::pg_gbuffer_motion(cameras, p, x, y);
+        if (m != float2(0.0f)) ++moving;
+        // The points lie 3-4 units in front of the cameras at most 2 units off their axes: the
+        // projection's rounding is a few ulp of the film coordinate, times the image's size.
+        const float motion_bound = 64.0f * eps * static_cast<float>(std::max(w, h) + 1);
+        ASSERT_NEAR(d.motion[i].x, m.x, motion_bound) << i;
+        ASSERT_NEAR(d.motion[i].y, m.y, motion_bound) << i;
+        if (m == float2(0.0f)) {
+          ASSERT_EQ(d.motion[i], float2(0.0f)) << i;
+        }
+      }
+      // The still camera's motion is zero everywhere; the moving one's nowhere but the sky and
+      // the points behind it.
+      if (!moved) {
+        EXPECT_EQ(moving, 0u);
+      } else if (n > 20) {
+        EXPECT_GT(moving, n / 2);
+      }
     }
   }
 }
@@ -1335,8 +1382,8 @@ TEST(GuiderMisuse, WrongBuffersAreNamedAndLeaveTheGuiderUsable) {
   EXPECT_GT(guider.count_trained(), 0u);
 }
 
-// unpack_gbuffer refuses a G-buffer kernels may not write, and packed channels of another size,
-// naming them.
+// unpack_gbuffer refuses a G-buffer kernels may not write, packed channels of another size and
+// cameras of another image, naming them.
 TEST(GuiderMisuse, UnpackGBufferRefusesReadOnlyAndMissizedBuffers) {
   ClRuntime rt;
   const int w = 9, h = 5;
@@ -1344,18 +1391,25 @@ TEST(GuiderMisuse, UnpackGBufferRefusesReadOnlyAndMissizedBuffers) {
   const GuiderPackedGBuffer packed = make_guider_packed_gbuffer(rt.context(), w, h);
   const GuiderGBuffer writable =
       make_guider_gbuffer(rt.context(), w, h, 0, KernelAccess::read_write);
+  rtpg::pg_gbuffer_cameras cameras{};
+  cameras.width = w;
+  cameras.height = h;
   expect_guider_error(
-      [&] { guider.unpack_gbuffer(packed, make_guider_gbuffer(rt.context(), w, h)); },
+      [&] { guider.unpack_gbuffer(packed, make_guider_gbuffer(rt.context(), w, h), cameras); },
       "KernelAccess::read_write");
   GuiderPackedGBuffer bad = packed;
-  bad.shading = cl::Buffer(rt.context(), CL_MEM_READ_WRITE, (w * h - 1) * 8);
-  expect_guider_error([&] { guider.unpack_gbuffer(bad, writable); }, "packed.shading");
+  bad.shading = cl::Buffer(rt.context(), CL_MEM_READ_WRITE, (w * h - 1) * 16);
+  expect_guider_error([&] { guider.unpack_gbuffer(bad, writable, cameras); }, "packed.shading");
   expect_guider_error(
       [&] {
         guider.unpack_gbuffer(
-            packed, make_guider_gbuffer(rt.context(), w + 1, h, 0, KernelAccess::read_write));
+            packed, make_guider_gbuffer(rt.context(), w + 1, h, 0, KernelAccess::read_write),
+            cameras);
       },
       "unpacked.position_depth");
+  rtpg::pg_gbuffer_cameras other = cameras;
+  other.height = h + 1;
+  expect_guider_error([&] { guider.unpack_gbuffer(packed, writable, other); }, "9x6");
 }
 
 TEST(GuiderMisuse, ConfigurationsTheDeviceCannotRunAreRefused) {

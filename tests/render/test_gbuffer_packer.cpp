@@ -10,8 +10,11 @@
 
 #include "render/gbuffer_packer.h"
 #include "render/guided_first_bounce.h"
+#include "render/renderer.h"
 #include "rtpg/cl_runtime.h"
+#include "scene/scene_loader.h"
 #include "shared/gbuffer_packing.h"
+#include "support/angles.h"
 
 namespace rtpg {
 namespace {
@@ -58,13 +61,9 @@ GBuffer varied_gbuffer(int w, int h, std::uint32_t seed) {
 }
 
 struct Packed {
-  std::vector<shared::uint4> surface, view_material;
-  std::vector<shared::uint2> shading;
-  std::vector<float2> motion;
-  explicit Packed(std::size_t n) : surface(n), view_material(n), shading(n), motion(n) {}
-  PackedGBufferView view() {
-    return {surface.data(), view_material.data(), shading.data(), motion.data()};
-  }
+  std::vector<shared::uint4> surface, shading;
+  explicit Packed(std::size_t n) : surface(n), shading(n) {}
+  PackedGBufferView view() { return {surface.data(), shading.data()}; }
 };
 
 TEST(GBufferPacker, LanesGiveTheSharedFunctionsBits) {
@@ -80,9 +79,7 @@ TEST(GBufferPacker, LanesGiveTheSharedFunctionsBits) {
     EXPECT_TRUE(pack_gbuffer(g, first, last, lanes.view(), CpuCode::avx2));
     for (std::size_t i = 0; i < n; ++i) {
       ASSERT_EQ(lanes.surface[i], base.surface[i]) << i;
-      ASSERT_EQ(lanes.view_material[i], base.view_material[i]) << i;
       ASSERT_EQ(lanes.shading[i], base.shading[i]) << i;
-      ASSERT_EQ(lanes.motion[i], base.motion[i]) << i;
     }
     // And they are the shared functions' words, outside the range untouched.
     for (std::size_t i = 0; i < n; ++i) {
@@ -91,6 +88,11 @@ TEST(GBufferPacker, LanesGiveTheSharedFunctionsBits) {
           inside ? shared::pg_pack_gbuffer_surface(g.position_depth[i], g.shading_normal[i])
                  : shared::uint4(0u);
       ASSERT_EQ(base.surface[i], s) << i;
+      const shared::uint4 m =
+          inside ? shared::pg_pack_gbuffer_shading(
+                       g.base_color_roughness[i], g.metallic_specular[i], g.flags[i], g.material[i])
+                 : shared::uint4(0u);
+      ASSERT_EQ(base.shading[i], m) << i;
     }
   }
 }
@@ -108,6 +110,47 @@ TEST(GBufferPacker, MaterialIdsAndFlagsThatDoNotFitAreReported) {
       g.material[bad] = 0u;
       g.flags[bad] = 0x100u;
       EXPECT_FALSE(pack_gbuffer(g, 0, g.pixel_count(), p.view(), code)) << bad;
+    }
+  }
+}
+
+// What the device derives instead of receiving (pg_gbuffer_depth, pg_gbuffer_motion,
+// pg_gbuffer_view_dir from gbuffer_cameras) is the renderer's own G-buffer: depth and motion to
+// the bit (the same formulas in the same order on the host), the view direction (the renderer's
+// camera ray, the packing's line from the camera) within 1e-5 rad, along a camera path at an odd
+// size and with the camera held still.
+TEST(GBufferPacker, DerivedChannelsAreTheRenderersOwn) {
+  const Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
+  for (const int held : {-1, 3}) {
+    RenderSettings settings;
+    settings.width = 37;
+    settings.height = 23;
+    settings.camera_path = "pan";
+    settings.camera_frame = held;
+    Renderer renderer(scene, settings);
+    for (int f = 0; f < 3; ++f) {
+      SCOPED_TRACE("frame " + std::to_string(f) + (held >= 0 ? ", camera held" : ""));
+      renderer.render_frame(f);
+      const GBuffer& g = renderer.gbuffer();
+      const pg_gbuffer_cameras cameras = gbuffer_cameras(g);
+      EXPECT_EQ(cameras.width, 37);
+      EXPECT_EQ(cameras.height, 23);
+      EXPECT_EQ(cameras.moved, f > 0 && held < 0 ? 1 : 0);
+      std::size_t moving = 0, surfaces = 0;
+      for (std::size_t i = 0; i < g.pixel_count(); ++i) {
+        if (!g.has_surface(i)) continue;
+        ++surfaces;
+        const float3 p(g.position_depth[i]);
+        ASSERT_EQ(shared::pg_gbuffer_depth(cameras.current, p), g.position_depth[i].w) << i;
+        const float2 m = shared::pg_gbuffer_motion(cameras, p, static_cast<shared::uint>(i % 37),
+                                                   static_cast<shared::uint>(i / 37));
+        ASSERT_EQ(m, g.motion[i]) << i;
+        if (m != float2(0.0f)) ++moving;
+        const float3 v(shared::pg_gbuffer_view_dir(cameras.current, p));
+        ASSERT_LT(testing::angle_between(v, float3(g.view_dir[i])), 1e-5f) << i;
+      }
+      EXPECT_GT(surfaces, g.pixel_count() / 2);
+      EXPECT_EQ(moving > surfaces / 2, cameras.moved == 1) << moving << " of " << surfaces;
     }
   }
 }

@@ -421,11 +421,11 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
       EXPECT_EQ(stats.extra.at("zero_copy"), in_place ? 1.0 : 0.0);
       EXPECT_EQ(stats.extra.at("host_transfer"), static_cast<double>(used));
       // In place only the kernels' count records are copied; otherwise the G-buffer (96 bytes
-      // a pixel, 48 packed) and VPLs (32, packed) go up and each sample's direction, density and
+      // a pixel, 32 packed) and VPLs (32, packed) go up and each sample's direction, density and
       // strategy (20) come down, with the mixture (24) where the host reads it
       // (include/rtpg/guiding_layout.h).
       const double sample_bytes = cases[t].mixture ? 44.0 : 20.0;
-      const double gbuffer_bytes = used == HostTransfer::packed ? 48.0 : 96.0;
+      const double gbuffer_bytes = used == HostTransfer::packed ? 32.0 : 96.0;
       EXPECT_DOUBLE_EQ(
           stats.extra.at("host_device_bytes_per_pixel"),
           (in_place ? 0.0 : gbuffer_bytes + sample_bytes * settings.spp + 32.0) + count_records);
