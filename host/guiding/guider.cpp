@@ -11,7 +11,7 @@ namespace {
 
 static_assert(sizeof(pg_kernel_settings) == 24 * 4,
               "pg_kernel_settings: 24 plain 4-byte fields, no padding");
-static_assert(sizeof(pg_gbuffer_cameras) == 31 * 4,
+static_assert(sizeof(pg_gbuffer_cameras) == 34 * 4,
               "pg_gbuffer_cameras must hold only 4-byte fields (include/rtpg/guiding_layout.h)");
 static_assert(sizeof(shared::pg_pmm_state) == 4 * PG_STATE_FLOATS_PER_PIXEL,
               "the state's floats per pixel");
@@ -46,6 +46,15 @@ GuiderPackedGBuffer make_guider_packed_gbuffer(cl::Context& context, int width, 
   return b;
 }
 
+GuiderPackedSamples make_guider_packed_samples(cl::Context& context, int width, int height,
+                                               cl_mem_flags host_flags) {
+  const std::size_t n = pixels(width, height);
+  const cl_mem_flags flags = CL_MEM_WRITE_ONLY | host_flags;
+  GuiderPackedSamples b;
+  translate_cl_errors([&] { PG_PACKED_SAMPLE_CHANNELS(RTPG_ALLOCATE) });
+  return b;
+}
+
 GuiderVpls make_guider_vpls(cl::Context& context, int width, int height, cl_mem_flags host_flags) {
   const std::size_t n = pixels(width, height);
   const cl_mem_flags flags = CL_MEM_READ_ONLY | host_flags;
@@ -55,9 +64,10 @@ GuiderVpls make_guider_vpls(cl::Context& context, int width, int height, cl_mem_
 }
 
 GuiderSamples make_guider_samples(cl::Context& context, int width, int height,
-                                  cl_mem_flags host_flags) {
+                                  cl_mem_flags host_flags, KernelAccess access) {
   const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags = CL_MEM_WRITE_ONLY | host_flags;
+  const cl_mem_flags flags =
+      (access == KernelAccess::read_write ? CL_MEM_READ_WRITE : CL_MEM_WRITE_ONLY) | host_flags;
   GuiderSamples b;
   translate_cl_errors([&] { PG_SAMPLE_CHANNELS(RTPG_ALLOCATE) });
   return b;
@@ -263,6 +273,34 @@ void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuff
         64, unpack_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
     run(unpack_, cl::NDRange((n + group - 1) / group * group), cl::NDRange(group), wait,
         &times_.unpack_ms);
+  });
+}
+
+void Guider::pack_samples(const GuiderSamples& samples, const GuiderPackedSamples& out, Wait wait) {
+#define RTPG_CHECK(name, type, bytes) check_buffer(samples.name, bytes, "samples." #name);
+  PG_SAMPLE_CHANNELS(RTPG_CHECK)
+#undef RTPG_CHECK
+#define RTPG_CHECK(name, type, bytes) check_buffer(out.name, bytes, "packed." #name);
+  PG_PACKED_SAMPLE_CHANNELS(RTPG_CHECK)
+#undef RTPG_CHECK
+  translate_cl_errors([&] {
+    if (samples.direction_pdf.getInfo<CL_MEM_FLAGS>() & CL_MEM_WRITE_ONLY)
+      throw GuiderError(
+          "pack_samples: the samples are write-only for kernels (make them with "
+          "KernelAccess::read_write)");
+    if (pack_samples_() == nullptr)
+      pack_samples_ = runtime_.kernel("pack_samples.cl", "pack_samples");
+    const std::size_t n = static_cast<std::size_t>(width_) * height_;
+    KernelArgs args(pack_samples_);
+    args << samples;
+#define RTPG_ARG(name, type, bytes) args << out.name;
+    PG_PACKED_SAMPLE_CHANNELS(RTPG_ARG)
+#undef RTPG_ARG
+    args << static_cast<cl_uint>(n);
+    const std::size_t group = std::min<std::size_t>(
+        64, pack_samples_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
+    run(pack_samples_, cl::NDRange((n + group - 1) / group * group), cl::NDRange(group), wait,
+        &times_.pack_samples_ms);
   });
 }
 

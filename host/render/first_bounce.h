@@ -36,10 +36,15 @@ struct FirstBounceSample {
 // or end_frame()): pixel i's direction (world space, unit) and the whole sampler's solid-angle
 // density in direction_pdf[i] (a density not above 0, or not finite: no sample), and its
 // FirstBounceStrategy in strategy[i]. The guided sampler hands out the sample kernel's output
-// as it lies (include/rtpg/guiding_layout.h: PG_STRATEGY_* equal FirstBounceStrategy).
+// as it lies (include/rtpg/guiding_layout.h: PG_STRATEGY_* equal FirstBounceStrategy), or, where
+// they crossed the bus packed (HostTransfer::packed), the packed channels instead
+// (PG_PACKED_SAMPLE_CHANNELS; direction_pdf and strategy null). at() reads either.
 struct FirstBounceSamples {
   const glm::vec4* direction_pdf = nullptr;
   const std::uint32_t* strategy = nullptr;
+  const glm::vec2* packed_direction = nullptr;
+  const float* packed_pdf_strategy = nullptr;
+  FirstBounceSample at(std::size_t i) const;
 };
 
 struct SampleCoordinates {

@@ -38,8 +38,9 @@ pg_pinhole_camera pinhole(const CameraFrame& c) {
 }  // namespace
 
 pg_gbuffer_cameras gbuffer_cameras(const GBuffer& g) {
-  return pg_gbuffer_cameras{pinhole(g.camera), pinhole(g.previous_camera), g.width, g.height,
-                            g.camera_moved ? 1 : 0};
+  return pg_gbuffer_cameras{
+      pinhole(g.camera),      pinhole(g.previous_camera), g.width,       g.height,
+      g.camera_moved ? 1 : 0, g.jitter.enabled ? 1 : 0,   g.jitter.seed, g.jitter.frame};
 }
 
 }  // namespace rtpg

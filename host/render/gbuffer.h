@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "render/camera_rays.h"
 #include "rtpg/guiding_layout.h"
 #include "scene/camera.h"
 #include "shared/bsdf.h"
@@ -29,6 +30,7 @@ struct GBuffer {
   // (where it did not, every motion vector is zero whatever the jitter).
   CameraFrame previous_camera;
   bool camera_moved = false;
+  CameraJitter jitter;  // the primary rays' sub-pixel jitter (render/camera_rays.h)
 
   void resize(int w, int h);  // every pixel sky
   std::size_t pixel_count() const {
@@ -43,8 +45,9 @@ struct GBuffer {
 // distribution of that pixel lives in).
 shared::pg_material gbuffer_material(const GBuffer& g, std::size_t i);
 shared::pg_frame gbuffer_frame(const GBuffer& g, std::size_t i);
-// The G-buffer's two cameras and size as the kernels take them (include/rtpg/guiding_layout.h,
-// "Cameras"): what a packed G-buffer's depths, view directions and motion follow from.
+// The G-buffer's two cameras, size and jitter as the kernels take them (include/rtpg/
+// guiding_layout.h, "Cameras"): what a packed G-buffer's positions, view directions and motion
+// follow from.
 pg_gbuffer_cameras gbuffer_cameras(const GBuffer& g);
 
 }  // namespace rtpg

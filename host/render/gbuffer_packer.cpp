@@ -19,9 +19,10 @@ bool pack_baseline(const GBuffer& g, std::size_t first, std::size_t last,
                    const PackedGBufferView& out) {
   bool all_fit = true;
   for (std::size_t i = first; i < last; ++i) {
-    out.surface[i] = shared::pg_pack_gbuffer_surface(g.position_depth[i], g.shading_normal[i]);
-    out.shading[i] = shared::pg_pack_gbuffer_shading(
-        g.base_color_roughness[i], g.metallic_specular[i], g.flags[i], g.material[i]);
+    out.surface[i] = shared::pg_pack_gbuffer_surface(g.position_depth[i], g.shading_normal[i],
+                                                     g.base_color_roughness[i]);
+    out.shading[i] =
+        shared::pg_pack_gbuffer_shading(g.metallic_specular[i], g.flags[i], g.material[i]);
     all_fit &= fits(g, i);
   }
   return all_fit;
@@ -92,13 +93,11 @@ RTPG_LANES_VARIANT bool pack_lanes(const GBuffer& g, std::size_t first, std::siz
     _mm256_store_si256(reinterpret_cast<__m256i*>(normal), pack_unit_vector8(x, y, z));
     for (int k = 0; k < 8; ++k) {
       const std::size_t p = i + static_cast<std::size_t>(kLaneOrder[k]);
-      const shared::float4& pd = g.position_depth[p];
-      out.surface[p] = shared::uint4(shared::as_uint(pd.x), shared::as_uint(pd.y),
-                                     shared::as_uint(pd.z), normal[k]);
       const __m128i colour = halves4(g.base_color_roughness[p]);
-      out.shading[p] = shared::uint4(
-          static_cast<std::uint32_t>(_mm_extract_epi32(colour, 0)),
-          static_cast<std::uint32_t>(_mm_extract_epi32(colour, 1)),
+      out.surface[p] = shared::uint4(shared::as_uint(g.position_depth[p].w), normal[k],
+                                     static_cast<std::uint32_t>(_mm_extract_epi32(colour, 0)),
+                                     static_cast<std::uint32_t>(_mm_extract_epi32(colour, 1)));
+      out.shading[p] = shared::uint2(
           static_cast<std::uint32_t>(_mm_cvtsi128_si32(halves4(g.metallic_specular[p]))),
           (g.flags[p] & 0xffu) | (g.material[p] << 8));
       all_fit &= fits(g, p);

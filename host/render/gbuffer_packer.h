@@ -17,7 +17,7 @@ namespace rtpg {
 // Where the packed channels go (PG_PACKED_GBUFFER_CHANNELS), pixel i at index i.
 struct PackedGBufferView {
   shared::uint4* surface = nullptr;
-  shared::uint4* shading = nullptr;
+  shared::uint2* shading = nullptr;
 };
 
 // Whether this CPU runs the lane variant (AVX2 and F16C).

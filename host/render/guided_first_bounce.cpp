@@ -26,6 +26,7 @@ double ms_since(Clock::time_point start) {
 constexpr std::size_t kGBufferBytes = 0 PG_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kVplBytes = 0 PG_VPL_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kPackedGBufferBytes = 0 PG_PACKED_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
+constexpr std::size_t kPackedSampleBytes = 0 PG_PACKED_SAMPLE_CHANNELS(RTPG_ADD_BYTES);
 #undef RTPG_ADD_BYTES
 #define RTPG_COUNT(name, type, bytes) +1
 constexpr std::size_t kGBufferChannels = 0 PG_GBUFFER_CHANNELS(RTPG_COUNT);
@@ -54,7 +55,7 @@ void stage_packed_gbuffer(PinnedStaging& staging, const GBuffer& g,
   auto* surface =
       static_cast<shared::uint4*>(staging.reserve(n * 16, device.surface, "packed surface"));
   auto* shading =
-      static_cast<shared::uint4*>(staging.reserve(n * 16, device.shading, "packed shading"));
+      static_cast<shared::uint2*>(staging.reserve(n * 8, device.shading, "packed shading"));
   const PackedGBufferView view{surface, shading};
   std::atomic<bool> unpackable{false};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 13),
@@ -66,7 +67,7 @@ void stage_packed_gbuffer(PinnedStaging& staging, const GBuffer& g,
         "packed G-buffer: a material id above " + std::to_string(PG_PACKED_MATERIAL_MAX) +
         " or flags above 255 do not fit in the packed shading word (use --host-transfer pinned)");
   staging.commit(surface, n * 16, device.surface);
-  staging.commit(shading, n * 16, device.shading);
+  staging.commit(shading, n * 8, device.shading);
 }
 
 }  // namespace
@@ -122,9 +123,15 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
     owned_vpls_ = make_guider_vpls(runtime.context(), width, height);
   }
   samples_ =
-      make_guider_samples(runtime.context(), width, height, zero_copy_ ? CL_MEM_ALLOC_HOST_PTR : 0);
+      make_guider_samples(runtime.context(), width, height, zero_copy_ ? CL_MEM_ALLOC_HOST_PTR : 0,
+                          packed_ ? KernelAccess::read_write : KernelAccess::read_only);
   if (!zero_copy_) {
     staging_ = make_guider_samples(runtime.context(), width, height, CL_MEM_ALLOC_HOST_PTR);
+    if (packed_) {
+      packed_samples_ = make_guider_packed_samples(runtime.context(), width, height);
+      packed_staging_ =
+          make_guider_packed_samples(runtime.context(), width, height, CL_MEM_ALLOC_HOST_PTR);
+    }
     translate_cl_errors([&] {
       cl::CommandQueue& q = runtime_.queue();
 #define RTPG_MAP_STAGING(name, type, bytes)                                              \
@@ -133,6 +140,15 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
       staging_.name, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, pixels_ * (bytes)));
       PG_SAMPLE_CHANNELS(RTPG_MAP_STAGING)
 #undef RTPG_MAP_STAGING
+      if (packed_) {
+#define RTPG_MAP_STAGING(name, type, bytes)                                  \
+  staged_packed_.name.count = pixels_;                                       \
+  staged_packed_.name.pointer =                                              \
+      static_cast<decltype(staged_packed_.name.pointer)>(q.enqueueMapBuffer( \
+          packed_staging_.name, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, pixels_ * (bytes)));
+        PG_PACKED_SAMPLE_CHANNELS(RTPG_MAP_STAGING)
+#undef RTPG_MAP_STAGING
+      }
     });
   }
 }
@@ -146,6 +162,12 @@ GuidedFirstBounce::~GuidedFirstBounce() {
   q.enqueueUnmapMemObject(staging_.name, staged_.name.pointer);
       PG_SAMPLE_CHANNELS(RTPG_UNMAP_STAGING)
 #undef RTPG_UNMAP_STAGING
+      if (packed_) {
+#define RTPG_UNMAP_STAGING(name, type, bytes) \
+  q.enqueueUnmapMemObject(packed_staging_.name, staged_packed_.name.pointer);
+        PG_PACKED_SAMPLE_CHANNELS(RTPG_UNMAP_STAGING)
+#undef RTPG_UNMAP_STAGING
+      }
     }
     runtime_.queue().finish();
   } catch (...) {  // a failing queue at teardown has nothing left to corrupt
@@ -250,7 +272,8 @@ FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoord
   readback_ms_ += ms_since(t);
   // The path tracer reads the directions as the kernel wrote them (no copy); the statistics
   // of this frame's models wait for end_frame (count_models).
-  return FirstBounceSamples{view_.direction_pdf, view_.strategy};
+  return FirstBounceSamples{view_.direction_pdf, view_.strategy, view_.packed_direction,
+                            view_.packed_pdf_strategy};
 }
 
 SampleOutputs GuidedFirstBounce::sample_outputs() const {
@@ -275,7 +298,8 @@ FirstBounceSamples GuidedFirstBounce::finish_sample() {
   guider_->wait_for_kernels();
   readback_ms_ += ms_since(t);
   sample_ms_ += guider_->last_times().sample_ms;
-  return FirstBounceSamples{view_.direction_pdf, view_.strategy};
+  return FirstBounceSamples{view_.direction_pdf, view_.strategy, view_.packed_direction,
+                            view_.packed_pdf_strategy};
 }
 
 void GuidedFirstBounce::enqueue_sample_transfer(SampleOutputs outputs) {
@@ -296,14 +320,35 @@ void GuidedFirstBounce::enqueue_sample_transfer(SampleOutputs outputs) {
     });
     return;
   }
-  enqueue_download(runtime_.queue(), samples_, staged_, outputs);
-  bytes_ += sample_bytes_per_pixel(outputs) * n;
   if (host_reads_mixture_) {
     view_.mixture_a = staged_.mixture_a.data();
     view_.mixture_b = staged_.mixture_b.data();
   }
-  view_.direction_pdf = staged_.direction_pdf.data();
-  view_.strategy = staged_.strategy.data();
+  if (!packed_) {
+    enqueue_download(runtime_.queue(), samples_, staged_, outputs);
+    bytes_ += sample_bytes_per_pixel(outputs) * n;
+    view_.direction_pdf = staged_.direction_pdf.data();
+    view_.strategy = staged_.strategy.data();
+    return;
+  }
+  // Packed: 12 bytes a pixel instead of direction_pdf's and strategy's 20, and the mixture
+  // where the host reads it.
+  guider_->pack_samples(samples_, packed_samples_,
+                        sample_overlap_ ? Guider::Wait::later : Guider::Wait::finish);
+  enqueue_download(runtime_.queue(), packed_samples_, staged_packed_);
+  bytes_ += kPackedSampleBytes * n;
+  if (host_reads_mixture_) {
+    translate_cl_errors([&] {
+      cl::CommandQueue& q = runtime_.queue();
+      q.enqueueReadBuffer(samples_.mixture_a, CL_FALSE, 0, n * 16, staged_.mixture_a.data());
+      q.enqueueReadBuffer(samples_.mixture_b, CL_FALSE, 0, n * 8, staged_.mixture_b.data());
+    });
+    bytes_ += (sample_bytes_per_pixel(SampleOutputs::directions_and_mixture) -
+               sample_bytes_per_pixel(SampleOutputs::directions)) *
+              n;
+  }
+  view_.packed_direction = staged_packed_.direction.data();
+  view_.packed_pdf_strategy = staged_packed_.pdf_strategy.data();
 }
 
 void GuidedFirstBounce::count_models() {
@@ -382,7 +427,10 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   time_ms["train"] = k.train_ms;
   time_ms["upload"] = upload_ms_;
   if (overlap_) time_ms["train_wait"] = train_wait_ms_;
-  if (packed_) time_ms["unpack"] = k.unpack_ms;
+  if (packed_) {
+    time_ms["unpack"] = k.unpack_ms;
+    time_ms["pack_samples"] = k.pack_samples_ms;
+  }
   time_ms["readback"] = readback_ms_;
   extra["guided_fraction"] = guided_fraction_;
   extra["trained_fraction"] = trained_fraction_;

@@ -134,9 +134,19 @@ class GuidedFirstBounce final : public FirstBounceSampler {
     HostChannelView<glm::vec4> mixture_a;  // what pdf() evaluates
     HostChannelView<glm::vec2> mixture_b;
   } staged_;
+  // HostTransfer::packed: the sample kernel's directions, densities and strategies come back
+  // packed (Guider::pack_samples into packed_samples_, copied into packed_staging_, mapped at
+  // staged_packed_); the mixture, where the host reads it, through staging_ as before.
+  GuiderPackedSamples packed_samples_, packed_staging_;
+  struct HostPackedSamples {  // PG_PACKED_SAMPLE_CHANNELS in packed_staging_
+    HostChannelView<glm::vec2> direction;
+    HostChannelView<float> pdf_strategy;
+  } staged_packed_;
   struct SampleView {  // this frame's samples, in staging_ or mapped
     const glm::vec4* direction_pdf = nullptr;
     const std::uint32_t* strategy = nullptr;
+    const glm::vec2* packed_direction = nullptr;
+    const float* packed_pdf_strategy = nullptr;
     const glm::vec4* mixture_a = nullptr;
     const glm::vec2* mixture_b = nullptr;
   } view_;

@@ -308,10 +308,7 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
 
             FirstBounceSample fs;
             if (first) {
-              const glm::vec4 d = first->direction_pdf[i];
-              fs.direction = glm::vec3(d);
-              fs.pdf = std::isfinite(d.w) ? d.w : 0.0f;
-              fs.strategy = first->strategy[i];
+              fs = first->at(i);
             } else {
               fs = bsdf_first_bounce_sample(frame, wo, lobes, first_starts[i - chunk]);
             }

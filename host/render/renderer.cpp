@@ -97,10 +97,8 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
   camera_hits_.resize(n);
 
   auto start = Clock::now();
-  make_camera_rays(
-      camera, w, h,
-      CameraJitter{settings_.jitter, settings_.seed, static_cast<std::uint32_t>(frame)},
-      camera_rays_.data());
+  g.jitter = CameraJitter{settings_.jitter, settings_.seed, static_cast<std::uint32_t>(frame)};
+  make_camera_rays(camera, w, h, g.jitter, camera_rays_.data());
   tracer_->intersect_image(camera_rays_.data(), camera_hits_.data(), w, h);
   stats.time_ms["primary"] += ms_since(start);
   stats.primary_rays += n;

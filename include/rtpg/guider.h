@@ -51,6 +51,10 @@ struct GuiderSamples {  // what sample() writes (PG_SAMPLE_CHANNELS)
 struct GuiderPackedGBuffer {
   PG_PACKED_GBUFFER_CHANNELS(RTPG_DEVICE_CHANNEL)
 };
+// Samples as they cross the bus back (PG_PACKED_SAMPLE_CHANNELS): what pack_samples() writes.
+struct GuiderPackedSamples {
+  PG_PACKED_SAMPLE_CHANNELS(RTPG_DEVICE_CHANNEL)
+};
 #undef RTPG_DEVICE_CHANNEL
 
 // What sample() writes besides the directions, their densities and strategies: the mixture each
@@ -76,7 +80,9 @@ constexpr std::size_t sample_bytes_per_pixel(SampleOutputs outputs) {
 // memory (DeviceInfo::host_unified_memory), the host can map the samples and read them in place
 // instead of copying them; elsewhere such buffers, mapped, are pinned staging that a discrete
 // GPU copies from and into several times faster (host/render/guided_first_bounce.cpp does both).
-// A G-buffer that Guider::unpack_gbuffer() writes must be made with KernelAccess::read_write.
+// A G-buffer that Guider::unpack_gbuffer() writes, and samples that Guider::pack_samples()
+// reads, must be made with KernelAccess::read_write (otherwise the kernels only read a G-buffer
+// and only write samples).
 enum class KernelAccess { read_only, read_write };
 GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height,
                                   cl_mem_flags host_flags = 0,
@@ -86,7 +92,10 @@ GuiderPackedGBuffer make_guider_packed_gbuffer(cl::Context& context, int width, 
 GuiderVpls make_guider_vpls(cl::Context& context, int width, int height,
                             cl_mem_flags host_flags = 0);
 GuiderSamples make_guider_samples(cl::Context& context, int width, int height,
-                                  cl_mem_flags host_flags = 0);
+                                  cl_mem_flags host_flags = 0,
+                                  KernelAccess access = KernelAccess::read_only);
+GuiderPackedSamples make_guider_packed_samples(cl::Context& context, int width, int height,
+                                               cl_mem_flags host_flags = 0);
 
 namespace detail {
 template <std::size_t Bytes, class Channel>
@@ -161,6 +170,14 @@ void enqueue_download(cl::CommandQueue& queue, const GuiderSamples& dev, HostSam
 #undef RTPG_DOWNLOAD
 }
 
+template <class HostPackedSamples>
+void enqueue_download(cl::CommandQueue& queue, const GuiderPackedSamples& dev,
+                      HostPackedSamples& host) {
+#define RTPG_DOWNLOAD(name, type, bytes) detail::enqueue_read<bytes>(queue, dev.name, host.name);
+  PG_PACKED_SAMPLE_CHANNELS(RTPG_DOWNLOAD)
+#undef RTPG_DOWNLOAD
+}
+
 // Device buffers that read a host struct's channels in place (CL_MEM_USE_HOST_PTR) instead of
 // a copy: for devices that share host memory (DeviceInfo::host_unified_memory), where nothing
 // is copied; elsewhere the OpenCL implementation may copy at creation, which is correct but
@@ -197,6 +214,7 @@ struct GuiderSampleCounts {
 struct GuiderTimes {
   double reproject_ms = 0.0, sample_ms = 0.0, train_ms = 0.0;  // from profiling events
   double unpack_ms = 0.0;                                      // the last unpack_gbuffer()
+  double pack_samples_ms = 0.0;                                // the last pack_samples()
 };
 
 class Guider {
@@ -240,6 +258,11 @@ class Guider {
   // third of the layout's bytes. out must be made with KernelAccess::read_write.
   void unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out,
                       const pg_gbuffer_cameras& cameras, Wait wait = Wait::finish);
+  // Writes out from samples' directions, densities and strategies (PG_PACKED_SAMPLE_CHANNELS;
+  // kernels/shared/sample_packing.h unpacks): for a device with memory of its own, where the
+  // host then copies 12 bytes a pixel instead of 20.
+  void pack_samples(const GuiderSamples& samples, const GuiderPackedSamples& out,
+                    Wait wait = Wait::finish);
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
   void reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous,
                  Wait wait = Wait::finish);
@@ -313,8 +336,9 @@ class Guider {
   cl::Buffer sample_counts_, train_counts_;
   int current_ = 0;  // index of the buffers holding this frame's state
   cl::Kernel reproject_, sample_, train_;
-  cl::Kernel unpack_;     // built at the first unpack_gbuffer()
-  cl::Event train_done_;  // the last train() enqueued with Wait::later
+  cl::Kernel unpack_;        // built at the first unpack_gbuffer()
+  cl::Kernel pack_samples_;  // built at the first pack_samples()
+  cl::Event train_done_;     // the last train() enqueued with Wait::later
   bool train_pending_ = false;
   // The other kernels enqueued with Wait::later, and where each one's time goes (in times_).
   std::vector<std::pair<cl::Event, double*>> pending_;

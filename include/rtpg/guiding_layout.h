@@ -31,19 +31,19 @@
   X(motion, float2, 8)
 
 /* ---- Packed G-buffer: the G-buffer as it crosses the bus -----------------------------------
- * Where the device has memory of its own, the host packs each pixel into these 32 bytes
+ * Where the device has memory of its own, the host packs each pixel into these 24 bytes
  * (kernels/shared/gbuffer_packing.h, which packs and unpacks them) and the device's
  * unpack_gbuffer kernel writes PG_GBUFFER_CHANNELS from them and the frame's cameras
- * (pg_gbuffer_cameras below; rtpg::Guider::unpack_gbuffer): the depth, the view direction and
- * the motion vector are functions of the position and the two pinhole cameras, so they do not
- * travel.
- * surface  xyz the position's float bits, w the shading normal (octahedral)
- * shading  x base colour r and g as half floats, y base colour b and roughness as half floats,
- *          z metallic and specular as half floats (low half first), w the flags (low 8 bits)
- *          and the material id (the high 24) */
+ * (pg_gbuffer_cameras below; rtpg::Guider::unpack_gbuffer): the position is the depth along
+ * the pixel's camera ray, the view direction that ray's reverse, the motion vector where the
+ * position was in last frame's camera, so none of them travels.
+ * surface  x the depth's float bits, y the shading normal (octahedral), z base colour r and g
+ *          as half floats, w base colour b and roughness as half floats (low half first)
+ * shading  x metallic and specular as half floats, y the flags (low 8 bits) and the material
+ *          id (the high 24) */
 #define PG_PACKED_GBUFFER_CHANNELS(X) \
   X(surface, uint4, 16)               \
-  X(shading, uint4, 16)
+  X(shading, uint2, 8)
 
 /* Pixels guiding skips (paper, section 5: sky, emitters, transmission, roughness near 0). */
 #define PG_GBUF_SKY 1u          /* camera ray escaped: no surface */
@@ -90,6 +90,16 @@
   X(mixture_a, float4, 16)     \
   X(mixture_b, float2, 8)
 
+/* ---- Packed samples: the samples as they cross the bus back -----------------------------
+ * Where the device has memory of its own, the pack_samples kernel writes each pixel's sample in
+ * these 12 bytes (kernels/shared/sample_packing.h packs and unpacks them) and the host reads
+ * them instead of direction_pdf and strategy (rtpg::Guider::pack_samples).
+ * direction     the unit direction's point on the octahedron, folded into the square (two floats)
+ * pdf_strategy  direction_pdf.w with the strategy in its sign bit (set: PG_STRATEGY_GUIDE) */
+#define PG_PACKED_SAMPLE_CHANNELS(X) \
+  X(direction, float2, 8)            \
+  X(pdf_strategy, float, 4)
+
 /* ---- Counts: what the host's statistics need, one record per work-group ---------------
  * The sample and train kernels each sum, over their work-group, one float4 of counts into the
  * group's record (group g = get_group_id(1) * get_num_groups(0) + get_group_id(0)), so the host
@@ -125,12 +135,15 @@
 /* At most this many neighbour VPLs train a pixel per frame (the train kernel's array). */
 #define PG_MAX_TRAIN_SAMPLES 32
 
-/* ---- Cameras: what unpack_gbuffer derives a packed G-buffer's depth, view direction and
+/* ---- Cameras: what unpack_gbuffer derives a packed G-buffer's position, view direction and
  * motion from (kernels/shared/gbuffer_packing.h), passed by value like the settings below.
  * A pinhole camera: its position, its orthonormal right, up and forward (the view direction),
  * tan(fov_y / 2) and the image's aspect (width / height); film point (sx, sy) in [0, 1]^2 (top
- * left (0, 0)) looks along forward + (2 sx - 1) tan_half_fov_y aspect right
- * + (1 - 2 sy) tan_half_fov_y up (host: rtpg::CameraFrame). */
+ * left (0, 0)) looks along normalize(forward + (2 sx - 1) tan_half_fov_y aspect right
+ * + (1 - 2 sy) tan_half_fov_y up) (host: rtpg::CameraFrame). Pixel (x, y)'s ray passes through
+ * film point ((x + jx) / width, (y + jy) / height), with (jx, jy) the first two numbers of its
+ * stream (jitter_seed, pixel y * width + x, jitter_frame, sample 0, PG_RNG_STREAM_CAMERA), or
+ * (0.5, 0.5) without jitter: the renderer's camera rays (host/render/camera_rays.h). */
 #ifdef __cplusplus
 namespace rtpg {
 #endif
@@ -147,8 +160,10 @@ typedef struct pg_pinhole_camera {
 typedef struct pg_gbuffer_cameras {
   pg_pinhole_camera current;  /* the frame's: depth = dot(p - position, forward), view direction */
   pg_pinhole_camera previous; /* last frame's: where each point was (the motion vector) */
-  int width, height;          /* the image, for the motion vector in pixels */
-  int moved; /* 0: the motion is zero (a static camera; whatever the sub-pixel jitter) */
+  int width, height;          /* the image */
+  int moved;                  /* 0: the motion is zero (a static camera, whatever the jitter) */
+  int jitter;                 /* 0: every ray through its pixel's centre */
+  unsigned int jitter_seed, jitter_frame; /* the rays' jitter streams */
 } pg_gbuffer_cameras;
 
 #ifdef __cplusplus

@@ -19,6 +19,8 @@
 #define PG_ARG_OUT(name, type, bytes) __global type *name,
 
 #define PG_ARG_IN_PACKED(name, type, bytes) __global const type *packed_##name,
+#define PG_ARG_OUT_PACKED(name, type, bytes) __global type *packed_##name,
+#define PG_ARG_IN_SAMPLE(name, type, bytes) __global const type *sample_##name,
 
 #define PG_ARGS_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_IN)      /* this frame's G-buffer */
 #define PG_ARGS_OUT_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_OUT) /* written by unpack_gbuffer */
@@ -30,6 +32,8 @@
 /* The state updated in place (train: each work-item reads and writes only its own pixels). */
 #define PG_ARGS_STATE PG_STATE_CHANNELS(PG_ARG_STATE)
 #define PG_ARGS_SAMPLES PG_SAMPLE_CHANNELS(PG_ARG_OUT)
+#define PG_ARGS_IN_SAMPLES PG_SAMPLE_CHANNELS(PG_ARG_IN_SAMPLE) /* read by pack_samples */
+#define PG_ARGS_PACKED_SAMPLES PG_PACKED_SAMPLE_CHANNELS(PG_ARG_OUT_PACKED)
 
 /* The same lists as arguments of a call, for a kernel that hands its buffers to a function of
  * its own (a kernel with a work-group reduction at its end cannot return early). */

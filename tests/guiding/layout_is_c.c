@@ -12,12 +12,12 @@ int main(void) {
     printf("pg_kernel_settings: %u bytes, expected 96\n", (unsigned)sizeof(pg_kernel_settings));
     failed = 1;
   }
-  if (sizeof(pg_gbuffer_cameras) != 31 * 4) {
-    printf("pg_gbuffer_cameras: %u bytes, expected 124\n", (unsigned)sizeof(pg_gbuffer_cameras));
+  if (sizeof(pg_gbuffer_cameras) != 34 * 4) {
+    printf("pg_gbuffer_cameras: %u bytes, expected 136\n", (unsigned)sizeof(pg_gbuffer_cameras));
     failed = 1;
   }
   if (0 PG_GBUFFER_CHANNELS(PG_SUM_BYTES) != 5 * 16 + 4 + 4 + 8 ||
-      0 PG_PACKED_GBUFFER_CHANNELS(PG_SUM_BYTES) != 16 + 16 ||
+      0 PG_PACKED_GBUFFER_CHANNELS(PG_SUM_BYTES) != 16 + 8 ||
       0 PG_VPL_CHANNELS(PG_SUM_BYTES) != 2 * 16 ||
       0 PG_SAMPLE_CHANNELS(PG_SUM_BYTES) != 16 + 4 + 16 + 8 ||
       0 PG_STATE_CHANNELS(PG_SUM_BYTES) != 4 * PG_STATE_FLOATS_PER_PIXEL) {

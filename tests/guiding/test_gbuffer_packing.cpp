@@ -84,16 +84,16 @@ TEST(GBufferPacking, PixelsRoundTripWithinTheirBounds) {
     const uint flags = static_cast<uint>(gen() & 0xfu);
     const uint material = static_cast<uint>(gen() & PG_PACKED_MATERIAL_MAX);
 
-    const uint4 surface = pg_pack_gbuffer_surface(position_depth, shading_normal);
-    const uint4 shading = pg_pack_gbuffer_shading(bcr, ms, flags, material);
+    const uint4 surface = pg_pack_gbuffer_surface(position_depth, shading_normal, bcr);
+    const uint2 shading = pg_pack_gbuffer_shading(ms, flags, material);
 
-    ASSERT_EQ(pg_unpack_gbuffer_position(surface), pg_float4_xyz(position_depth));
+    ASSERT_EQ(pg_unpack_gbuffer_depth(surface), position_depth.w);
     ASSERT_EQ(pg_unpack_gbuffer_flags(shading), flags);
     ASSERT_EQ(pg_unpack_gbuffer_material(shading), material);
     const float4 n2 = pg_unpack_gbuffer_shading_normal(surface);
     ASSERT_EQ(n2.w, 0.0f);
     ASSERT_LT(angle_between(pg_float4_xyz(n2), n), PG_OCTAHEDRAL_MAX_ANGLE) << k;
-    const float4 bcr2 = pg_unpack_gbuffer_base_color_roughness(shading);
+    const float4 bcr2 = pg_unpack_gbuffer_base_color_roughness(surface);
     const float4 ms2 = pg_unpack_gbuffer_metallic_specular(shading);
     for (int c = 0; c < 4; ++c) {
       // Relative 2^-11 in the normal range, absolute 2^-25 among the subnormals.
@@ -110,18 +110,19 @@ TEST(GBufferPacking, PixelsRoundTripWithinTheirBounds) {
 }
 
 // The sky's pixels as GBuffer::resize writes them (normal +z, everything else 0) come back bit
-// for bit, with depth 0 and no motion whatever the cameras.
+// for bit, the position at the origin whatever the camera.
 TEST(GBufferPacking, SkyPixelsRoundTripExactly) {
   const float4 zero(0.0f), up(0.0f, 0.0f, 1.0f, 0.0f);
-  const uint4 surface = pg_pack_gbuffer_surface(zero, up);
-  const uint4 shading = pg_pack_gbuffer_shading(zero, zero, PG_GBUF_SKY, 0u);
-  rtpg::pg_gbuffer_cameras cameras{};
-  cameras.current.position_x = 3.0f;
-  cameras.current.forward_z = -1.0f;
-  cameras.moved = 1;
-  EXPECT_EQ(pg_unpack_gbuffer_position_depth(surface, shading, cameras), zero);
+  const uint4 surface = pg_pack_gbuffer_surface(zero, up, zero);
+  const uint2 shading = pg_pack_gbuffer_shading(zero, PG_GBUF_SKY, 0u);
+  rtpg::pg_pinhole_camera camera{};
+  camera.position_x = 3.0f;
+  camera.forward_z = -1.0f;
+  EXPECT_EQ(pg_gbuffer_position_depth(camera, float3(0.0f, 0.0f, -1.0f),
+                                      pg_unpack_gbuffer_depth(surface)),
+            zero);
   EXPECT_EQ(pg_unpack_gbuffer_shading_normal(surface), up);
-  EXPECT_EQ(pg_unpack_gbuffer_base_color_roughness(shading), zero);
+  EXPECT_EQ(pg_unpack_gbuffer_base_color_roughness(surface), zero);
   EXPECT_EQ(pg_unpack_gbuffer_metallic_specular(shading), zero);
   EXPECT_EQ(pg_unpack_gbuffer_flags(shading), PG_GBUF_SKY);
 }

@@ -14,7 +14,6 @@
 #include "rtpg/cl_runtime.h"
 #include "scene/scene_loader.h"
 #include "shared/gbuffer_packing.h"
-#include "support/angles.h"
 
 namespace rtpg {
 namespace {
@@ -61,7 +60,8 @@ GBuffer varied_gbuffer(int w, int h, std::uint32_t seed) {
 }
 
 struct Packed {
-  std::vector<shared::uint4> surface, shading;
+  std::vector<shared::uint4> surface;
+  std::vector<shared::uint2> shading;
   explicit Packed(std::size_t n) : surface(n), shading(n) {}
   PackedGBufferView view() { return {surface.data(), shading.data()}; }
 };
@@ -85,13 +85,13 @@ TEST(GBufferPacker, LanesGiveTheSharedFunctionsBits) {
     for (std::size_t i = 0; i < n; ++i) {
       const bool inside = i >= first && i < last;
       const shared::uint4 s =
-          inside ? shared::pg_pack_gbuffer_surface(g.position_depth[i], g.shading_normal[i])
+          inside ? shared::pg_pack_gbuffer_surface(g.position_depth[i], g.shading_normal[i],
+                                                   g.base_color_roughness[i])
                  : shared::uint4(0u);
       ASSERT_EQ(base.surface[i], s) << i;
-      const shared::uint4 m =
-          inside ? shared::pg_pack_gbuffer_shading(
-                       g.base_color_roughness[i], g.metallic_specular[i], g.flags[i], g.material[i])
-                 : shared::uint4(0u);
+      const shared::uint2 m = inside ? shared::pg_pack_gbuffer_shading(g.metallic_specular[i],
+                                                                       g.flags[i], g.material[i])
+                                     : shared::uint2(0u);
       ASSERT_EQ(base.shading[i], m) << i;
     }
   }
@@ -114,43 +114,60 @@ TEST(GBufferPacker, MaterialIdsAndFlagsThatDoNotFitAreReported) {
   }
 }
 
-// What the device derives instead of receiving (pg_gbuffer_depth, pg_gbuffer_motion,
-// pg_gbuffer_view_dir from gbuffer_cameras) is the renderer's own G-buffer: depth and motion to
-// the bit (the same formulas in the same order on the host), the view direction (the renderer's
-// camera ray, the packing's line from the camera) within 1e-5 rad, along a camera path at an odd
-// size and with the camera held still.
+// What the device derives instead of receiving is the renderer's own G-buffer: each pixel's
+// camera ray (pg_gbuffer_camera_ray, from gbuffer_cameras) is the renderer's to the bit, so its
+// view direction is too; the point at the pixel's depth along it lies within 4e-6 of the depth
+// from the renderer's (which interpolates the triangle's corners), and its motion vector within
+// 1e-3 pixels; along a camera path at an odd size, with the camera held still, and without
+// jitter.
 TEST(GBufferPacker, DerivedChannelsAreTheRenderersOwn) {
   const Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
   for (const int held : {-1, 3}) {
-    RenderSettings settings;
-    settings.width = 37;
-    settings.height = 23;
-    settings.camera_path = "pan";
-    settings.camera_frame = held;
-    Renderer renderer(scene, settings);
-    for (int f = 0; f < 3; ++f) {
-      SCOPED_TRACE("frame " + std::to_string(f) + (held >= 0 ? ", camera held" : ""));
-      renderer.render_frame(f);
-      const GBuffer& g = renderer.gbuffer();
-      const pg_gbuffer_cameras cameras = gbuffer_cameras(g);
-      EXPECT_EQ(cameras.width, 37);
-      EXPECT_EQ(cameras.height, 23);
-      EXPECT_EQ(cameras.moved, f > 0 && held < 0 ? 1 : 0);
-      std::size_t moving = 0, surfaces = 0;
-      for (std::size_t i = 0; i < g.pixel_count(); ++i) {
-        if (!g.has_surface(i)) continue;
-        ++surfaces;
-        const float3 p(g.position_depth[i]);
-        ASSERT_EQ(shared::pg_gbuffer_depth(cameras.current, p), g.position_depth[i].w) << i;
-        const float2 m = shared::pg_gbuffer_motion(cameras, p, static_cast<shared::uint>(i % 37),
-                                                   static_cast<shared::uint>(i / 37));
-        ASSERT_EQ(m, g.motion[i]) << i;
-        if (m != float2(0.0f)) ++moving;
-        const float3 v(shared::pg_gbuffer_view_dir(cameras.current, p));
-        ASSERT_LT(testing::angle_between(v, float3(g.view_dir[i])), 1e-5f) << i;
+    for (const bool jitter : {true, false}) {
+      RenderSettings settings;
+      settings.width = 37;
+      settings.height = 23;
+      settings.camera_path = "pan";
+      settings.camera_frame = held;
+      settings.jitter = jitter;
+      Renderer renderer(scene, settings);
+      for (int f = 0; f < 3; ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f) + (held >= 0 ? ", camera held" : "") +
+                     (jitter ? "" : ", no jitter"));
+        renderer.render_frame(f);
+        const GBuffer& g = renderer.gbuffer();
+        const pg_gbuffer_cameras cameras = gbuffer_cameras(g);
+        EXPECT_EQ(cameras.width, 37);
+        EXPECT_EQ(cameras.height, 23);
+        EXPECT_EQ(cameras.moved, f > 0 && held < 0 ? 1 : 0);
+        EXPECT_EQ(cameras.jitter, jitter ? 1 : 0);
+        EXPECT_EQ(cameras.jitter_frame, static_cast<std::uint32_t>(f));
+        std::size_t moving = 0, surfaces = 0;
+        float worst_position = 0.0f, worst_motion = 0.0f;
+        for (std::size_t i = 0; i < g.pixel_count(); ++i) {
+          const auto x = static_cast<shared::uint>(i % 37), y = static_cast<shared::uint>(i / 37);
+          const float3 ray = shared::pg_gbuffer_camera_ray(cameras, x, y);
+          ASSERT_EQ(shared::pg_gbuffer_view_dir(ray), g.view_dir[i]) << i;
+          const float4 pd =
+              shared::pg_gbuffer_position_depth(cameras.current, ray, g.position_depth[i].w);
+          if (!g.has_surface(i)) {
+            ASSERT_EQ(pd, g.position_depth[i]) << i;
+            continue;
+          }
+          ++surfaces;
+          ASSERT_EQ(pd.w, g.position_depth[i].w) << i;
+          worst_position =
+              std::max(worst_position, glm::length(float3(pd) - float3(g.position_depth[i])) /
+                                           g.position_depth[i].w);
+          const float2 m = shared::pg_gbuffer_motion(cameras, float3(pd), x, y);
+          worst_motion = std::max(worst_motion, glm::length(m - g.motion[i]));
+          if (m != float2(0.0f)) ++moving;
+        }
+        EXPECT_LT(worst_position, 4e-6f);
+        EXPECT_LT(worst_motion, 1e-3f);
+        EXPECT_GT(surfaces, g.pixel_count() / 2);
+        EXPECT_EQ(moving > surfaces / 2, cameras.moved == 1) << moving << " of " << surfaces;
       }
-      EXPECT_GT(surfaces, g.pixel_count() / 2);
-      EXPECT_EQ(moving > surfaces / 2, cameras.moved == 1) << moving << " of " << surfaces;
     }
   }
 }

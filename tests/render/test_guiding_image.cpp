@@ -57,13 +57,19 @@ class PdfTooHigh final : public ForwardingSampler {
   using ForwardingSampler::ForwardingSampler;
   FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
     const FirstBounceSamples inner = ForwardingSampler::sample(g, at);
-    direction_pdf_.assign(inner.direction_pdf, inner.direction_pdf + g.pixel_count());
-    for (glm::vec4& d : direction_pdf_) d.w *= 1.05f;
-    return FirstBounceSamples{direction_pdf_.data(), inner.strategy};
+    direction_pdf_.resize(g.pixel_count());
+    strategy_.resize(g.pixel_count());
+    for (std::size_t i = 0; i < g.pixel_count(); ++i) {  // as they came, or packed
+      const FirstBounceSample s = inner.at(i);
+      direction_pdf_[i] = glm::vec4(s.direction, s.pdf * 1.05f);
+      strategy_[i] = s.strategy;
+    }
+    return FirstBounceSamples{direction_pdf_.data(), strategy_.data()};
   }
 
  private:
   std::vector<glm::vec4> direction_pdf_;
+  std::vector<std::uint32_t> strategy_;
 };
 
 enum class Method { PathTracing, Guided, GuidedWithBias };
@@ -421,11 +427,12 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
       EXPECT_EQ(stats.extra.at("zero_copy"), in_place ? 1.0 : 0.0);
       EXPECT_EQ(stats.extra.at("host_transfer"), static_cast<double>(used));
       // In place only the kernels' count records are copied; otherwise the G-buffer (96 bytes
-      // a pixel, 32 packed) and VPLs (32, packed) go up and each sample's direction, density and
-      // strategy (20) come down, with the mixture (24) where the host reads it
+      // a pixel, 24 packed) and VPLs (32) go up and each sample's direction, density and
+      // strategy (20, 12 packed) come down, with the mixture (24) where the host reads it
       // (include/rtpg/guiding_layout.h).
-      const double sample_bytes = cases[t].mixture ? 44.0 : 20.0;
-      const double gbuffer_bytes = used == HostTransfer::packed ? 32.0 : 96.0;
+      const bool packed = used == HostTransfer::packed;
+      const double sample_bytes = (packed ? 12.0 : 20.0) + (cases[t].mixture ? 24.0 : 0.0);
+      const double gbuffer_bytes = packed ? 24.0 : 96.0;
       EXPECT_DOUBLE_EQ(
           stats.extra.at("host_device_bytes_per_pixel"),
           (in_place ? 0.0 : gbuffer_bytes + sample_bytes * settings.spp + 32.0) + count_records);

@@ -30,9 +30,14 @@ class KeepsFirstSamples final : public ForwardingSampler {
   using ForwardingSampler::ForwardingSampler;
   FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
     const FirstBounceSamples s = ForwardingSampler::sample(g, at);
-    if (at.sample == 0) {
-      direction_pdf.assign(s.direction_pdf, s.direction_pdf + g.pixel_count());
-      strategy.assign(s.strategy, s.strategy + g.pixel_count());
+    if (at.sample == 0) {  // as they came, or packed
+      direction_pdf.resize(g.pixel_count());
+      strategy.resize(g.pixel_count());
+      for (std::size_t i = 0; i < g.pixel_count(); ++i) {
+        const FirstBounceSample f = s.at(i);
+        direction_pdf[i] = glm::vec4(f.direction, f.pdf);
+        strategy[i] = f.strategy;
+      }
     }
     return s;
   }
