@@ -106,8 +106,8 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
   grp->add_option("--host-transfer", r.host_transfer,
                   "How the G-buffer and VPLs reach the device and the samples come back: auto "
                   "(in-place where the device shares host memory, else packed), in-place, pinned "
-                  "(through mapped staging), packed (as pinned, the G-buffer in 48 bytes a "
-                  "pixel instead of 96) or pageable")
+                  "(through mapped staging), packed (as pinned, packed: G-buffer, VPLs and samples "
+                  "in 46 bytes a pixel at 1 spp instead of 148) or pageable")
       ->check(CLI::IsMember({"auto", "in-place", "pinned", "packed", "pageable"}))
       ->capture_default_str();
   grp->add_option("--train-overlap", r.train_overlap,

@@ -55,11 +55,22 @@ GuiderPackedSamples make_guider_packed_samples(cl::Context& context, int width, 
   return b;
 }
 
-GuiderVpls make_guider_vpls(cl::Context& context, int width, int height, cl_mem_flags host_flags) {
+GuiderVpls make_guider_vpls(cl::Context& context, int width, int height, cl_mem_flags host_flags,
+                            KernelAccess access) {
   const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags = CL_MEM_READ_ONLY | host_flags;
+  const cl_mem_flags flags =
+      (access == KernelAccess::read_write ? CL_MEM_READ_WRITE : CL_MEM_READ_ONLY) | host_flags;
   GuiderVpls b;
   translate_cl_errors([&] { PG_VPL_CHANNELS(RTPG_ALLOCATE) });
+  return b;
+}
+
+GuiderPackedVpls make_guider_packed_vpls(cl::Context& context, int width, int height,
+                                         cl_mem_flags host_flags) {
+  const std::size_t n = pixels(width, height);
+  const cl_mem_flags flags = CL_MEM_READ_ONLY | host_flags;
+  GuiderPackedVpls b;
+  translate_cl_errors([&] { PG_PACKED_VPL_CHANNELS(RTPG_ALLOCATE) });
   return b;
 }
 
@@ -301,6 +312,43 @@ void Guider::pack_samples(const GuiderSamples& samples, const GuiderPackedSample
         64, pack_samples_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
     run(pack_samples_, cl::NDRange((n + group - 1) / group * group), cl::NDRange(group), wait,
         &times_.pack_samples_ms);
+  });
+}
+
+void Guider::unpack_vpls(const GuiderPackedVpls& packed, const GuiderGBuffer& gbuffer,
+                         const GuiderSamples& first_samples, const GuiderVpls& out, Wait wait) {
+  check_gbuffer(gbuffer, "gbuffer");
+#define RTPG_CHECK(name, type, bytes) check_buffer(packed.name, bytes, "packed." #name);
+  PG_PACKED_VPL_CHANNELS(RTPG_CHECK)
+#undef RTPG_CHECK
+#define RTPG_CHECK(name, type, bytes) \
+  check_buffer(first_samples.name, bytes, "first_samples." #name);
+  PG_SAMPLE_CHANNELS(RTPG_CHECK)
+#undef RTPG_CHECK
+#define RTPG_CHECK(name, type, bytes) check_buffer(out.name, bytes, "unpacked." #name);
+  PG_VPL_CHANNELS(RTPG_CHECK)
+#undef RTPG_CHECK
+  translate_cl_errors([&] {
+    if (out.position.getInfo<CL_MEM_FLAGS>() & CL_MEM_READ_ONLY)
+      throw GuiderError(
+          "unpack_vpls: the VPLs to write are read-only for kernels (make them with "
+          "KernelAccess::read_write)");
+    if (first_samples.direction_pdf.getInfo<CL_MEM_FLAGS>() & CL_MEM_WRITE_ONLY)
+      throw GuiderError(
+          "unpack_vpls: the first samples are write-only for kernels (make them with "
+          "KernelAccess::read_write)");
+    if (unpack_vpls_() == nullptr) unpack_vpls_ = runtime_.kernel("unpack_vpls.cl", "unpack_vpls");
+    const std::size_t n = static_cast<std::size_t>(width_) * height_;
+    KernelArgs args(unpack_vpls_);
+    args << gbuffer;
+#define RTPG_ARG(name, type, bytes) args << packed.name;
+    PG_PACKED_VPL_CHANNELS(RTPG_ARG)
+#undef RTPG_ARG
+    args << first_samples << out << static_cast<cl_uint>(n);
+    const std::size_t group = std::min<std::size_t>(
+        64, unpack_vpls_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
+    run(unpack_vpls_, cl::NDRange((n + group - 1) / group * group), cl::NDRange(group), wait,
+        &times_.unpack_vpls_ms);
   });
 }
 

@@ -10,6 +10,7 @@
 
 #include "render/gbuffer_packer.h"
 #include "render/pinned_staging.h"
+#include "render/vpl_packer.h"
 #include "rtpg/cl_runtime.h"
 #include "shared/gbuffer_packing.h"
 
@@ -27,6 +28,7 @@ constexpr std::size_t kGBufferBytes = 0 PG_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kVplBytes = 0 PG_VPL_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kPackedGBufferBytes = 0 PG_PACKED_GBUFFER_CHANNELS(RTPG_ADD_BYTES);
 constexpr std::size_t kPackedSampleBytes = 0 PG_PACKED_SAMPLE_CHANNELS(RTPG_ADD_BYTES);
+constexpr std::size_t kPackedVplBytes = 0 PG_PACKED_VPL_CHANNELS(RTPG_ADD_BYTES);
 #undef RTPG_ADD_BYTES
 #define RTPG_COUNT(name, type, bytes) +1
 constexpr std::size_t kGBufferChannels = 0 PG_GBUFFER_CHANNELS(RTPG_COUNT);
@@ -68,6 +70,27 @@ void stage_packed_gbuffer(PinnedStaging& staging, const GBuffer& g,
         " or flags above 255 do not fit in the packed shading word (use --host-transfer pinned)");
   staging.commit(surface, n * 16, device.surface);
   staging.commit(shading, n * 8, device.shading);
+}
+
+// The host's VPLs packed straight into the staging (render/vpl_packer.h), in parallel, and their
+// channels' copies to the device enqueued.
+void stage_packed_vpls(PinnedStaging& staging, const VplBuffer& vpls, const GBuffer& g,
+                       const GuiderPackedVpls& device) {
+  const std::size_t n = g.pixel_count();
+  auto* distance =
+      static_cast<std::uint32_t*>(staging.reserve(n * 4, device.distance, "packed distance"));
+  auto* radiance =
+      static_cast<std::uint32_t*>(staging.reserve(n * 4, device.radiance, "packed radiance"));
+  auto* normal =
+      static_cast<std::uint16_t*>(staging.reserve(n * 2, device.normal, "packed normal"));
+  const PackedVplView view{distance, radiance, normal};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 13),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      pack_vpls(vpls, g, r.begin(), r.end(), view);
+                    });
+  staging.commit(distance, n * 4, device.distance);
+  staging.commit(normal, n * 2, device.normal);
+  staging.commit(radiance, n * 4, device.radiance);
 }
 
 }  // namespace
@@ -120,7 +143,8 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
     for (GuiderGBuffer& g : owned_gbuffers_)
       g = make_guider_gbuffer(runtime.context(), width, height, 0,
                               packed_ ? KernelAccess::read_write : KernelAccess::read_only);
-    owned_vpls_ = make_guider_vpls(runtime.context(), width, height);
+    owned_vpls_ = make_guider_vpls(runtime.context(), width, height, 0,
+                                   packed_ ? KernelAccess::read_write : KernelAccess::read_only);
   }
   samples_ =
       make_guider_samples(runtime.context(), width, height, zero_copy_ ? CL_MEM_ALLOC_HOST_PTR : 0,
@@ -128,6 +152,9 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
   if (!zero_copy_) {
     staging_ = make_guider_samples(runtime.context(), width, height, CL_MEM_ALLOC_HOST_PTR);
     if (packed_) {
+      first_samples_ =
+          make_guider_samples(runtime.context(), width, height, 0, KernelAccess::read_write);
+      packed_vpls_ = make_guider_packed_vpls(runtime.context(), width, height);
       packed_samples_ = make_guider_packed_samples(runtime.context(), width, height);
       packed_staging_ =
           make_guider_packed_samples(runtime.context(), width, height, CL_MEM_ALLOC_HOST_PTR);
@@ -264,7 +291,7 @@ FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoord
   }
   unmap_samples();  // the kernel overwrites them
   const SampleOutputs outputs = sample_outputs();
-  guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_, outputs);
+  guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_for(at), outputs);
   sample_ms_ += guider_->last_times().sample_ms;
   const auto t = Clock::now();
   enqueue_sample_transfer(outputs);
@@ -276,6 +303,11 @@ FirstBounceSamples GuidedFirstBounce::sample(const GBuffer& g, const SampleCoord
                             view_.packed_pdf_strategy};
 }
 
+const GuiderSamples& GuidedFirstBounce::samples_for(const SampleCoordinates& at) {
+  drawn_ = packed_ && at.sample == 0 ? &first_samples_ : &samples_;
+  return *drawn_;
+}
+
 SampleOutputs GuidedFirstBounce::sample_outputs() const {
   return host_reads_mixture_ ? SampleOutputs::directions_and_mixture : SampleOutputs::directions;
 }
@@ -283,7 +315,7 @@ SampleOutputs GuidedFirstBounce::sample_outputs() const {
 void GuidedFirstBounce::start_sample(const GBuffer& g, const SampleCoordinates& at) {
   unmap_samples();  // the kernel overwrites them
   const SampleOutputs outputs = sample_outputs();
-  guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_, outputs,
+  guider_->sample(current_gbuffer_, at.seed, at.frame, at.sample, samples_for(at), outputs,
                   Guider::Wait::later);
   enqueue_sample_transfer(outputs);
   translate_cl_errors([&] { runtime_.queue().flush(); });
@@ -325,7 +357,7 @@ void GuidedFirstBounce::enqueue_sample_transfer(SampleOutputs outputs) {
     view_.mixture_b = staged_.mixture_b.data();
   }
   if (!packed_) {
-    enqueue_download(runtime_.queue(), samples_, staged_, outputs);
+    enqueue_download(runtime_.queue(), *drawn_, staged_, outputs);
     bytes_ += sample_bytes_per_pixel(outputs) * n;
     view_.direction_pdf = staged_.direction_pdf.data();
     view_.strategy = staged_.strategy.data();
@@ -333,15 +365,15 @@ void GuidedFirstBounce::enqueue_sample_transfer(SampleOutputs outputs) {
   }
   // Packed: 12 bytes a pixel instead of direction_pdf's and strategy's 20, and the mixture
   // where the host reads it.
-  guider_->pack_samples(samples_, packed_samples_,
+  guider_->pack_samples(*drawn_, packed_samples_,
                         sample_overlap_ ? Guider::Wait::later : Guider::Wait::finish);
   enqueue_download(runtime_.queue(), packed_samples_, staged_packed_);
   bytes_ += kPackedSampleBytes * n;
   if (host_reads_mixture_) {
     translate_cl_errors([&] {
       cl::CommandQueue& q = runtime_.queue();
-      q.enqueueReadBuffer(samples_.mixture_a, CL_FALSE, 0, n * 16, staged_.mixture_a.data());
-      q.enqueueReadBuffer(samples_.mixture_b, CL_FALSE, 0, n * 8, staged_.mixture_b.data());
+      q.enqueueReadBuffer(drawn_->mixture_a, CL_FALSE, 0, n * 16, staged_.mixture_a.data());
+      q.enqueueReadBuffer(drawn_->mixture_b, CL_FALSE, 0, n * 8, staged_.mixture_b.data());
     });
     bytes_ += (sample_bytes_per_pixel(SampleOutputs::directions_and_mixture) -
                sample_bytes_per_pixel(SampleOutputs::directions)) *
@@ -398,13 +430,21 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   GuiderVpls device_vpls = owned_vpls_;
   if (zero_copy_) {
     device_vpls = wrap_host_vpls(runtime_.context(), vpls);  // released when train is done
+  } else if (packed_) {
+    upload_staging_->begin();
+    stage_packed_vpls(*upload_staging_, vpls, g, packed_vpls_);
+    if (!overlap_) translate_cl_errors([&] { runtime_.queue().finish(); });
+    bytes_ += kPackedVplBytes * g.pixel_count();
   } else {
     copy_to_device(vpls, device_vpls, kVplBytes * g.pixel_count(), /*wait=*/!overlap_);
-    if (overlap_ && upload_staging_)
-      translate_cl_errors(
-          [&] { runtime_.queue().enqueueMarkerWithWaitList(nullptr, &vpls_staged_); });
   }
+  if (!zero_copy_ && overlap_ && upload_staging_)
+    translate_cl_errors(
+        [&] { runtime_.queue().enqueueMarkerWithWaitList(nullptr, &vpls_staged_); });
   upload_ms_ += ms_since(t);
+  if (packed_)
+    guider_->unpack_vpls(packed_vpls_, current_gbuffer_, first_samples_, device_vpls,
+                         overlap_ ? Guider::Wait::later : Guider::Wait::finish);
   if (overlap_) {
     // Nothing touches the VPLs, their staging or this G-buffer before the next frame waits for
     // the training: the renderer writes the other G-buffer next frame (in place) and rewrites
@@ -430,6 +470,7 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   if (packed_) {
     time_ms["unpack"] = k.unpack_ms;
     time_ms["pack_samples"] = k.pack_samples_ms;
+    time_ms["unpack_vpls"] = k.unpack_vpls_ms;
   }
   time_ms["readback"] = readback_ms_;
   extra["guided_fraction"] = guided_fraction_;

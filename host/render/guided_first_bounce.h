@@ -55,6 +55,9 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   // Without pdf() or pixel_guide() to answer, the sample kernel leaves the mixture unwritten
   // and nothing of it is copied or mapped; the statistics come from the kernels' counts.
   void expect_queries(const HostQueries& queries) override;
+  // The VPLs the last end_frame() gave the training, where they were copied to the device
+  // (not HostTransfer::in_place): the layout the train kernel read.
+  const GuiderVpls& device_vpls() const { return owned_vpls_; }
   HostTransfer host_transfer() const { return transfer_; }  // automatic resolved
   bool overlaps_training() const { return overlap_; }       // Overlap resolved
   bool overlaps_sampling() const { return sample_overlap_; }
@@ -138,7 +141,14 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   // packed (Guider::pack_samples into packed_samples_, copied into packed_staging_, mapped at
   // staged_packed_); the mixture, where the host reads it, through staging_ as before.
   GuiderPackedSamples packed_samples_, packed_staging_;
-  struct HostPackedSamples {  // PG_PACKED_SAMPLE_CHANNELS in packed_staging_
+  // HostTransfer::packed: the VPLs go up packed into packed_vpls_ and the device unpacks them
+  // (Guider::unpack_vpls) from the samples they followed, sample 0's, which the sample kernel
+  // writes into first_samples_ (later samples into samples_) so that they survive the frame.
+  GuiderPackedVpls packed_vpls_;
+  GuiderSamples first_samples_;
+  const GuiderSamples& samples_for(const SampleCoordinates& at);  // sets drawn_
+  const GuiderSamples* drawn_ = &samples_;  // what the last sample() drew into
+  struct HostPackedSamples {                // PG_PACKED_SAMPLE_CHANNELS in packed_staging_
     HostChannelView<glm::vec2> direction;
     HostChannelView<float> pdf_strategy;
   } staged_packed_;

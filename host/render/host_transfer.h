@@ -20,9 +20,11 @@ enum class HostTransfer {
               // come back into such staging
   pageable,   // the device copies straight from the host's own (pageable) vectors; the samples
               // come back into pinned staging
-  packed,     // as pinned, but the G-buffer is packed into the staging in 48 bytes a pixel
-              // instead of 96 (include/rtpg/guiding_layout.h, "Packed G-buffer") and the device
-              // unpacks it (Guider::unpack_gbuffer); the SVGF denoiser copies as with pinned
+  packed,     // as pinned, but packed: the G-buffer in 24 bytes a pixel instead of 96 and the
+              // VPLs in 10 instead of 32, which the device unpacks (Guider::unpack_gbuffer,
+              // unpack_vpls), and the samples back in 12 instead of 20 (Guider::pack_samples;
+              // include/rtpg/guiding_layout.h, "Packed ..."); the SVGF denoiser copies as with
+              // pinned
 };
 // "auto", "in-place", "pinned", "packed", "pageable" (the CLI's --host-transfer); throws
 // GuiderError else.

@@ -51,6 +51,10 @@ struct GuiderSamples {  // what sample() writes (PG_SAMPLE_CHANNELS)
 struct GuiderPackedGBuffer {
   PG_PACKED_GBUFFER_CHANNELS(RTPG_DEVICE_CHANNEL)
 };
+// VPLs as they cross the bus (PG_PACKED_VPL_CHANNELS): what unpack_vpls() reads.
+struct GuiderPackedVpls {
+  PG_PACKED_VPL_CHANNELS(RTPG_DEVICE_CHANNEL)
+};
 // Samples as they cross the bus back (PG_PACKED_SAMPLE_CHANNELS): what pack_samples() writes.
 struct GuiderPackedSamples {
   PG_PACKED_SAMPLE_CHANNELS(RTPG_DEVICE_CHANNEL)
@@ -80,9 +84,10 @@ constexpr std::size_t sample_bytes_per_pixel(SampleOutputs outputs) {
 // memory (DeviceInfo::host_unified_memory), the host can map the samples and read them in place
 // instead of copying them; elsewhere such buffers, mapped, are pinned staging that a discrete
 // GPU copies from and into several times faster (host/render/guided_first_bounce.cpp does both).
-// A G-buffer that Guider::unpack_gbuffer() writes, and samples that Guider::pack_samples()
-// reads, must be made with KernelAccess::read_write (otherwise the kernels only read a G-buffer
-// and only write samples).
+// A G-buffer that Guider::unpack_gbuffer() writes, VPLs that Guider::unpack_vpls() writes and
+// samples that Guider::pack_samples() or unpack_vpls() read must be made with
+// KernelAccess::read_write (otherwise the kernels only read a G-buffer and VPLs and only write
+// samples).
 enum class KernelAccess { read_only, read_write };
 GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height,
                                   cl_mem_flags host_flags = 0,
@@ -90,7 +95,10 @@ GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height,
 GuiderPackedGBuffer make_guider_packed_gbuffer(cl::Context& context, int width, int height,
                                                cl_mem_flags host_flags = 0);
 GuiderVpls make_guider_vpls(cl::Context& context, int width, int height,
-                            cl_mem_flags host_flags = 0);
+                            cl_mem_flags host_flags = 0,
+                            KernelAccess access = KernelAccess::read_only);
+GuiderPackedVpls make_guider_packed_vpls(cl::Context& context, int width, int height,
+                                         cl_mem_flags host_flags = 0);
 GuiderSamples make_guider_samples(cl::Context& context, int width, int height,
                                   cl_mem_flags host_flags = 0,
                                   KernelAccess access = KernelAccess::read_only);
@@ -215,6 +223,7 @@ struct GuiderTimes {
   double reproject_ms = 0.0, sample_ms = 0.0, train_ms = 0.0;  // from profiling events
   double unpack_ms = 0.0;                                      // the last unpack_gbuffer()
   double pack_samples_ms = 0.0;                                // the last pack_samples()
+  double unpack_vpls_ms = 0.0;                                 // the last unpack_vpls()
 };
 
 class Guider {
@@ -263,6 +272,14 @@ class Guider {
   // host then copies 12 bytes a pixel instead of 20.
   void pack_samples(const GuiderSamples& samples, const GuiderPackedSamples& out,
                     Wait wait = Wait::finish);
+  // Writes out's channels from VPLs the host packed (PG_PACKED_VPL_CHANNELS; kernels/shared/
+  // vpl_packing.h packs), the G-buffer they were found from and the frame's first samples
+  // (sample 0's, which the VPLs followed: their directions, densities and strategies): for a
+  // device with memory of its own, where the packed form sends 12 bytes a pixel instead of 32.
+  // out, and first_samples, must be made with KernelAccess::read_write.
+  void unpack_vpls(const GuiderPackedVpls& packed, const GuiderGBuffer& gbuffer,
+                   const GuiderSamples& first_samples, const GuiderVpls& out,
+                   Wait wait = Wait::finish);
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
   void reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous,
                  Wait wait = Wait::finish);
@@ -338,6 +355,7 @@ class Guider {
   cl::Kernel reproject_, sample_, train_;
   cl::Kernel unpack_;        // built at the first unpack_gbuffer()
   cl::Kernel pack_samples_;  // built at the first pack_samples()
+  cl::Kernel unpack_vpls_;   // built at the first unpack_vpls()
   cl::Event train_done_;     // the last train() enqueued with Wait::later
   bool train_pending_ = false;
   // The other kernels enqueued with Wait::later, and where each one's time goes (in times_).

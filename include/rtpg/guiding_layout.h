@@ -67,6 +67,23 @@
   X(position, float4, 16)  \
   X(normal_radiance, uint4, 16)
 
+/* ---- Packed VPLs: the VPLs as they cross the bus ------------------------------------------
+ * Where the device has memory of its own, the host sends each pixel's VPL in these 10 bytes
+ * (kernels/shared/vpl_packing.h packs and unpacks them) and the device's unpack_vpls kernel
+ * writes PG_VPL_CHANNELS from them, the device's G-buffer and the frame's first samples
+ * (rtpg::Guider::unpack_vpls): the hit lies along the direction the device sampled, whose
+ * densities and strategy the device has, so only its distance, normal and radiance travel.
+ * distance  the distance from the pixel's point to y (the float's bits; +infinity: an escaped
+ *           ray, PG_VPL_DISTANT; 0: no VPL, PG_VPL_VALID clear)
+ * radiance  the rgb radiance leaving y towards the pixel's point, shared exponent
+ *           (pg_pack_rgbe, kernels/shared/bit_packing.h)
+ * normal    the geometric normal at y, octahedral in two 8-bit signed normalised integers
+ *           (pg_pack_unit_vector8) */
+#define PG_PACKED_VPL_CHANNELS(X) \
+  X(distance, uint, 4)            \
+  X(radiance, uint, 4)            \
+  X(normal, ushort, 2)
+
 #define PG_VPL_VALID 1u
 #define PG_VPL_DISTANT 2u /* escaped ray: position holds a direction */
 #define PG_VPL_STRATEGY_SHIFT 8u

@@ -47,6 +47,7 @@ typedef glm::vec2 float2;
 typedef glm::vec3 float3;
 typedef glm::vec4 float4;
 typedef std::uint32_t uint;
+typedef std::uint16_t ushort;
 typedef std::uint64_t ulong;
 typedef glm::uvec2 uint2;
 typedef glm::uvec4 uint4;

@@ -21,12 +21,15 @@
 #define PG_ARG_IN_PACKED(name, type, bytes) __global const type *packed_##name,
 #define PG_ARG_OUT_PACKED(name, type, bytes) __global type *packed_##name,
 #define PG_ARG_IN_SAMPLE(name, type, bytes) __global const type *sample_##name,
+#define PG_ARG_OUT_VPL(name, type, bytes) __global type *vpl_##name,
 
 #define PG_ARGS_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_IN)      /* this frame's G-buffer */
 #define PG_ARGS_OUT_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_OUT) /* written by unpack_gbuffer */
 #define PG_ARGS_PACKED_GBUFFER PG_PACKED_GBUFFER_CHANNELS(PG_ARG_IN_PACKED)
 #define PG_ARGS_PREV_GBUFFER PG_GBUFFER_CHANNELS(PG_ARG_IN_PREV) /* last frame's */
 #define PG_ARGS_VPLS PG_VPL_CHANNELS(PG_ARG_IN_VPL)
+#define PG_ARGS_OUT_VPLS PG_VPL_CHANNELS(PG_ARG_OUT_VPL) /* written by unpack_vpls */
+#define PG_ARGS_PACKED_VPLS PG_PACKED_VPL_CHANNELS(PG_ARG_IN_PACKED)
 #define PG_ARGS_IN_STATE PG_STATE_CHANNELS(PG_ARG_IN_STATE)
 #define PG_ARGS_OUT_STATE PG_STATE_CHANNELS(PG_ARG_OUT_STATE)
 /* The state updated in place (train: each work-item reads and writes only its own pixels). */

@@ -18,30 +18,17 @@
 #define RTPG_SHARED_SAMPLE_PACKING_H
 
 #include "rtpg/guiding_layout.h"
+#include "shared/bit_packing.h"
 #include "shared/compat.h"
 
 PG_NAMESPACE_BEGIN
 
+/* The direction's octahedral point (kernels/shared/bit_packing.h) as it is, and back. */
 PG_FN float2 pg_pack_direction(float3 d) {
-  float l1 = fabs(d.x) + fabs(d.y) + fabs(d.z);
-  float inv = l1 > 0.0f ? 1.0f / l1 : 0.0f;
-  float px = d.x * inv, py = d.y * inv;
-  if (d.z < 0.0f) {
-    float fx = (1.0f - fabs(py)) * (px >= 0.0f ? 1.0f : -1.0f);
-    float fy = (1.0f - fabs(px)) * (py >= 0.0f ? 1.0f : -1.0f);
-    px = fx;
-    py = fy;
-  }
-  return pg_make_float2(px, py);
+  return pg_octahedral_point(d);
 }
-
 PG_FN float3 pg_unpack_direction(float2 p) {
-  float x = p.x, y = p.y;
-  float z = 1.0f - fabs(x) - fabs(y);
-  float t = fmax(-z, 0.0f); /* the folded half: move x and y back towards the axes */
-  x += x >= 0.0f ? -t : t;
-  y += y >= 0.0f ? -t : t;
-  return normalize(pg_make_float3(x, y, z));
+  return normalize(pg_octahedral_unfold(p.x, p.y));
 }
 
 /* The density with the strategy in its sign bit, and back. */

@@ -16,6 +16,7 @@
 #ifndef RTPG_SHARED_VPL_PACKING_H
 #define RTPG_SHARED_VPL_PACKING_H
 
+#include "rtpg/guiding_layout.h"
 #include "shared/bit_packing.h"
 
 PG_NAMESPACE_BEGIN
@@ -53,6 +54,74 @@ PG_FN float3 pg_vpl_radiance(uint4 packed) {
 }
 PG_FN uint pg_vpl_info(uint4 packed) {
   return packed.w >> 16;
+}
+
+/* ---- The VPLs on the bus (include/rtpg/guiding_layout.h, "Packed VPLs") ------------------
+ * The host sends a VPL's distance from the pixel's point x0, its normal and its radiance; the
+ * device puts y at that distance along the direction it sampled for the pixel (sample 0's
+ * direction_pdf), and takes the densities from that sample: D, and the strategy's (the BSDF's
+ * density at the direction for a BSDF sample, which the unpack kernel evaluates with its
+ * G-buffer, else D), both in area measure at y by the cosine at y over the distance squared as
+ * the path tracer converts them (host/render/path_tracer.cpp). The device's x0 and direction
+ * are the host's to a few units in the last place (kernels/shared/gbuffer_packing.h,
+ * sample_packing.h); the normal comes within PG_OCTAHEDRAL8_MAX_ANGLE, and the cosine at y that
+ * converts this pixel's densities is taken with the normal the train kernel will read, so that
+ * a neighbour's conversion (its cosine over this one) keeps its accuracy where the two views of
+ * y are alike; the radiance rounds to 8-bit shared-exponent mantissas (within 2^-7 of the
+ * brightest channel). All of it moves where the guide points, not what a pixel converges to:
+ * the training alone reads VPLs. */
+typedef struct {
+  float4 position;
+  uint4 normal_radiance;
+} pg_vpl;
+
+/* What the host sends: x0 the pixel's point (the G-buffer's position). */
+PG_FN uint pg_pack_vpl_distance(float4 position, uint4 normal_radiance, float3 x0) {
+  uint info = pg_vpl_info(normal_radiance);
+  if ((info & PG_VPL_VALID) == 0u) return 0u;
+  if ((info & PG_VPL_DISTANT) != 0u) return 0x7f800000u; /* +infinity */
+  return as_uint(length(pg_float4_xyz(position) - x0));
+}
+PG_FN uint pg_pack_vpl_bus_radiance(uint4 normal_radiance) {
+  return pg_pack_rgbe(pg_vpl_radiance(normal_radiance));
+}
+PG_FN uint pg_pack_vpl_bus_normal(uint4 normal_radiance) {
+  return pg_pack_unit_vector8(pg_vpl_normal(normal_radiance));
+}
+
+/* What the device rebuilds: x0 its pixel's point, direction_pdf and strategy the pixel's first
+ * sample (PG_SAMPLE_CHANNELS), bsdf_pdf the BSDF's solid-angle density at that direction (read
+ * only for a BSDF sample). A VPL the host did not send (distance 0), or whose densities are not
+ * positive and finite here, comes back invalid: every word 0. */
+PG_FN pg_vpl pg_unpack_vpl(uint distance, uint radiance, uint normal, float3 x0,
+                           float4 direction_pdf, uint strategy, float bsdf_pdf) {
+  pg_vpl v;
+  v.position = pg_make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+  v.normal_radiance = pg_make_uint4(0u, 0u, 0u, 0u);
+  float d = as_float(distance);
+  if (!(d > 0.0f)) return v;
+  float3 w = pg_float4_xyz(direction_pdf);
+  float density = direction_pdf.w;
+  float strategy_pdf = strategy == PG_STRATEGY_BSDF ? bsdf_pdf : density;
+  uint info = PG_VPL_VALID | (strategy << PG_VPL_STRATEGY_SHIFT);
+  uint normal_bits = pg_pack_vpl_normal(pg_unpack_unit_vector8(normal)); /* as train reads it */
+  float3 y = w;
+  if (isfinite(d)) {
+    float cos_y = fabs(dot(pg_unpack_unit_vector(normal_bits), w));
+    float to_area = cos_y / (d * d);
+    strategy_pdf *= to_area;
+    density *= to_area;
+    y = x0 + w * d;
+  } else {
+    info |= PG_VPL_DISTANT;
+  }
+  if (!(strategy_pdf > 0.0f && isfinite(strategy_pdf)) || !isfinite(density)) return v;
+  float3 l = pg_unpack_rgbe(radiance);
+  v.position = pg_make_float4(y.x, y.y, y.z, strategy_pdf);
+  v.normal_radiance =
+      pg_make_uint4(normal_bits, pg_pack_vpl_density(density), pg_pack_vpl_radiance_rg(l),
+                    pg_pack_vpl_radiance_b_info(l, info));
+  return v;
 }
 
 PG_NAMESPACE_END

@@ -1444,6 +1444,98 @@ TEST(GuidingKernels, PackSamplesMatchesTheHostPacking) {
   }
 }
 
+// The device's unpack of packed VPLs (kernels/unpack_vpls.cl) equals the host's (kernels/shared/
+// vpl_packing.h, pg_unpack_vpl with the BSDF's density evaluated on the host) at odd sizes: the
+// radiance and info words bit for bit, the position and the densities within the rounding of the
+// device's square roots and divisions (and of its BSDF density for a BSDF sample), the normal
+// within 1e-4 rad of the host's (its 8-bit code decoded and packed again in 16 bits).
+TEST(GuidingKernels, UnpackVplsMatchesTheHostUnpack) {
+  ClRuntime rt;
+  Random r(1010);
+  const std::vector<std::pair<int, int>> sizes =
+      simulated(rt) ? std::vector<std::pair<int, int>>{{13, 9}, {1, 1}}
+                    : std::vector<std::pair<int, int>>{{93, 61}, {1, 1}, {301, 3}};
+  for (const auto& [w, h] : sizes) {
+    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+    const HostGBuffer g = random_gbuffer(r, w, h);
+    const std::size_t n = g.n();
+    std::vector<float4> direction_pdf(n), mixture_a(n, float4(0.0f));
+    std::vector<float2> mixture_b(n, float2(0.0f));
+    std::vector<std::uint32_t> strategy(n), distance(n), radiance(n);
+    std::vector<std::uint16_t> normal(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const float3 nx(g.shading_normal[i]);
+      const float3 wi = r.tilt(nx, 0.0f, 85.0f);
+      const float u = r.uniform();
+      direction_pdf[i] = float4(wi.x, wi.y, wi.z, r.uniform(0.05f, 5.0f));
+      strategy[i] = u < 0.5f ? PG_STRATEGY_BSDF : PG_STRATEGY_GUIDE;
+      const float d = u < 0.1f ? 0.0f : (u < 0.2f ? INFINITY : r.uniform(0.01f, 20.0f));
+      distance[i] = sh::as_uint(d);
+      radiance[i] =
+          sh::pg_pack_rgbe(float3(r.uniform(0.0f, 3.0f), r.uniform(), 1e3f * r.uniform()));
+      normal[i] = static_cast<std::uint16_t>(sh::pg_pack_unit_vector8(-r.tilt(wi, 0.0f, 80.0f)));
+    }
+    const GuiderGBuffer dg = upload(rt, g);
+    const GuiderSamples samples =
+        make_guider_samples(rt.context(), w, h, 0, KernelAccess::read_write);
+    const GuiderPackedVpls packed = make_guider_packed_vpls(rt.context(), w, h);
+    cl::CommandQueue& q = rt.queue();
+    q.enqueueWriteBuffer(samples.direction_pdf, CL_FALSE, 0, n * 16, direction_pdf.data());
+    q.enqueueWriteBuffer(samples.strategy, CL_FALSE, 0, n * 4, strategy.data());
+    q.enqueueWriteBuffer(samples.mixture_a, CL_FALSE, 0, n * 16, mixture_a.data());
+    q.enqueueWriteBuffer(samples.mixture_b, CL_FALSE, 0, n * 8, mixture_b.data());
+    q.enqueueWriteBuffer(packed.distance, CL_FALSE, 0, n * 4, distance.data());
+    q.enqueueWriteBuffer(packed.radiance, CL_FALSE, 0, n * 4, radiance.data());
+    q.enqueueWriteBuffer(packed.normal, CL_FALSE, 0, n * 2, normal.data());
+    const GuiderVpls out = make_guider_vpls(rt.context(), w, h, 0, KernelAccess::read_write);
+    Guider guider(rt, w, h);
+    guider.unpack_vpls(packed, dg, samples, out);
+    EXPECT_GE(guider.last_times().unpack_vpls_ms, 0.0);
+    std::vector<float4> position(n);
+    std::vector<sh::uint4> nr(n);
+    q.enqueueReadBuffer(out.position, CL_FALSE, 0, n * 16, position.data());
+    q.enqueueReadBuffer(out.normal_radiance, CL_TRUE, 0, n * 16, nr.data());
+    std::size_t valid = 0, distant = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const sh::pg_frame frame = sh::pg_frame_from_normal(float3(g.shading_normal[i]));
+      const float3 wo = sh::pg_to_local(frame, float3(g.view_dir[i]));
+      const sh::pg_lobes lobes = sh::pg_make_lobes(
+          sh::pg_material_from_gbuffer(g.base_color_roughness[i], g.metallic_specular[i]), wo);
+      const float bsdf =
+          sh::pg_bsdf_pdf(lobes, wo, sh::pg_to_local(frame, float3(direction_pdf[i])));
+      const sh::pg_vpl host =
+          sh::pg_unpack_vpl(distance[i], radiance[i], normal[i], float3(g.position_depth[i]),
+                            direction_pdf[i], strategy[i], bsdf);
+      const std::uint32_t info = sh::pg_vpl_info(host.normal_radiance);
+      ASSERT_EQ(sh::pg_vpl_info(nr[i]), info) << i;
+      ASSERT_EQ(nr[i].z, host.normal_radiance.z) << i;
+      ASSERT_EQ(nr[i].w, host.normal_radiance.w) << i;
+      if ((info & PG_VPL_VALID) == 0u) {
+        ASSERT_EQ(position[i], float4(0.0f)) << i;
+        continue;
+      }
+      ++valid;
+      distant += (info & PG_VPL_DISTANT) != 0u;
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(position[i][c], host.position[c], 1e-5f * (std::fabs(host.position[c]) + 25.0f))
+            << i;
+      ASSERT_NEAR(position[i].w / host.position.w, 1.0f, 1e-4f) << i;
+      ASSERT_NEAR(
+          sh::pg_vpl_mixture_density(nr[i]) / sh::pg_vpl_mixture_density(host.normal_radiance),
+          1.0f, 1e-4f)
+          << i;
+      ASSERT_LT(rtpg::testing::angle_between(sh::pg_vpl_normal(nr[i]),
+                                             sh::pg_vpl_normal(host.normal_radiance)),
+                1e-4)
+          << i;
+    }
+    if (n > 20) {
+      EXPECT_GT(valid, n / 2);
+      EXPECT_GT(distant, 0u);
+    }
+  }
+}
+
 // unpack_gbuffer refuses a G-buffer kernels may not write, packed channels of another size and
 // cameras of another image, naming them; pack_samples samples it may not read.
 TEST(GuiderMisuse, UnpackGBufferRefusesReadOnlyAndMissizedBuffers) {
@@ -1478,6 +1570,22 @@ TEST(GuiderMisuse, UnpackGBufferRefusesReadOnlyAndMissizedBuffers) {
   expect_guider_error(
       [&] { guider.pack_samples(make_guider_samples(rt.context(), w, h), packed_samples); },
       "KernelAccess::read_write");
+  // unpack_vpls writes VPLs and reads the first samples: read-only VPLs and write-only samples
+  // are refused.
+  const GuiderPackedVpls packed_vpls = make_guider_packed_vpls(rt.context(), w, h);
+  const GuiderSamples readable =
+      make_guider_samples(rt.context(), w, h, 0, KernelAccess::read_write);
+  expect_guider_error(
+      [&] {
+        guider.unpack_vpls(packed_vpls, writable, readable, make_guider_vpls(rt.context(), w, h));
+      },
+      "KernelAccess::read_write");
+  expect_guider_error(
+      [&] {
+        guider.unpack_vpls(packed_vpls, writable, make_guider_samples(rt.context(), w, h),
+                           make_guider_vpls(rt.context(), w, h, 0, KernelAccess::read_write));
+      },
+      "first samples are write-only");
   GuiderPackedSamples short_samples = packed_samples;
   short_samples.pdf_strategy = cl::Buffer(rt.context(), CL_MEM_READ_WRITE, (w * h - 1) * 4);
   expect_guider_error(

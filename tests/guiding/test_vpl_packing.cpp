@@ -22,7 +22,7 @@ using rtpg::testing::angle_between;
 TEST(VplPacking, UnitVectorsWithinTheirAngularBound) {
   std::mt19937 gen(11);
   std::normal_distribution<float> g;
-  double worst = 0.0;
+  double worst = 0.0, worst8 = 0.0;
   for (int i = 0; i < 1000000; ++i) {
     float3 n(g(gen), g(gen), g(gen));
     n = n * (1.0f / std::sqrt(dot(n, n)));
@@ -34,8 +34,13 @@ TEST(VplPacking, UnitVectorsWithinTheirAngularBound) {
     const float3 m = pg_unpack_unit_vector(pg_pack_unit_vector(n));
     ASSERT_NEAR(std::sqrt(dot(m, m)), 1.0f, 1e-6f);
     worst = std::max(worst, angle_between(n, m));
+    const float3 m8 = pg_unpack_unit_vector8(pg_pack_unit_vector8(n));
+    ASSERT_NEAR(std::sqrt(dot(m8, m8)), 1.0f, 1e-6f);
+    worst8 = std::max(worst8, angle_between(n, m8));
   }
   EXPECT_LT(worst, PG_OCTAHEDRAL_MAX_ANGLE);
+  EXPECT_LT(worst8, PG_OCTAHEDRAL8_MAX_ANGLE);
+  std::printf("[ info     ] worst angles %.3g rad (16 bits), %.3g rad (8 bits)\n", worst, worst8);
   // The axes come back exactly; the zero vector (a distant VPL's) packs as +z.
   for (int axis = 0; axis < 3; ++axis)
     for (float s : {1.0f, -1.0f}) {
@@ -117,6 +122,98 @@ TEST(VplPacking, PublicPackerWritesTheKernelsLayout) {
   EXPECT_THROW(
       rtpg::pack_vpl_normal_radiance({0.0f, 0.0f, 1.0f}, 1.0f, {1.0f, 1.0f, 1.0f}, 0x10000u),
       rtpg::GuiderError);
+}
+
+// The shared-exponent radiance (pg_pack_rgbe): the brightest channel within 2^-8 of its value,
+// each other within 2^-7 of the brightest (2^-8 but where the brightest rounds up to a power), over
+// 12 decades and every hue; black, negative and NaN channels as 0; a sun's radiance (1e6 to 1e9)
+// kept; above 2^127 saturated.
+TEST(VplPacking, SharedExponentRadianceWithinItsBound) {
+  std::mt19937 gen(23);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int k = 0; k < 200000; ++k) {
+    const float scale = std::pow(10.0f, -6.0f + 15.0f * u(gen));
+    float3 c(u(gen) * scale, u(gen) * scale, u(gen) * scale);
+    if (k % 5 == 0) c[k % 3] = 0.0f;
+    const float m = std::max(c.x, std::max(c.y, c.z));
+    const float3 back = pg_unpack_rgbe(pg_pack_rgbe(c));
+    for (int ch = 0; ch < 3; ++ch) {
+      const float bound = std::ldexp(m, -7);
+      ASSERT_LE(std::fabs(back[ch] - c[ch]), bound) << k << " " << ch << " " << c[ch];
+      if (c[ch] == m) {
+        ASSERT_LE(std::fabs(back[ch] - c[ch]), std::ldexp(c[ch], -8)) << k;
+      }
+    }
+  }
+  EXPECT_EQ(pg_pack_rgbe(float3(0.0f)), 0u);
+  EXPECT_EQ(pg_unpack_rgbe(0u), float3(0.0f));
+  EXPECT_EQ(pg_unpack_rgbe(pg_pack_rgbe(float3(-1.0f, std::nanf(""), 2.0f))), float3(0, 0, 2));
+  EXPECT_EQ(pg_unpack_rgbe(pg_pack_rgbe(float3(1e-31f))), float3(0.0f));  // below 2^-100
+  // Powers of two and values that round up to the next power come back exactly or within bound.
+  EXPECT_EQ(pg_unpack_rgbe(pg_pack_rgbe(float3(1.0f, 0.5f, 0.25f))), float3(1.0f, 0.5f, 0.25f));
+  EXPECT_EQ(pg_unpack_rgbe(pg_pack_rgbe(float3(255.9f, 0.0f, 0.0f))).x, 256.0f);
+  const float huge = pg_unpack_rgbe(pg_pack_rgbe(float3(1e38f * 3.0f, 0.0f, 0.0f))).x;
+  EXPECT_TRUE(std::isfinite(huge));
+  EXPECT_GT(huge, 1e38f);
+}
+
+// A VPL through the bus (pg_pack_vpl_distance, _bus_radiance, _bus_normal; pg_unpack_vpl) as the
+// device rebuilds it from its own point and sample: at, beyond (escaped) and without a hit, for
+// either strategy, the position within a few ulp of where the host found it, the densities in
+// area measure within the normal's rounding of the host's conversion, the radiance within its
+// shared exponent, the info bits the host's.
+TEST(VplPacking, BusRoundTripRebuildsTheVpl) {
+  std::mt19937 gen(29);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::normal_distribution<float> g;
+  const auto unit = [&] {
+    float3 v(g(gen), g(gen), g(gen));
+    return v * (1.0f / std::sqrt(dot(v, v)));
+  };
+  for (int k = 0; k < 20000; ++k) {
+    const float3 x0(u(gen) * 5.0f, u(gen) * 5.0f, u(gen) * 5.0f);
+    float3 w = unit();
+    const float d = std::pow(10.0f, -2.0f + 3.0f * (0.5f + 0.5f * u(gen)));
+    float3 n = unit();
+    if (dot(n, w) > 0.0f) n = -n;  // facing x0
+    const float cos_y = std::fabs(dot(n, w));
+    if (cos_y < 0.05f) continue;  // grazing: the 8-bit normal's cosine error is the whole bound
+    const float density = 0.3f + 2.0f * (0.5f + 0.5f * u(gen)), bsdf = 0.5f * density;
+    const uint strategy = k % 2 ? PG_STRATEGY_BSDF : PG_STRATEGY_GUIDE;
+    const float strategy_pdf = strategy == PG_STRATEGY_BSDF ? bsdf : density;
+    const float3 radiance(0.5f + 0.5f * u(gen), 2.0f, 0.01f);
+    const bool distant = k % 7 == 0, invalid = k % 11 == 0;
+    // What the path tracer writes (host/render/path_tracer.cpp).
+    const float3 y = distant ? w : x0 + w * d;
+    const float to_area = distant ? 1.0f : cos_y / (d * d);
+    uint info = strategy << PG_VPL_STRATEGY_SHIFT;
+    if (!invalid) info |= PG_VPL_VALID | (distant ? PG_VPL_DISTANT : 0u);
+    const float4 position(y.x, y.y, y.z, strategy_pdf * to_area);
+    const uint4 nr =
+        pg_pack_vpl_normal_radiance(distant ? float3(0.0f) : n, density * to_area, radiance, info);
+    const pg_vpl v = pg_unpack_vpl(pg_pack_vpl_distance(position, nr, x0),
+                                   pg_pack_vpl_bus_radiance(nr), pg_pack_vpl_bus_normal(nr), x0,
+                                   float4(w.x, w.y, w.z, density), strategy, bsdf);
+    if (invalid) {
+      ASSERT_EQ(v.normal_radiance, uint4(0u)) << k;
+      ASSERT_EQ(v.position, float4(0.0f)) << k;
+      continue;
+    }
+    ASSERT_EQ(pg_vpl_info(v.normal_radiance), info) << k;
+    for (int c = 0; c < 3; ++c)
+      ASSERT_NEAR(v.position[c], y[c], 1e-6f * (std::fabs(y[c]) + 10.0f * (1.0f + d))) << k;
+    // The cosine through the 8-bit normal: within sin(2e-2) of the exact one.
+    const float area_bound = distant ? 1e-6f : PG_OCTAHEDRAL8_MAX_ANGLE / cos_y + 1e-5f;
+    ASSERT_NEAR(v.position.w / position.w, 1.0f, area_bound) << k;
+    ASSERT_NEAR(pg_vpl_mixture_density(v.normal_radiance) / pg_vpl_mixture_density(nr), 1.0f,
+                area_bound)
+        << k;
+    ASSERT_LT(angle_between(pg_vpl_normal(v.normal_radiance), distant ? float3(0, 0, 1) : n),
+              PG_OCTAHEDRAL8_MAX_ANGLE + PG_OCTAHEDRAL_MAX_ANGLE)
+        << k;
+    const float3 l = pg_vpl_radiance(v.normal_radiance), l0 = pg_vpl_radiance(nr);
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(l[c], l0[c], std::ldexp(2.0f, -7)) << k;
+  }
 }
 
 }  // namespace

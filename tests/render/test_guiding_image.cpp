@@ -3,6 +3,7 @@
 // clearly lower error at 1 sample per pixel once trained.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -17,6 +18,8 @@
 #include "render/image_io.h"
 #include "render/renderer.h"
 #include "scene/scene_loader.h"
+#include "shared/bit_packing.h"
+#include "shared/vpl_packing.h"
 #include "support/scene_edits.h"
 
 namespace rtpg {
@@ -427,15 +430,15 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
       EXPECT_EQ(stats.extra.at("zero_copy"), in_place ? 1.0 : 0.0);
       EXPECT_EQ(stats.extra.at("host_transfer"), static_cast<double>(used));
       // In place only the kernels' count records are copied; otherwise the G-buffer (96 bytes
-      // a pixel, 24 packed) and VPLs (32) go up and each sample's direction, density and
-      // strategy (20, 12 packed) come down, with the mixture (24) where the host reads it
-      // (include/rtpg/guiding_layout.h).
+      // a pixel, 24 packed) and VPLs (32, 10 packed) go up and each sample's direction,
+      // density and strategy (20, 12 packed) come down, with the mixture (24) where the host
+      // reads it (include/rtpg/guiding_layout.h).
       const bool packed = used == HostTransfer::packed;
       const double sample_bytes = (packed ? 12.0 : 20.0) + (cases[t].mixture ? 24.0 : 0.0);
-      const double gbuffer_bytes = packed ? 24.0 : 96.0;
-      EXPECT_DOUBLE_EQ(
-          stats.extra.at("host_device_bytes_per_pixel"),
-          (in_place ? 0.0 : gbuffer_bytes + sample_bytes * settings.spp + 32.0) + count_records);
+      const double gbuffer_bytes = packed ? 24.0 : 96.0, vpl_bytes = packed ? 10.0 : 32.0;
+      EXPECT_DOUBLE_EQ(stats.extra.at("host_device_bytes_per_pixel"),
+                       (in_place ? 0.0 : gbuffer_bytes + sample_bytes * settings.spp + vpl_bytes) +
+                           count_records);
       EXPECT_EQ(stats.time_ms.count("unpack"), used == HostTransfer::packed ? 1u : 0u);
     }
     if (cases[t].transfer == HostTransfer::automatic) {
@@ -467,6 +470,69 @@ TEST(GuidingImage, EveryHostTransferGivesTheSameImage) {
     EXPECT_EQ(pixels_that_differ(images[0], images[t]), 0u)
         << host_transfer_name(cases[t].transfer) << (cases[t].mixture ? ", mixture read" : "")
         << ": of " << images[0].size() << " pixels";
+  }
+}
+
+// The VPLs sent packed (10 bytes a pixel) reach the training as the host found them: along a
+// moving camera at 2 spp (sample 0's directions, which the VPLs followed, kept apart from sample
+// 1's) and at an odd size, the device's rebuilt VPLs have the host's info bits, positions within
+// 1e-4 of the distance they lie at (and the pixel point's own rounding), densities within the 8-bit
+// normal's cosine (and the rounding of the device's BSDF density), radiance within its shared
+// exponent.
+TEST(GuidingImage, PackedVplsReachTheTrainingAsTheHostFoundThem) {
+  const Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
+  const RenderSettings settings = odd_size_along_camera_path(scene);
+  ClRuntime cl;
+  Renderer renderer(scene, settings);
+  auto guided = std::make_unique<GuidedFirstBounce>(
+      cl, settings.width, settings.height, GuidingSettings{}, HostTransfer::packed, Overlap::off);
+  GuidedFirstBounce* sampler = guided.get();
+  renderer.set_first_bounce_sampler(std::move(guided));
+  const std::size_t n = static_cast<std::size_t>(settings.width) * settings.height;
+  std::vector<glm::vec4> position(n);
+  std::vector<shared::uint4> nr(n);
+  for (int f = 0; f < 4; ++f) {
+    SCOPED_TRACE("frame " + std::to_string(f));
+    renderer.render_frame(f);
+    const GuiderVpls& device = sampler->device_vpls();
+    cl.queue().enqueueReadBuffer(device.position, CL_FALSE, 0, n * 16, position.data());
+    cl.queue().enqueueReadBuffer(device.normal_radiance, CL_TRUE, 0, n * 16, nr.data());
+    const VplBuffer& host = renderer.vpls();
+    const GBuffer& g = renderer.gbuffer();
+    std::size_t valid = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t info = shared::pg_vpl_info(host.normal_radiance[i]);
+      if ((info & PG_VPL_VALID) == 0u) {
+        ASSERT_EQ(shared::pg_vpl_info(nr[i]), 0u) << i;
+        continue;
+      }
+      ++valid;
+      ASSERT_EQ(shared::pg_vpl_info(nr[i]), info) << i;
+      const glm::vec3 y(host.position[i]);
+      const float reach =
+          (info & PG_VPL_DISTANT) != 0u ? 1.0f : glm::length(y - glm::vec3(g.position_depth[i]));
+      // The device's pixel point is the host's within 4e-6 of its depth (GBufferPacker.
+      // DerivedChannelsAreTheRenderersOwn).
+      ASSERT_LT(glm::length(glm::vec3(position[i]) - y),
+                1e-4f * reach + 8e-6f * g.position_depth[i].w)
+          << i;
+      const float cos_y =
+          (info & PG_VPL_DISTANT) != 0u
+              ? 1.0f
+              : std::fabs(glm::dot(shared::pg_vpl_normal(host.normal_radiance[i]),
+                                   glm::normalize(y - glm::vec3(g.position_depth[i]))));
+      const float bound = 1e-3f + PG_OCTAHEDRAL8_MAX_ANGLE / std::max(cos_y, 0.02f);
+      ASSERT_NEAR(position[i].w / host.position[i].w, 1.0f, bound) << i;
+      ASSERT_NEAR(shared::pg_vpl_mixture_density(nr[i]) /
+                      shared::pg_vpl_mixture_density(host.normal_radiance[i]),
+                  1.0f, bound)
+          << i;
+      const glm::vec3 l = shared::pg_vpl_radiance(nr[i]),
+                      l0 = shared::pg_vpl_radiance(host.normal_radiance[i]);
+      const float brightest = std::max(l0.x, std::max(l0.y, l0.z));
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(l[c], l0[c], std::ldexp(brightest, -7)) << i;
+    }
+    EXPECT_GT(valid, n / 3);
   }
 }
 
