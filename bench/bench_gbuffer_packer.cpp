@@ -2,7 +2,7 @@
 // packed costs the host per pixel, against a copy of the 96-byte layout (what pinned staging
 // does instead), at 1920x1080 on the Cornell box's real G-buffer. Packing pays where its time is
 // below the copy's plus the bus time of the 72 bytes it saves (docs/guiding.md, "The G-buffer
-// packed for the bus").
+// packed for the bus", "The bus at 46 bytes a pixel").
 //   bench_gbuffer_packer [--benchmark_repetitions=5 --benchmark_report_aggregates_only=true]
 #include <benchmark/benchmark.h>
 

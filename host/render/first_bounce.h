@@ -71,6 +71,9 @@ class FirstBounceSampler {
   virtual void end_frame(const GBuffer& gbuffer, const VplBuffer& vpls,
                          const SampleCoordinates& at) {}
   virtual bool wants_vpls() const { return false; }
+  // Whether end_frame sends the VPLs over a bus packed (VplBuffer::for_bus: the path tracer
+  // then writes their packed form too).
+  virtual bool sends_packed_vpls() const { return false; }
   // True when the sampler reads the G-buffer in place from begin_frame() until the next
   // frame's end_frame() (its reprojection reads last frame's): the renderer then writes each
   // frame into the other of two G-buffers, leaving last frame's untouched.

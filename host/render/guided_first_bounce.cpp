@@ -10,7 +10,6 @@
 
 #include "render/gbuffer_packer.h"
 #include "render/pinned_staging.h"
-#include "render/vpl_packer.h"
 #include "rtpg/cl_runtime.h"
 #include "shared/gbuffer_packing.h"
 
@@ -72,25 +71,11 @@ void stage_packed_gbuffer(PinnedStaging& staging, const GBuffer& g,
   staging.commit(shading, n * 8, device.shading);
 }
 
-// The host's VPLs packed straight into the staging (render/vpl_packer.h), in parallel, and their
-// channels' copies to the device enqueued.
-void stage_packed_vpls(PinnedStaging& staging, const VplBuffer& vpls, const GBuffer& g,
-                       const GuiderPackedVpls& device) {
-  const std::size_t n = g.pixel_count();
-  auto* distance =
-      static_cast<std::uint32_t*>(staging.reserve(n * 4, device.distance, "packed distance"));
-  auto* radiance =
-      static_cast<std::uint32_t*>(staging.reserve(n * 4, device.radiance, "packed radiance"));
-  auto* normal =
-      static_cast<std::uint16_t*>(staging.reserve(n * 2, device.normal, "packed normal"));
-  const PackedVplView view{distance, radiance, normal};
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 13),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      pack_vpls(vpls, g, r.begin(), r.end(), view);
-                    });
-  staging.commit(distance, n * 4, device.distance);
-  staging.commit(normal, n * 2, device.normal);
-  staging.commit(radiance, n * 4, device.radiance);
+void stage_channels(PinnedStaging& staging, const VplBuffer::Packed& host,
+                    const GuiderPackedVpls& device) {
+#define RTPG_STAGE(name, type, bytes) staging.stage(host.name, device.name, "packed " #name);
+  PG_PACKED_VPL_CHANNELS(RTPG_STAGE)
+#undef RTPG_STAGE
 }
 
 }  // namespace
@@ -431,8 +416,13 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   if (zero_copy_) {
     device_vpls = wrap_host_vpls(runtime_.context(), vpls);  // released when train is done
   } else if (packed_) {
+    // The path tracer wrote them packed (VplBuffer::for_bus, which the renderer sets from
+    // sends_packed_vpls()).
+    if (!vpls.for_bus || vpls.packed.distance.size() != g.pixel_count())
+      throw GuiderError(
+          "guided first bounce: the VPLs were not packed for the bus (VplBuffer::for_bus)");
     upload_staging_->begin();
-    stage_packed_vpls(*upload_staging_, vpls, g, packed_vpls_);
+    stage_channels(*upload_staging_, vpls.packed, packed_vpls_);
     if (!overlap_) translate_cl_errors([&] { runtime_.queue().finish(); });
     bytes_ += kPackedVplBytes * g.pixel_count();
   } else {

@@ -58,6 +58,7 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   // The VPLs the last end_frame() gave the training, where they were copied to the device
   // (not HostTransfer::in_place): the layout the train kernel read.
   const GuiderVpls& device_vpls() const { return owned_vpls_; }
+  bool sends_packed_vpls() const override { return packed_; }
   HostTransfer host_transfer() const { return transfer_; }  // automatic resolved
   bool overlaps_training() const { return overlap_; }       // Overlap resolved
   bool overlaps_sampling() const { return sample_overlap_; }

@@ -409,6 +409,10 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
             vpls->normal_radiance[i].x = shared::pg_pack_vpl_normal(glm::vec3(0.0f));
             vpls->normal_radiance[i].y = shared::pg_pack_vpl_density(vpl_paths_[i].sampler_pdf);
             if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID | PG_VPL_DISTANT;
+            if (vpls->for_bus) {
+              vpls->packed.distance[i] = 0x7f800000u;  // +infinity: escaped
+              vpls->packed.normal[i] = 0u;
+            }
           }
         }
         continue;
@@ -433,6 +437,11 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         vpls->normal_radiance[i].y =
             shared::pg_pack_vpl_density(vpl_paths_[i].sampler_pdf * cos_y / d2);
         if (usable_vpl_density(strategy_pdf)) vpls->info[i] |= PG_VPL_VALID;
+        if (vpls->for_bus) {
+          vpls->packed.distance[i] = shared::as_uint(std::sqrt(d2));
+          vpls->packed.normal[i] =
+              static_cast<std::uint16_t>(shared::pg_pack_unit_vector8(sp.geometric_normal));
+        }
       }
       if (depth == settings_.max_bounces) continue;
 
@@ -760,6 +769,12 @@ void PathTracer::gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls,
             const glm::vec3 l = is_finite(vpl_l) ? vpl_l : glm::vec3(0.0f);
             vpls->normal_radiance[i].z = shared::pg_pack_vpl_radiance_rg(l);
             vpls->normal_radiance[i].w = shared::pg_pack_vpl_radiance_b_info(l, vpls->info[i]);
+            if (vpls->for_bus) {
+              // The VPL as it crosses the bus (include/rtpg/guiding_layout.h, "Packed VPLs"):
+              // the distance and normal written at the hit, where there was one.
+              vpls->packed.radiance[i] = shared::pg_pack_rgbe(l);
+              if ((vpls->info[i] & PG_VPL_VALID) == 0u) vpls->packed.distance[i] = 0u;
+            }
           }
         }
         return bad;

@@ -73,6 +73,7 @@ void Renderer::set_first_bounce_sampler(std::unique_ptr<FirstBounceSampler> samp
   }
   sampler->expect_queries({settings_.path_tracer.first_bounce_mis == FirstBounceMis::mixture,
                            settings_.path_tracer.guide_secondary});
+  vpls_.for_bus = sampler->sends_packed_vpls();
   sampler_ = std::move(sampler);
 }
 

@@ -16,13 +16,22 @@ namespace rtpg {
 struct VplBuffer {
 #define RTPG_HOST_CHANNEL(name, type, bytes) std::vector<shared::type> name;
   PG_VPL_CHANNELS(RTPG_HOST_CHANNEL)
-#undef RTPG_HOST_CHANNEL
   std::vector<std::uint32_t> info;  // PG_VPL_* bits, the strategy in bits 8..15
   // Host only, from the first bounce to its hit: the density (solid angle at x0) of the
   // strategy that drew the direction, which becomes position.w in area measure at the hit.
   // Kept apart so that the path tracer writes position, normal and mixture density once, at
   // the hit, instead of some at x0 and the rest at y (docs/guiding.md, "The VPLs written once").
   std::vector<float> strategy_pdf;
+
+  // The VPLs as they cross the bus (PG_PACKED_VPL_CHANNELS: distance, radiance, normal), which
+  // the path tracer writes beside the layout where for_bus is set (the guided first bounce with
+  // HostTransfer::packed): at the hit and in the final gather it has the distance, the normal
+  // and the radiance at hand, where packing them costs a fraction of packing the layout
+  // afterwards (docs/guiding.md, "The bus at 46 bytes a pixel"). Invalid VPLs have distance 0.
+  bool for_bus = false;
+  struct Packed {
+    PG_PACKED_VPL_CHANNELS(RTPG_HOST_CHANNEL)
+  } packed;
 
   // Every VPL invalid: info 0. Each frame's path tracer calls it, so only a new size zeroes
   // every channel; otherwise the channels keep last frame's values, read by nobody before the
@@ -33,5 +42,6 @@ struct VplBuffer {
   // (docs/host-path-tracer.md, "Empty shadow rays skipped; per-frame fills").
   void resize(std::size_t n);
 };
+#undef RTPG_HOST_CHANNEL
 
 }  // namespace rtpg

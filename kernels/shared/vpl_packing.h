@@ -57,7 +57,9 @@ PG_FN uint pg_vpl_info(uint4 packed) {
 }
 
 /* ---- The VPLs on the bus (include/rtpg/guiding_layout.h, "Packed VPLs") ------------------
- * The host sends a VPL's distance from the pixel's point x0, its normal and its radiance; the
+ * The host sends a VPL's distance from the pixel's point x0 (+infinity for an escaped ray, 0 for
+ * no VPL), its normal (pg_pack_unit_vector8) and its radiance (pg_pack_rgbe), which the path
+ * tracer writes where it finds them (host/render/vpl_buffer.h, VplBuffer::packed); the
  * device puts y at that distance along the direction it sampled for the pixel (sample 0's
  * direction_pdf), and takes the densities from that sample: D, and the strategy's (the BSDF's
  * density at the direction for a BSDF sample, which the unpack kernel evaluates with its
@@ -74,20 +76,6 @@ typedef struct {
   float4 position;
   uint4 normal_radiance;
 } pg_vpl;
-
-/* What the host sends: x0 the pixel's point (the G-buffer's position). */
-PG_FN uint pg_pack_vpl_distance(float4 position, uint4 normal_radiance, float3 x0) {
-  uint info = pg_vpl_info(normal_radiance);
-  if ((info & PG_VPL_VALID) == 0u) return 0u;
-  if ((info & PG_VPL_DISTANT) != 0u) return 0x7f800000u; /* +infinity */
-  return as_uint(length(pg_float4_xyz(position) - x0));
-}
-PG_FN uint pg_pack_vpl_bus_radiance(uint4 normal_radiance) {
-  return pg_pack_rgbe(pg_vpl_radiance(normal_radiance));
-}
-PG_FN uint pg_pack_vpl_bus_normal(uint4 normal_radiance) {
-  return pg_pack_unit_vector8(pg_vpl_normal(normal_radiance));
-}
 
 /* What the device rebuilds: x0 its pixel's point, direction_pdf and strategy the pixel's first
  * sample (PG_SAMPLE_CHANNELS), bsdf_pdf the BSDF's solid-angle density at that direction (read

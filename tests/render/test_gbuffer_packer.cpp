@@ -192,5 +192,29 @@ TEST(GBufferPacker, PackedTransferRefusesAMaterialIdThatDoesNotFit) {
   EXPECT_NO_THROW(sampler.begin_frame(g, SampleCoordinates{1, 2, 0}));
 }
 
+// The guided first bounce with --host-transfer packed sends the VPLs in the form the path
+// tracer writes beside the layout (VplBuffer::for_bus, which the renderer sets from
+// sends_packed_vpls()); VPLs without it are refused, naming the flag, not sent as garbage.
+TEST(GBufferPacker, PackedTransferRefusesVplsNotPackedForTheBus) {
+  ClRuntime cl;
+  const GBuffer g = varied_gbuffer(19, 7, 5);
+  GuidedFirstBounce sampler(cl, 19, 7, GuidingSettings{}, HostTransfer::packed, Overlap::off);
+  EXPECT_TRUE(sampler.sends_packed_vpls());
+  const SampleCoordinates at{1, 0, 0};
+  sampler.begin_frame(g, at);
+  sampler.sample(g, at);
+  VplBuffer vpls;
+  vpls.resize(g.pixel_count());
+  try {
+    sampler.end_frame(g, vpls, at);
+    ADD_FAILURE() << "no GuiderError";
+  } catch (const GuiderError& e) {
+    EXPECT_NE(std::string(e.what()).find("for_bus"), std::string::npos) << e.what();
+  }
+  vpls.for_bus = true;
+  vpls.resize(g.pixel_count());  // every VPL invalid: distance 0
+  EXPECT_NO_THROW(sampler.end_frame(g, vpls, at));
+}
+
 }  // namespace
 }  // namespace rtpg
