@@ -257,6 +257,26 @@ std::array<double, 4> Guider::sum_count_records(const cl::Buffer& records, std::
   return sum;
 }
 
+void Guider::run_per_pixel(cl::Kernel& kernel, const char* file, const char* name,
+                           const std::function<void(KernelArgs&)>& arguments, Wait wait,
+                           double* ms) {
+  if (kernel() == nullptr) kernel = runtime_.kernel(file, name);
+  KernelArgs args(kernel);
+  arguments(args);
+  const std::size_t n = static_cast<std::size_t>(width_) * height_;
+  const std::size_t group = std::min<std::size_t>(
+      64, kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
+  run(kernel, cl::NDRange((n + group - 1) / group * group), cl::NDRange(group), wait, ms);
+}
+
+void Guider::require_kernel_access(const cl::Buffer& buffer, cl_mem_flags flag,
+                                   const std::string& what) {
+  translate_cl_errors([&] {
+    if (buffer.getInfo<CL_MEM_FLAGS>() & flag)
+      throw GuiderError(what + " (made without KernelAccess::read_write)");
+  });
+}
+
 void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out,
                             const pg_gbuffer_cameras& cameras, Wait wait) {
 #define RTPG_CHECK(name, type, bytes) check_buffer(packed.name, bytes, "packed." #name);
@@ -267,23 +287,19 @@ void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuff
     throw GuiderError("unpack_gbuffer: the cameras' image is " + std::to_string(cameras.width) +
                       "x" + std::to_string(cameras.height) + ", the guider's " +
                       std::to_string(width_) + "x" + std::to_string(height_));
+  require_kernel_access(out.position_depth, CL_MEM_READ_ONLY,
+                        "unpack_gbuffer: the G-buffer to write is read-only for kernels");
   translate_cl_errors([&] {
-    if (out.position_depth.getInfo<CL_MEM_FLAGS>() & CL_MEM_READ_ONLY)
-      throw GuiderError(
-          "unpack_gbuffer: the G-buffer to write is read-only for kernels (make it with "
-          "KernelAccess::read_write)");
-    if (unpack_() == nullptr) unpack_ = runtime_.kernel("unpack_gbuffer.cl", "unpack_gbuffer");
-    const std::size_t n = static_cast<std::size_t>(width_) * height_;
-    KernelArgs args(unpack_);
+    run_per_pixel(
+        unpack_, "unpack_gbuffer.cl", "unpack_gbuffer",
+        [&](KernelArgs& args) {
 #define RTPG_ARG(name, type, bytes) args << packed.name;
-    PG_PACKED_GBUFFER_CHANNELS(RTPG_ARG)
+          PG_PACKED_GBUFFER_CHANNELS(RTPG_ARG)
 #undef RTPG_ARG
-    args << out << static_cast<cl_uint>(n) << cameras;
-    // One work-item a pixel in groups of up to 64 (any size works: the kernel checks its bound).
-    const std::size_t group = std::min<std::size_t>(
-        64, unpack_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
-    run(unpack_, cl::NDRange((n + group - 1) / group * group), cl::NDRange(group), wait,
-        &times_.unpack_ms);
+          args << out << static_cast<cl_uint>(static_cast<std::size_t>(width_) * height_)
+               << cameras;
+        },
+        wait, &times_.unpack_ms);
   });
 }
 
@@ -294,24 +310,19 @@ void Guider::pack_samples(const GuiderSamples& samples, const GuiderPackedSample
 #define RTPG_CHECK(name, type, bytes) check_buffer(out.name, bytes, "packed." #name);
   PG_PACKED_SAMPLE_CHANNELS(RTPG_CHECK)
 #undef RTPG_CHECK
+  require_kernel_access(samples.direction_pdf, CL_MEM_WRITE_ONLY,
+                        "pack_samples: the samples are write-only for kernels");
   translate_cl_errors([&] {
-    if (samples.direction_pdf.getInfo<CL_MEM_FLAGS>() & CL_MEM_WRITE_ONLY)
-      throw GuiderError(
-          "pack_samples: the samples are write-only for kernels (make them with "
-          "KernelAccess::read_write)");
-    if (pack_samples_() == nullptr)
-      pack_samples_ = runtime_.kernel("pack_samples.cl", "pack_samples");
-    const std::size_t n = static_cast<std::size_t>(width_) * height_;
-    KernelArgs args(pack_samples_);
-    args << samples;
+    run_per_pixel(
+        pack_samples_, "pack_samples.cl", "pack_samples",
+        [&](KernelArgs& args) {
+          args << samples;
 #define RTPG_ARG(name, type, bytes) args << out.name;
-    PG_PACKED_SAMPLE_CHANNELS(RTPG_ARG)
+          PG_PACKED_SAMPLE_CHANNELS(RTPG_ARG)
 #undef RTPG_ARG
-    args << static_cast<cl_uint>(n);
-    const std::size_t group = std::min<std::size_t>(
-        64, pack_samples_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
-    run(pack_samples_, cl::NDRange((n + group - 1) / group * group), cl::NDRange(group), wait,
-        &times_.pack_samples_ms);
+          args << static_cast<cl_uint>(static_cast<std::size_t>(width_) * height_);
+        },
+        wait, &times_.pack_samples_ms);
   });
 }
 
@@ -328,27 +339,22 @@ void Guider::unpack_vpls(const GuiderPackedVpls& packed, const GuiderGBuffer& gb
 #define RTPG_CHECK(name, type, bytes) check_buffer(out.name, bytes, "unpacked." #name);
   PG_VPL_CHANNELS(RTPG_CHECK)
 #undef RTPG_CHECK
+  require_kernel_access(out.position, CL_MEM_READ_ONLY,
+                        "unpack_vpls: the VPLs to write are read-only for kernels");
+  require_kernel_access(first_samples.direction_pdf, CL_MEM_WRITE_ONLY,
+                        "unpack_vpls: the first samples are write-only for kernels");
   translate_cl_errors([&] {
-    if (out.position.getInfo<CL_MEM_FLAGS>() & CL_MEM_READ_ONLY)
-      throw GuiderError(
-          "unpack_vpls: the VPLs to write are read-only for kernels (make them with "
-          "KernelAccess::read_write)");
-    if (first_samples.direction_pdf.getInfo<CL_MEM_FLAGS>() & CL_MEM_WRITE_ONLY)
-      throw GuiderError(
-          "unpack_vpls: the first samples are write-only for kernels (make them with "
-          "KernelAccess::read_write)");
-    if (unpack_vpls_() == nullptr) unpack_vpls_ = runtime_.kernel("unpack_vpls.cl", "unpack_vpls");
-    const std::size_t n = static_cast<std::size_t>(width_) * height_;
-    KernelArgs args(unpack_vpls_);
-    args << gbuffer;
+    run_per_pixel(
+        unpack_vpls_, "unpack_vpls.cl", "unpack_vpls",
+        [&](KernelArgs& args) {
+          args << gbuffer;
 #define RTPG_ARG(name, type, bytes) args << packed.name;
-    PG_PACKED_VPL_CHANNELS(RTPG_ARG)
+          PG_PACKED_VPL_CHANNELS(RTPG_ARG)
 #undef RTPG_ARG
-    args << first_samples << out << static_cast<cl_uint>(n);
-    const std::size_t group = std::min<std::size_t>(
-        64, unpack_vpls_.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(runtime_.device()));
-    run(unpack_vpls_, cl::NDRange((n + group - 1) / group * group), cl::NDRange(group), wait,
-        &times_.unpack_vpls_ms);
+          args << first_samples << out
+               << static_cast<cl_uint>(static_cast<std::size_t>(width_) * height_);
+        },
+        wait, &times_.unpack_vpls_ms);
   });
 }
 

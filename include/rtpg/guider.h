@@ -23,6 +23,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -226,6 +227,8 @@ struct GuiderTimes {
   double unpack_vpls_ms = 0.0;                                 // the last unpack_vpls()
 };
 
+class KernelArgs;  // host/guiding/kernel_args.h
+
 class Guider {
  public:
   // Throws GuiderError when the settings are out of range (validate()) or cannot run on the
@@ -327,6 +330,15 @@ class Guider {
   // leaves that to wait_for_kernels().
   void run(cl::Kernel& kernel, const cl::NDRange& global, const cl::NDRange& local, Wait wait,
            double* ms);
+  // The transfer kernels (unpack_gbuffer, pack_samples, unpack_vpls): one work-item a pixel over
+  // the image in groups of up to 64 (any size works: each kernel checks its bound), the kernel
+  // built from `file` at its first call, its arguments set by `arguments`.
+  void run_per_pixel(cl::Kernel& kernel, const char* file, const char* name,
+                     const std::function<void(KernelArgs&)>& arguments, Wait wait, double* ms);
+  // Throws GuiderError naming `what` where `buffer` was made with `flag` (CL_MEM_READ_ONLY for a
+  // buffer a kernel writes, CL_MEM_WRITE_ONLY for one it reads).
+  static void require_kernel_access(const cl::Buffer& buffer, cl_mem_flags flag,
+                                    const std::string& what);
   // Reads a kernel's count records (one float4 per work-group) and sums each component.
   std::array<double, 4> sum_count_records(const cl::Buffer& records, std::size_t groups);
 
