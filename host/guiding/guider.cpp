@@ -418,6 +418,7 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
                                           train_launch_.local, nullptr, &train_done_);
     runtime_.queue().flush();  // so that it starts now, not at the next blocking call
     train_pending_ = true;
+    pending_before_train_ = pending_.size();
   });
 }
 
@@ -427,6 +428,14 @@ void Guider::wait_for_training() {
   translate_cl_errors([&] {
     train_done_.wait();
     times_.train_ms = ClRuntime::event_ms(train_done_);
+    // What was enqueued before the training (unpack_vpls, its input) is done too: the queue is
+    // in order. Its times are recorded and its events released here, so that a caller who only
+    // ever waits for the training does not collect them frame after frame.
+    for (std::size_t k = 0; k < pending_before_train_; ++k)
+      *pending_[k].second = ClRuntime::event_ms(pending_[k].first);
+    pending_.erase(pending_.begin(),
+                   pending_.begin() + static_cast<std::ptrdiff_t>(pending_before_train_));
+    pending_before_train_ = 0;
   });
 }
 

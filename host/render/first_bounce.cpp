@@ -3,29 +3,10 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <cmath>
-
 #include "rtpg/guiding_layout.h"
 #include "shared/rng.h"
-#include "shared/sample_packing.h"
 
 namespace rtpg {
-
-FirstBounceSample FirstBounceSamples::at(std::size_t i) const {
-  FirstBounceSample s;
-  if (direction_pdf != nullptr) {
-    const glm::vec4 d = direction_pdf[i];
-    s.direction = glm::vec3(d);
-    s.pdf = d.w;
-    s.strategy = strategy[i];
-  } else {
-    s.direction = shared::pg_unpack_direction(packed_direction[i]);
-    s.pdf = shared::pg_sample_density_of(packed_pdf_strategy[i]);
-    s.strategy = shared::pg_sample_strategy_of(packed_pdf_strategy[i]);
-  }
-  if (!std::isfinite(s.pdf)) s.pdf = 0.0f;  // no sample
-  return s;
-}
 
 FirstBounceSample bsdf_first_bounce_sample(const shared::pg_frame& frame, const glm::vec3& wo,
                                            const shared::pg_lobes& lobes,

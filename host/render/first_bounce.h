@@ -3,6 +3,7 @@
 // with the mixture of the paper (eq. 2) without touching the rest of the path tracer.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -13,6 +14,7 @@
 #include "render/gbuffer.h"
 #include "rtpg/guiding_layout.h"
 #include "shared/pmm.h"
+#include "shared/sample_packing.h"
 
 namespace rtpg {
 
@@ -44,7 +46,22 @@ struct FirstBounceSamples {
   const std::uint32_t* strategy = nullptr;
   const glm::vec2* packed_direction = nullptr;
   const float* packed_pdf_strategy = nullptr;
-  FirstBounceSample at(std::size_t i) const;
+  // Inline: the path tracer reads every pixel's sample through it.
+  FirstBounceSample at(std::size_t i) const {
+    FirstBounceSample s;
+    if (direction_pdf != nullptr) {
+      const glm::vec4 d = direction_pdf[i];
+      s.direction = glm::vec3(d);
+      s.pdf = d.w;
+      s.strategy = strategy[i];
+    } else {
+      s.direction = shared::pg_unpack_direction(packed_direction[i]);
+      s.pdf = shared::pg_sample_density_of(packed_pdf_strategy[i]);
+      s.strategy = shared::pg_sample_strategy_of(packed_pdf_strategy[i]);
+    }
+    if (!std::isfinite(s.pdf)) s.pdf = 0.0f;  // no sample
+    return s;
+  }
 };
 
 struct SampleCoordinates {

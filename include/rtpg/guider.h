@@ -372,6 +372,7 @@ class Guider {
   bool train_pending_ = false;
   // The other kernels enqueued with Wait::later, and where each one's time goes (in times_).
   std::vector<std::pair<cl::Event, double*>> pending_;
+  std::size_t pending_before_train_ = 0;  // of pending_, those enqueued before the training
   GuiderTimes times_;
 };
 

@@ -1449,6 +1449,7 @@ TEST(GuidingKernels, PackSamplesMatchesTheHostPacking) {
 // radiance and info words bit for bit, the position and the densities within the rounding of the
 // device's square roots and divisions (and of its BSDF density for a BSDF sample), the normal
 // within 1e-4 rad of the host's (its 8-bit code decoded and packed again in 16 bits).
+// Overlapped with the training, its time is recorded when the training is waited for.
 TEST(GuidingKernels, UnpackVplsMatchesTheHostUnpack) {
   ClRuntime rt;
   Random r(1010);
@@ -1533,6 +1534,16 @@ TEST(GuidingKernels, UnpackVplsMatchesTheHostUnpack) {
       EXPECT_GT(valid, n / 2);
       EXPECT_GT(distant, 0u);
     }
+    // Left running before an overlapped training (Wait::later), its time is recorded once the
+    // training is waited for, with nothing else waited for (the renderer's order where only the
+    // training overlaps the next frame).
+    Guider overlapped(rt, w, h);
+    overlapped.unpack_vpls(packed, dg, samples, out, Guider::Wait::later);
+    overlapped.train(dg, out, 7u, 1u, Guider::Wait::later);
+    EXPECT_EQ(overlapped.last_times().unpack_vpls_ms, 0.0);
+    overlapped.wait_for_training();
+    EXPECT_GT(overlapped.last_times().unpack_vpls_ms, 0.0);
+    EXPECT_GT(overlapped.last_times().train_ms, 0.0);
   }
 }
 

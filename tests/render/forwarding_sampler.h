@@ -23,6 +23,7 @@ class ForwardingSampler : public FirstBounceSampler {
     inner_->end_frame(g, v, at);
   }
   bool wants_vpls() const override { return inner_->wants_vpls(); }
+  bool sends_packed_vpls() const override { return inner_->sends_packed_vpls(); }
   bool reads_gbuffers_in_place() const override { return inner_->reads_gbuffers_in_place(); }
   void report(std::map<std::string, double>& time_ms,
               std::map<std::string, double>& extra) override {
