@@ -57,6 +57,7 @@
 #include "bench_roofline.h"
 
 #include <map>
+#include <memory>
 #include <random>
 #include <tuple>
 
@@ -67,9 +68,11 @@
 #include "rtpg/guider.h"
 #include "support/guiding_buffers.h"
 #include "rtpg/guiding_layout.h"
+#include "shared/gbuffer_packing.h"
 #include "shared/guiding_pixel.h"
 #include "shared/pmm.h"
 #include "shared/pmm_train.h"
+#include "shared/vpl_packing.h"
 
 namespace rtpg::bench {
 namespace {
@@ -754,6 +757,150 @@ void BM_FrameTraffic(benchmark::State& state, int w, int h, bool pinned) {
       static_cast<double>(kBytes * in.n) * it / (ms_total * 1e-3) * 1e-9;
 }
 
+// ---- the transfer kernels (HostTransfer::packed) ----------------------------------------------
+
+// Transfer/<kernel>/WxH: the three kernels of the packed bus (include/rtpg/guiding_layout.h,
+// "Packed ..."), each from its profiled launches, with its roofline like the guiding kernels'.
+// Bytes and flops per pixel as counted beside each kernel (kernels/unpack_gbuffer.cl,
+// pack_samples.cl, unpack_vpls.cl): divisions, square roots and the hash's integer work count
+// one each; for unpack_vpls the BSDF's density only on the pixels whose first sample is the
+// BSDF's (half of these).
+enum class Transfer { UnpackGBuffer, PackSamples, UnpackVpls };
+
+struct TransferInputs {
+  GuiderPackedGBuffer packed_gbuffer;
+  GuiderGBuffer unpacked;
+  pg_gbuffer_cameras cameras{};
+  GuiderSamples samples;
+  GuiderPackedSamples packed_samples;
+  GuiderPackedVpls packed_vpls;
+  GuiderVpls vpls;
+  double bsdf_fraction = 0.0;  // of the pixels, those whose VPL takes the BSDF's density
+  std::unique_ptr<Guider> guider;
+};
+
+rtpg::pg_pinhole_camera transfer_camera(float3 from, float3 at, float aspect) {
+  const float3 f = sh::normalize(at - from);
+  const float3 r = sh::normalize(sh::cross(f, float3(0, 1, 0)));
+  const float3 u = sh::cross(r, f);
+  return {from.x, from.y, from.z, r.x, r.y, r.z, u.x, u.y, u.z, f.x, f.y, f.z, 0.6f, aspect};
+}
+
+TransferInputs& transfer_inputs(int w, int h) {
+  static std::map<std::pair<int, int>, std::unique_ptr<TransferInputs>> cache;
+  auto& slot = cache[{w, h}];
+  if (slot) return *slot;
+  Inputs& in = inputs_for(w, h);
+  auto t = std::make_unique<TransferInputs>();
+  cl::Context& ctx = runtime().context();
+  cl::CommandQueue& q = runtime().queue();
+  const std::size_t n = in.n;
+  std::mt19937 gen(31);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+  // The synthetic G-buffer packed, seen by a camera moving over it with jitter.
+  std::vector<sh::uint4> surface(n);
+  std::vector<sh::uint2> shading(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    surface[i] = sh::pg_pack_gbuffer_surface(in.cur.position_depth[i], in.cur.shading_normal[i],
+                                             in.cur.base_color_roughness[i]);
+    shading[i] = sh::pg_pack_gbuffer_shading(in.cur.metallic_specular[i], in.cur.flags[i],
+                                             in.cur.material[i]);
+  }
+  const float aspect = static_cast<float>(w) / static_cast<float>(h);
+  t->cameras = {transfer_camera(float3(1.0f, 1.0f, 4.0f), float3(1.0f, 1.0f, 0.0f), aspect),
+                transfer_camera(float3(1.1f, 0.9f, 4.1f), float3(1.0f, 1.0f, 0.0f), aspect),
+                w,
+                h,
+                1,
+                1,
+                7u,
+                3u};
+  t->packed_gbuffer = make_guider_packed_gbuffer(ctx, w, h);
+  q.enqueueWriteBuffer(t->packed_gbuffer.surface, CL_TRUE, 0, n * 16, surface.data());
+  q.enqueueWriteBuffer(t->packed_gbuffer.shading, CL_TRUE, 0, n * 8, shading.data());
+  t->unpacked = make_guider_gbuffer(ctx, w, h, 0, KernelAccess::read_write);
+  // First samples around each pixel's normal, half the BSDF's; VPLs at, beyond and without hits.
+  std::vector<float4> direction_pdf(n), zeros4(n, float4(0.0f));
+  std::vector<float2> zeros2(n, float2(0.0f));
+  std::vector<std::uint32_t> strategy(n), distance(n), radiance(n);
+  std::vector<std::uint16_t> normal(n);
+  std::size_t bsdf = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const float3 wi = tilt(gen, float3(in.cur.shading_normal[i]), 80.0f);
+    direction_pdf[i] = float4(wi.x, wi.y, wi.z, 0.05f + 5.0f * u01(gen));
+    strategy[i] = u01(gen) < 0.5f ? PG_STRATEGY_BSDF : PG_STRATEGY_GUIDE;
+    bsdf += strategy[i] == PG_STRATEGY_BSDF;
+    const float v = u01(gen);
+    distance[i] = sh::as_uint(v < 0.1f ? 0.0f : v < 0.2f ? INFINITY : 0.1f + 5.0f * u01(gen));
+    radiance[i] = sh::pg_pack_rgbe(float3(u01(gen), u01(gen), 3.0f * u01(gen)));
+    normal[i] = static_cast<std::uint16_t>(sh::pg_pack_unit_vector8(-tilt(gen, wi, 80.0f)));
+  }
+  t->bsdf_fraction = static_cast<double>(bsdf) / static_cast<double>(n);
+  t->samples = make_guider_samples(ctx, w, h, 0, KernelAccess::read_write);
+  q.enqueueWriteBuffer(t->samples.direction_pdf, CL_TRUE, 0, n * 16, direction_pdf.data());
+  q.enqueueWriteBuffer(t->samples.strategy, CL_TRUE, 0, n * 4, strategy.data());
+  q.enqueueWriteBuffer(t->samples.mixture_a, CL_TRUE, 0, n * 16, zeros4.data());
+  q.enqueueWriteBuffer(t->samples.mixture_b, CL_TRUE, 0, n * 8, zeros2.data());
+  t->packed_samples = make_guider_packed_samples(ctx, w, h);
+  t->packed_vpls = make_guider_packed_vpls(ctx, w, h);
+  q.enqueueWriteBuffer(t->packed_vpls.distance, CL_TRUE, 0, n * 4, distance.data());
+  q.enqueueWriteBuffer(t->packed_vpls.radiance, CL_TRUE, 0, n * 4, radiance.data());
+  q.enqueueWriteBuffer(t->packed_vpls.normal, CL_TRUE, 0, n * 2, normal.data());
+  t->vpls = make_guider_vpls(ctx, w, h, 0, KernelAccess::read_write);
+  t->guider = std::make_unique<Guider>(runtime(), w, h);
+  slot = std::move(t);
+  return *slot;
+}
+
+double launch_transfer(TransferInputs& t, const Inputs& in, Transfer kernel) {
+  Guider& g = *t.guider;
+  switch (kernel) {
+    case Transfer::UnpackGBuffer:
+      g.unpack_gbuffer(t.packed_gbuffer, t.unpacked, t.cameras);
+      return g.last_times().unpack_ms;
+    case Transfer::PackSamples:
+      g.pack_samples(t.samples, t.packed_samples);
+      return g.last_times().pack_samples_ms;
+    case Transfer::UnpackVpls:
+      g.unpack_vpls(t.packed_vpls, in.d_cur, t.samples, t.vpls);
+      return g.last_times().unpack_vpls_ms;
+  }
+  return 0.0;
+}
+
+void BM_TransferKernel(benchmark::State& state, Transfer kernel, int w, int h) {
+  Inputs& in = inputs_for(w, h);
+  TransferInputs& t = transfer_inputs(w, h);
+  launch_transfer(t, in, kernel);  // first launch: compile the work-group function
+  Copy& c = copy();
+  FmaPeak& f = fma_peak16();
+  double kernel_ms = 0.0, copy_ms = 0.0, fma_ms = 0.0;
+  for (auto _ : state) {
+    const double ms = launch_transfer(t, in, kernel);
+    state.SetIterationTime(ms * 1e-3);
+    kernel_ms += ms;
+    copy_ms += c.run();
+    fma_ms += f.run();
+  }
+  // Per pixel (the counts beside the kernels).
+  const double b = t.bsdf_fraction;
+  const double bytes_per_pixel = kernel == Transfer::UnpackGBuffer ? 24.0 + 96.0
+                                 : kernel == Transfer::PackSamples
+                                     ? 20.0 + 12.0
+                                     : 10.0 + 20.0 + 16.0 + 64.0 * b + 32.0;
+  const double flops_per_pixel = kernel == Transfer::UnpackGBuffer ? 130.0
+                                 : kernel == Transfer::PackSamples ? 15.0
+                                                                   : 60.0 + 190.0 * b;
+  const double n = static_cast<double>(in.n), it = static_cast<double>(state.iterations());
+  const double bound_ms =
+      roofline_ms(bytes_per_pixel * n, flops_per_pixel * n, copy_ms, fma_ms, it);
+  state.SetItemsProcessed(static_cast<std::int64_t>(in.n) * state.iterations());
+  state.counters["bytes_per_pixel"] = bytes_per_pixel;
+  state.counters["flops_per_pixel"] = flops_per_pixel;
+  state.counters["roofline_ms"] = bound_ms;
+  state.counters["roofline_fraction"] = bound_ms / (kernel_ms / it);
+}
+
 // ---- registration ----------------------------------------------------------------------------
 
 void register_all(bool full) {
@@ -806,6 +953,17 @@ void register_all(bool full) {
                                     (pinned ? "/pinned" : "/pageable"))
                                        .c_str(),
                                    BM_FrameTraffic, w, h, pinned)
+          ->UseManualTime()
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(0.2);
+  for (auto [w, h] : std::vector<std::pair<int, int>>{{960, 540}, {1920, 1080}})
+    for (auto [name, kernel] :
+         std::vector<std::pair<std::string, Transfer>>{{"UnpackGBuffer", Transfer::UnpackGBuffer},
+                                                       {"PackSamples", Transfer::PackSamples},
+                                                       {"UnpackVpls", Transfer::UnpackVpls}})
+      benchmark::RegisterBenchmark(
+          ("Transfer/" + name + "/" + std::to_string(w) + "x" + std::to_string(h)).c_str(),
+          BM_TransferKernel, kernel, w, h)
           ->UseManualTime()
           ->Unit(benchmark::kMillisecond)
           ->MinTime(0.2);
