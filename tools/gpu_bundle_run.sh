@@ -57,7 +57,7 @@ fi
 if [ -z "${NO_BENCH:-}" ]; then
   # One repetition: on a GPU each configuration is already the mean of thousands of launches.
   "$dir/bin/bench_guiding_kernels" --benchmark_repetitions=1 \
-    --benchmark_filter="${BENCH_FILTER:-^(CopyFloat4|FmaPeak|(Reproject|Sample|Train)/1280x720/local:auto(/memory:global)?/min|FrameTraffic/960x540)}" \
+    --benchmark_filter="${BENCH_FILTER:-^(CopyFloat4|FmaPeak|(Reproject|Sample|Train)/1280x720/local:auto(/memory:global)?/min|FrameTraffic/960x540|Transfer/.*/960x540)}" \
     --benchmark_out="$out/bench.json" --benchmark_out_format=json > "$out/bench.log" 2>&1
   grep -E 'manual_time|ERROR' "$out/bench.log"
 fi

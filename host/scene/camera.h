@@ -32,8 +32,11 @@ struct CameraSetup {
 
 // The matrices a frame needs: world -> camera and camera -> image plane.
 struct CameraFrame {
-  glm::vec3 position;
-  glm::vec3 right, up, forward;  // orthonormal, right-handed, forward = view direction
+  // The defaults (a camera at the origin looking down -z) only keep a default-constructed frame
+  // defined (GBuffer::camera before a renderer set it); make_camera_frame sets every field.
+  glm::vec3 position{0.0f};
+  glm::vec3 right{1.0f, 0.0f, 0.0f}, up{0.0f, 1.0f, 0.0f},
+      forward{0.0f, 0.0f, -1.0f};  // orthonormal, right-handed, forward = view direction
   float tan_half_fov_y = 0.0f;
   float aspect = 1.0f;  // width / height
   // Ray direction through film point (sx, sy) in [0,1]^2, (0,0) = top-left corner. Inline:
