@@ -25,64 +25,49 @@ std::size_t pixels(int width, int height) {
 
 }  // namespace
 
+// What every make_guider_* does: each channel of `list` allocated for width x height pixels,
+// with the kernels' access `kernel_flags` and the caller's host_flags.
 #define RTPG_ALLOCATE(name, type, bytes) b.name = cl::Buffer(context, flags, n * (bytes));
+#define RTPG_ALLOCATE_CHANNELS(Buffers, list, kernel_flags) \
+  const std::size_t n = pixels(width, height);              \
+  const cl_mem_flags flags = (kernel_flags) | host_flags;   \
+  Buffers b;                                                \
+  translate_cl_errors([&] { list(RTPG_ALLOCATE) });         \
+  return b;
+
+namespace {
+// read_write, else what the kernels do with such buffers otherwise (read or write only).
+cl_mem_flags kernel_access(KernelAccess access, cl_mem_flags otherwise) {
+  return access == KernelAccess::read_write ? CL_MEM_READ_WRITE : otherwise;
+}
+}  // namespace
 
 GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height,
-                                  cl_mem_flags host_flags, KernelAccess access) {
-  const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags =
-      (access == KernelAccess::read_write ? CL_MEM_READ_WRITE : CL_MEM_READ_ONLY) | host_flags;
-  GuiderGBuffer b;
-  translate_cl_errors([&] { PG_GBUFFER_CHANNELS(RTPG_ALLOCATE) });
-  return b;
-}
+                                  cl_mem_flags host_flags, KernelAccess access){
+    RTPG_ALLOCATE_CHANNELS(GuiderGBuffer, PG_GBUFFER_CHANNELS,
+                           kernel_access(access, CL_MEM_READ_ONLY))}
 
 GuiderPackedGBuffer make_guider_packed_gbuffer(cl::Context& context, int width, int height,
-                                               cl_mem_flags host_flags) {
-  const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags = CL_MEM_READ_ONLY | host_flags;
-  GuiderPackedGBuffer b;
-  translate_cl_errors([&] { PG_PACKED_GBUFFER_CHANNELS(RTPG_ALLOCATE) });
-  return b;
-}
+                                               cl_mem_flags host_flags){
+    RTPG_ALLOCATE_CHANNELS(GuiderPackedGBuffer, PG_PACKED_GBUFFER_CHANNELS, CL_MEM_READ_ONLY)}
 
 GuiderPackedSamples make_guider_packed_samples(cl::Context& context, int width, int height,
-                                               cl_mem_flags host_flags) {
-  const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags = CL_MEM_WRITE_ONLY | host_flags;
-  GuiderPackedSamples b;
-  translate_cl_errors([&] { PG_PACKED_SAMPLE_CHANNELS(RTPG_ALLOCATE) });
-  return b;
-}
+                                               cl_mem_flags host_flags){
+    RTPG_ALLOCATE_CHANNELS(GuiderPackedSamples, PG_PACKED_SAMPLE_CHANNELS, CL_MEM_WRITE_ONLY)}
 
 GuiderVpls make_guider_vpls(cl::Context& context, int width, int height, cl_mem_flags host_flags,
-                            KernelAccess access) {
-  const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags =
-      (access == KernelAccess::read_write ? CL_MEM_READ_WRITE : CL_MEM_READ_ONLY) | host_flags;
-  GuiderVpls b;
-  translate_cl_errors([&] { PG_VPL_CHANNELS(RTPG_ALLOCATE) });
-  return b;
-}
+                            KernelAccess access){
+    RTPG_ALLOCATE_CHANNELS(GuiderVpls, PG_VPL_CHANNELS, kernel_access(access, CL_MEM_READ_ONLY))}
 
-GuiderPackedVpls make_guider_packed_vpls(cl::Context& context, int width, int height,
-                                         cl_mem_flags host_flags) {
-  const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags = CL_MEM_READ_ONLY | host_flags;
-  GuiderPackedVpls b;
-  translate_cl_errors([&] { PG_PACKED_VPL_CHANNELS(RTPG_ALLOCATE) });
-  return b;
-}
+GuiderPackedVpls
+    make_guider_packed_vpls(cl::Context& context, int width, int height, cl_mem_flags host_flags){
+        RTPG_ALLOCATE_CHANNELS(GuiderPackedVpls, PG_PACKED_VPL_CHANNELS, CL_MEM_READ_ONLY)}
 
 GuiderSamples make_guider_samples(cl::Context& context, int width, int height,
-                                  cl_mem_flags host_flags, KernelAccess access) {
-  const std::size_t n = pixels(width, height);
-  const cl_mem_flags flags =
-      (access == KernelAccess::read_write ? CL_MEM_READ_WRITE : CL_MEM_WRITE_ONLY) | host_flags;
-  GuiderSamples b;
-  translate_cl_errors([&] { PG_SAMPLE_CHANNELS(RTPG_ALLOCATE) });
-  return b;
-}
+                                  cl_mem_flags host_flags, KernelAccess access){
+    RTPG_ALLOCATE_CHANNELS(GuiderSamples, PG_SAMPLE_CHANNELS,
+                           kernel_access(access, CL_MEM_WRITE_ONLY))}
+#undef RTPG_ALLOCATE_CHANNELS
 
 Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings& settings)
     : runtime_(runtime),
