@@ -8,7 +8,7 @@
  * vector (within PG_OCTAHEDRAL_MAX_ANGLE); base colour, roughness, metallic and specular as half
  * floats (relative error at most 2^-11). The position, the view direction and the motion vector
  * do not travel: the device follows the pixel's camera ray, the renderer's own, to the depth
- * (pg_gbuffer_camera_ray, pg_unpack_gbuffer_position_depth), which puts the point within a few
+ * (pg_gbuffer_camera_ray, pg_gbuffer_position_depth), which puts the point within a few
  * units in the last place of the host's (the host interpolates it from the triangle's corners),
  * and projects it into last frame's camera (pg_gbuffer_motion). The device samples the first
  * bounce with its rounded BSDF and frame and returns the density of what it did, which is all
