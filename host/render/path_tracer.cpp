@@ -114,6 +114,8 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSource& first,
   gbuffer_ = &g;
   sampler_ = &sampler;
   at_ = at;
+  first_bounce_mis_deferred_ =
+      settings_.first_bounce_mis == FirstBounceMis::mixture && !sampler.samples_the_bsdf();
   prepare(n, vpls);
   auto start = Clock::now();
   if (first.await) {
@@ -337,7 +339,10 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                 }
                 set_ray(rays_[i], origin, fs.direction, 0.0f, 1e30f);
                 // The density the hit's MIS weight uses: the same function of the direction
-                // as next-event estimation's above.
+                // as next-event estimation's above. Under first_bounce_mis_deferred_ the hit
+                // asks the sampler's pdf() instead of this sample's density, which a device
+                // may have computed from a G-buffer rounded for the bus (docs/guiding.md, "One
+                // density for both weights at the primary hit").
                 p.prev_pdf = mis_with_bsdf ? bsdf_mis_density(bsdf_pdf) : fs.pdf;
                 p.prev_position = x0;
                 alive_[i] = 1;
@@ -359,6 +364,14 @@ void PathTracer::add_found_light(PathState& p, std::uint32_t i, int depth, const
   } else {
     p.radiance += found;
   }
+}
+
+float PathTracer::first_bounce_mis_density(std::size_t i, const glm::vec3& direction) const {
+  const GBuffer& g = *gbuffer_;
+  const shared::pg_frame frame = gbuffer_frame(g, i);
+  const glm::vec3 wo = shared::pg_to_local(frame, glm::vec3(g.view_dir[i]));
+  const shared::pg_lobes lobes = shared::pg_make_lobes(gbuffer_material(g, i), wo);
+  return sampler_->pdf(g, i, lobes, wo, shared::pg_to_local(frame, direction));
 }
 
 void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays) {
@@ -398,9 +411,15 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       has_shadow_[j] = 0;
       alive_[j] = 0;
       const glm::vec3 dir = glm::normalize(ray.direction);
+      // The density the light found here weighs itself with against a light sample.
+      const auto arriving_pdf = [&] {
+        return depth == 1 && first_bounce_mis_deferred_ ? first_bounce_mis_density(i, dir)
+                                                        : p.prev_pdf;
+      };
       if (!hit.valid()) {
         const glm::vec3 le = lights_.escaped_radiance(dir);
-        const float w = nee ? power_heuristic(p.prev_pdf, lights_.pdf_escaped(dir)) : 1.0f;
+        const float light_pdf = nee ? lights_.pdf_escaped(dir) : 0.0f;
+        const float w = light_pdf > 0.0f ? power_heuristic(arriving_pdf(), light_pdf) : 1.0f;
         add_found_light(p, i, depth, p.throughput * le * w);
         if (depth == 1) {
           if (vpls) {
@@ -419,11 +438,10 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       }
       const SurfacePoint sp = make_surface_point(scene_, triangles_, ray, hit);
       if (!is_black(sp.emission)) {
-        const float w =
-            nee ? power_heuristic(p.prev_pdf,
-                                  lights_.pdf_triangle(hit.mesh, hit.triangle, p.prev_position,
-                                                       sp.position, sp.geometric_normal))
-                : 1.0f;
+        const float light_pdf = nee ? lights_.pdf_triangle(hit.mesh, hit.triangle, p.prev_position,
+                                                           sp.position, sp.geometric_normal)
+                                    : 0.0f;
+        const float w = light_pdf > 0.0f ? power_heuristic(arriving_pdf(), light_pdf) : 1.0f;
         add_found_light(p, i, depth, p.throughput * sp.emission * w);
       }
       if (depth == 1 && vpls) {

@@ -170,6 +170,8 @@ class PathTracer {
   // The hits of the m live paths at path vertex `depth`: emission found by the bounce (MIS),
   // the VPL at depth 1, next-event estimation, BSDF sampling and Russian roulette.
   void shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays);
+  // The sampler's pdf() at pixel i for world direction `direction` (first_bounce_mis_deferred_).
+  float first_bounce_mis_density(std::size_t i, const glm::vec3& direction) const;
   // The random numbers of path i's vertex y (the first bounce's hit) where the frame's samples
   // share it (SharedRandoms::second_vertex): sample 0's stream there; `own` then continues
   // past y as if it had drawn them.
@@ -237,6 +239,11 @@ class PathTracer {
   const GBuffer* gbuffer_ = nullptr;
   const FirstBounceSampler* sampler_ = nullptr;
   SampleCoordinates at_;  // this sample's (trace)
+  // Under FirstBounceMis::mixture with a sampler that is not the BSDF's, the first bounce's
+  // hit on a light weighs itself with the sampler's pdf(), as the primary hit's light sample
+  // does, evaluated only where a light is found (first_bounce_mis_density) instead of for
+  // every path at x0 (docs/guiding.md, "One density for both weights at the primary hit").
+  bool first_bounce_mis_deferred_ = false;
 
   // Scratch, reused across frames.
   std::vector<PathState> paths_;
