@@ -196,7 +196,7 @@ TEST(SvgfKernels, EqualTheHostReferenceAtSeveralSizes) {
 
 // The 3x3 a-trous kernel (SvgfSettings::atrous_radius 1) in every iteration, after the history
 // iteration only, and before it only. A test of its own so that Oclgrind runs it beside the
-// 5x5 cases (tests/CMakeLists.txt, oclgrind_test_svgf_3x3).
+// 5x5 cases (tests/CMakeLists.txt, oclgrind_test_svgf_part2).
 TEST(SvgfKernels, EqualTheHostReferenceWithThe3x3Kernel) {
   ClRuntime rt;
   expect_equal_to_the_host_reference(rt, {{37, 23, 16, 16, 1, 1, 1},
