@@ -23,51 +23,59 @@ std::size_t pixels(int width, int height) {
   return static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
 }
 
-}  // namespace
-
-// What every make_guider_* does: each channel of `list` allocated for width x height pixels,
-// with the kernels' access `kernel_flags` and the caller's host_flags.
-#define RTPG_ALLOCATE(name, type, bytes) b.name = cl::Buffer(context, flags, n * (bytes));
-#define RTPG_ALLOCATE_CHANNELS(Buffers, list, kernel_flags) \
-  const std::size_t n = pixels(width, height);              \
-  const cl_mem_flags flags = (kernel_flags) | host_flags;   \
-  Buffers b;                                                \
-  translate_cl_errors([&] { list(RTPG_ALLOCATE) });         \
-  return b;
-
-namespace {
 // read_write, else what the kernels do with such buffers otherwise (read or write only).
 cl_mem_flags kernel_access(KernelAccess access, cl_mem_flags otherwise) {
   return access == KernelAccess::read_write ? CL_MEM_READ_WRITE : otherwise;
 }
 }  // namespace
 
+// What every make_guider_* does, as an expression: each channel of the channel list `list`
+// (include/rtpg/guiding_layout.h) allocated for width x height pixels, with the kernels' access
+// `kernel_flags` and the caller's host_flags.
+#define RTPG_ALLOCATE(name, type, bytes) b.name = cl::Buffer(context, flags, n * (bytes));
+#define RTPG_ALLOCATE_CHANNELS(Buffers, list, kernel_flags) \
+  [&] {                                                     \
+    const std::size_t n = pixels(width, height);            \
+    const cl_mem_flags flags = (kernel_flags) | host_flags; \
+    Buffers b;                                              \
+    translate_cl_errors([&] { list(RTPG_ALLOCATE) });       \
+    return b;                                               \
+  }()
+
 GuiderGBuffer make_guider_gbuffer(cl::Context& context, int width, int height,
-                                  cl_mem_flags host_flags, KernelAccess access){
-    RTPG_ALLOCATE_CHANNELS(GuiderGBuffer, PG_GBUFFER_CHANNELS,
-                           kernel_access(access, CL_MEM_READ_ONLY))}
+                                  cl_mem_flags host_flags, KernelAccess access) {
+  return RTPG_ALLOCATE_CHANNELS(GuiderGBuffer, PG_GBUFFER_CHANNELS,
+                                kernel_access(access, CL_MEM_READ_ONLY));
+}
 
 GuiderPackedGBuffer make_guider_packed_gbuffer(cl::Context& context, int width, int height,
-                                               cl_mem_flags host_flags){
-    RTPG_ALLOCATE_CHANNELS(GuiderPackedGBuffer, PG_PACKED_GBUFFER_CHANNELS, CL_MEM_READ_ONLY)}
+                                               cl_mem_flags host_flags) {
+  return RTPG_ALLOCATE_CHANNELS(GuiderPackedGBuffer, PG_PACKED_GBUFFER_CHANNELS, CL_MEM_READ_ONLY);
+}
 
 GuiderPackedSamples make_guider_packed_samples(cl::Context& context, int width, int height,
-                                               cl_mem_flags host_flags){
-    RTPG_ALLOCATE_CHANNELS(GuiderPackedSamples, PG_PACKED_SAMPLE_CHANNELS, CL_MEM_WRITE_ONLY)}
+                                               cl_mem_flags host_flags) {
+  return RTPG_ALLOCATE_CHANNELS(GuiderPackedSamples, PG_PACKED_SAMPLE_CHANNELS, CL_MEM_WRITE_ONLY);
+}
 
 GuiderVpls make_guider_vpls(cl::Context& context, int width, int height, cl_mem_flags host_flags,
-                            KernelAccess access){
-    RTPG_ALLOCATE_CHANNELS(GuiderVpls, PG_VPL_CHANNELS, kernel_access(access, CL_MEM_READ_ONLY))}
+                            KernelAccess access) {
+  return RTPG_ALLOCATE_CHANNELS(GuiderVpls, PG_VPL_CHANNELS,
+                                kernel_access(access, CL_MEM_READ_ONLY));
+}
 
-GuiderPackedVpls
-    make_guider_packed_vpls(cl::Context& context, int width, int height, cl_mem_flags host_flags){
-        RTPG_ALLOCATE_CHANNELS(GuiderPackedVpls, PG_PACKED_VPL_CHANNELS, CL_MEM_READ_ONLY)}
+GuiderPackedVpls make_guider_packed_vpls(cl::Context& context, int width, int height,
+                                         cl_mem_flags host_flags) {
+  return RTPG_ALLOCATE_CHANNELS(GuiderPackedVpls, PG_PACKED_VPL_CHANNELS, CL_MEM_READ_ONLY);
+}
 
 GuiderSamples make_guider_samples(cl::Context& context, int width, int height,
-                                  cl_mem_flags host_flags, KernelAccess access){
-    RTPG_ALLOCATE_CHANNELS(GuiderSamples, PG_SAMPLE_CHANNELS,
-                           kernel_access(access, CL_MEM_WRITE_ONLY))}
+                                  cl_mem_flags host_flags, KernelAccess access) {
+  return RTPG_ALLOCATE_CHANNELS(GuiderSamples, PG_SAMPLE_CHANNELS,
+                                kernel_access(access, CL_MEM_WRITE_ONLY));
+}
 #undef RTPG_ALLOCATE_CHANNELS
+#undef RTPG_ALLOCATE
 
 Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings& settings)
     : runtime_(runtime),
