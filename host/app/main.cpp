@@ -116,11 +116,12 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
                   "or off")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
-  grp->add_option("--sample-overlap", r.sample_overlap,
-                  "Whether the G-buffer's upload, reproject and sample run on the device while the "
-                  "host makes the primary hit's light samples and traces their shadow rays: auto "
-                  "(where the device has memory of its own), on or off (same images; with "
-                  "--first-bounce-mis mixture the light samples wait for the samples)")
+  grp->add_option(
+         "--sample-overlap", r.sample_overlap,
+         "Whether the G-buffer's upload, reproject and sample run on the device while the "
+         "host makes the primary hit's light samples and traces their shadow rays: auto "
+         "(off: it cost more than it hid on PoCL and on an H200), on or off (same images; with "
+         "--first-bounce-mis mixture the light samples wait for the samples)")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
 }

@@ -108,15 +108,14 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
       pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
   transfer_ = resolve_host_transfer(transfer, runtime.info().host_unified_memory);
   zero_copy_ = transfer_ == HostTransfer::in_place;
-  // automatic: only where the device has cores of its own to work on while the host works; on
-  // PoCL's CPU device the kernels and the host share the cores (docs/guiding.md, "Training
-  // overlapped with the next frame's host work", "Sampling overlapped with the primary hit's
-  // light samples").
-  const auto resolve = [&](Overlap o) {
-    return o == Overlap::on || (o == Overlap::automatic && !runtime.info().host_unified_memory);
-  };
-  overlap_ = resolve(train_overlap);
-  sample_overlap_ = resolve(sample_overlap);
+  // The training's automatic overlap: only where the device has cores of its own to work on
+  // while the host works; on PoCL's CPU device the kernels and the host share the cores
+  // (docs/guiding.md, "Training overlapped with the next frame's host work"). The sampling's:
+  // nowhere, since its split pass over the pixels cost the host more than the overlap hid, on
+  // PoCL and on an H200 ("The bus and the sampling's overlap on an H200").
+  overlap_ = train_overlap == Overlap::on ||
+             (train_overlap == Overlap::automatic && !runtime.info().host_unified_memory);
+  sample_overlap_ = sample_overlap == Overlap::on;
   packed_ = transfer_ == HostTransfer::packed;
   if (transfer_ == HostTransfer::pinned || packed_)
     upload_staging_ = std::make_unique<PinnedStaging>(

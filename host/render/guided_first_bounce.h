@@ -17,14 +17,15 @@ namespace rtpg {
 class ClRuntime;
 class PinnedStaging;
 
-// What the device does beside the host (docs/guiding.md): automatic is on where the device has
+// What the device does beside the host (docs/guiding.md). Training: end_frame leaves it running
+// while the host makes the next frame's camera rays and G-buffer, and the next frame waits for it
+// ("Training overlapped with the next frame, on a GPU"); automatic is on where the device has
 // memory of its own (not DeviceInfo::host_unified_memory), off where its kernels share the host's
-// cores (PoCL). Training: end_frame leaves it running while the host makes the next frame's
-// camera rays and G-buffer, and the next frame waits for it ("Training overlapped with the next
-// frame, on a GPU"; on PoCL it saved nothing). Sampling: begin_frame and start_sample leave the
+// cores (PoCL, where it saved nothing). Sampling: begin_frame and start_sample leave the
 // G-buffer's upload, reproject and sample running while the path tracer makes the primary hit's
 // light samples, and finish_sample waits ("Sampling overlapped with the primary hit's light
-// samples").
+// samples"); automatic is off on every device: its split pass cost more than it hid on PoCL and
+// on an H200 ("The bus and the sampling's overlap on an H200").
 enum class Overlap { automatic, on, off };
 // "auto", "on", "off" (the CLI's --train-overlap and --sample-overlap); throws GuiderError else.
 Overlap parse_overlap(const std::string& name);

@@ -406,14 +406,14 @@ float direction_spread(const PixelMixture& m) {
 // change of frame) over |wo + wi| = 2 cos(theta_d) from the normalisation, and d's own few ulp.
 // Near the peak of a sharp lobe (d ~ a2, down to 1.6e-7) the first term is what float32 allows
 // in the inputs (~5e-4 at alpha 4e-4), not an artefact of the formula.
-double ggx_relative_error(const PixelMixture& m, float3 wi) {
-  if (!(m.lobes.p_specular > 0.0f)) return 0.0;
+double ggx_relative_error(const sh::pg_lobes& lobes, float3 wo, float3 wi) {
+  if (!(lobes.p_specular > 0.0f)) return 0.0;
   const double ulp = 6e-8;  // of a number below 1
-  const double sx = double(m.wo.x) + wi.x, sy = double(m.wo.y) + wi.y, sz = double(m.wo.z) + wi.z;
+  const double sx = double(wo.x) + wi.x, sy = double(wo.y) + wi.y, sz = double(wo.z) + wi.z;
   const double len = std::sqrt(sx * sx + sy * sy + sz * sz);
   const double hx = sx / std::max(len, 1e-30), hy = sy / std::max(len, 1e-30);
   const double hz = sz / std::max(len, 1e-30);
-  const double a2 = double(m.lobes.alpha) * m.lobes.alpha;
+  const double a2 = double(lobes.alpha) * lobes.alpha;
   const double d = hx * hx + hy * hy + a2 * hz * hz;
   const double h_error = 8.0 * ulp / std::max(len, 1e-6);
   const double d_error = 2.0 * (std::fabs(hx) + std::fabs(hy)) * h_error + 4.0 * ulp * d;
@@ -469,10 +469,11 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
         m.wo = px.wo;
         for (int k = 0; k < kept; ++k)
           if (samples[k].x > 0.0f)
-            (*conditioning)[i] =
-                std::max((*conditioning)[i],
-                         ggx_relative_error(m, sh::pg_square_to_hemisphere(sh::pg_make_float2(
-                                                   samples[k].y, samples[k].z))));
+            (*conditioning)[i] = std::max(
+                (*conditioning)[i],
+                ggx_relative_error(
+                    m.lobes, m.wo,
+                    sh::pg_square_to_hemisphere(sh::pg_make_float2(samples[k].y, samples[k].z))));
       }
       int updated = 0;
       s = sh::pg_pmm_train(s, samples, densities, kept, p, static_cast<float>(n), p.em_passes,
@@ -768,7 +769,7 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
                                  ? mixture[i].sampled_wi
                                  : sh::pg_to_local(mixture[i].frame, float3(b.x, b.y, b.z));
         const float reference = mixture[i].pdf(local), spread = pdf_spread(mixture[i], local);
-        const double ggx = ggx_relative_error(mixture[i], local);
+        const double ggx = ggx_relative_error(mixture[i].lobes, mixture[i].wo, local);
         const float model = model_spread(mixture[i], local);
         const double pdf_tolerance = (1e-4 + ggx) * reference + 2.0 * spread + 2.0 * model;
         ill_conditioned +=
@@ -1180,8 +1181,9 @@ rtpg::pg_pinhole_camera pinhole(float3 from, float3 at, float tan_half_fov_y, fl
 // nothing), with the camera moving, still, moving with every point behind its last position, and
 // without jitter: bit for bit where the unpacking is integer arithmetic and exact float products
 // (depths, halves, flags, material ids, a still camera's zero motion, the sky's position), within
-// 8 units in the last place per component for the unit vectors (sqrt and a division: 3 and 2.5
-// ulp in OpenCL 1.2), and within the rounding of their normalisations, dot products and
+// 8 units in the last place per component for the normal (sqrt and a division: 3 and 2.5 ulp in
+// OpenCL 1.2) and for the view direction plus its film point's division carried through the
+// camera's spread, and within the rounding of their normalisations, dot products and
 // divisions for the positions and the motion, which a device may compute with fused
 // multiply-adds. A guided frame then reads these channels as if they had been uploaded.
 TEST(GuidingKernels, UnpackGBufferMatchesTheHostUnpack) {
@@ -1245,6 +1247,8 @@ TEST(GuidingKernels, UnpackGBufferMatchesTheHostUnpack) {
           if (!(std::fabs(a[c] - b[c]) <= 8.0f * eps)) return false;
         return true;
       };
+      const float3 camera_forward(cameras.current.forward_x, cameras.current.forward_y,
+                                  cameras.current.forward_z);
       std::size_t moving = 0;
       for (std::size_t i = 0; i < n; ++i) {
         const bool sky = (g.flags[i] & PG_GBUF_SKY) != 0u;
@@ -1254,14 +1258,30 @@ TEST(GuidingKernels, UnpackGBufferMatchesTheHostUnpack) {
         const float4 pd = sh::pg_gbuffer_position_depth(cameras.current, ray,
                                                         sh::pg_unpack_gbuffer_depth(surface[i]));
         ASSERT_TRUE(same_bits(d.position_depth[i].w, g.position_depth[i].w)) << i;
+        // The film point (x + jitter) / width is a division, 3 ulp on a device (docs/design.md,
+        // "Floating point on other devices"), which the ray carries times the film's spread,
+        // 2 tan(fov / 2) (aspect + 1): to the point, times its depth along the view axis (the
+        // ray's forward component is 1 there); to the view direction, over the ray's length
+        // before normalisation, 1 / (v . forward). At the centre of the 301x3 image (a view
+        // 176 degrees wide) that is 2e-5 of the view direction, a few ulp at 93x61.
+        const float spread =
+            2.0f * cameras.current.tan_half_fov_y * (cameras.current.aspect + 1.0f);
+        const float film_error = 3.0f * eps * spread;
         // The ray's few ulp, scaled by the distance to the point, on top of the eye's position.
         const float reach = glm::length(float3(pd) - eye);
         for (int c = 0; c < 3; ++c)
-          ASSERT_NEAR(d.position_depth[i][c], pd[c], 16.0f * eps * (4.0f + reach)) << i << " " << c;
+          ASSERT_NEAR(d.position_depth[i][c], pd[c],
+                      16.0f * eps * (4.0f + reach) + film_error * pd.w)
+              << i << " " << c;
         if (sky) {
           ASSERT_TRUE(same4(d.position_depth[i], float4(0.0f))) << i;
         }
-        ASSERT_TRUE(near_unit(d.view_dir[i], sh::pg_gbuffer_view_dir(ray))) << i;
+        const float4 view = sh::pg_gbuffer_view_dir(ray);
+        const float view_tolerance =
+            8.0f * eps + film_error * std::fabs(glm::dot(float3(view), camera_forward));
+        for (int c = 0; c < 3; ++c)
+          ASSERT_NEAR(d.view_dir[i][c], view[c], view_tolerance) << i << " " << c;
+        ASSERT_EQ(d.view_dir[i].w, 0.0f) << i;
         ASSERT_TRUE(
             near_unit(d.shading_normal[i], sh::pg_unpack_gbuffer_shading_normal(surface[i])))
             << i;
@@ -1502,8 +1522,14 @@ TEST(GuidingKernels, UnpackVplsMatchesTheHostUnpack) {
       const float3 wo = sh::pg_to_local(frame, float3(g.view_dir[i]));
       const sh::pg_lobes lobes = sh::pg_make_lobes(
           sh::pg_material_from_gbuffer(g.base_color_roughness[i], g.metallic_specular[i]), wo);
-      const float bsdf =
-          sh::pg_bsdf_pdf(lobes, wo, sh::pg_to_local(frame, float3(direction_pdf[i])));
+      const float3 wi = sh::pg_to_local(frame, float3(direction_pdf[i]));
+      const float bsdf = sh::pg_bsdf_pdf(lobes, wo, wi);
+      // A BSDF sample's density is the device's own evaluation of the lobes: near a sharp GGX
+      // peak float32 allows it more than 1e-4 (ggx_relative_error). The message on failure
+      // splits the density from its conversion to area measure (docs/design.md, "Floating
+      // point on other devices": one pixel off by 1.5e-3 on an H200, not yet explained).
+      const double density_allowance =
+          strategy[i] == PG_STRATEGY_BSDF ? ggx_relative_error(lobes, wo, wi) : 0.0;
       const sh::pg_vpl host =
           sh::pg_unpack_vpl(distance[i], radiance[i], normal[i], float3(g.position_depth[i]),
                             direction_pdf[i], strategy[i], bsdf);
@@ -1520,7 +1546,14 @@ TEST(GuidingKernels, UnpackVplsMatchesTheHostUnpack) {
       for (int c = 0; c < 3; ++c)
         ASSERT_NEAR(position[i][c], host.position[c], 1e-5f * (std::fabs(host.position[c]) + 25.0f))
             << i;
-      ASSERT_NEAR(position[i].w / host.position.w, 1.0f, 1e-4f) << i;
+      const float device_to_area = sh::pg_vpl_mixture_density(nr[i]) / direction_pdf[i].w,
+                  host_to_area =
+                      sh::pg_vpl_mixture_density(host.normal_radiance) / direction_pdf[i].w;
+      ASSERT_NEAR(position[i].w / host.position.w, 1.0f, 1e-4 + density_allowance)
+          << i << " strategy " << strategy[i] << " roughness " << g.base_color_roughness[i].w
+          << " to_area " << device_to_area << " / " << host_to_area << " strategy density "
+          << position[i].w / device_to_area << " / " << host.position.w / host_to_area
+          << " normal bits " << nr[i].x << " / " << host.normal_radiance.x;
       ASSERT_NEAR(
           sh::pg_vpl_mixture_density(nr[i]) / sh::pg_vpl_mixture_density(host.normal_radiance),
           1.0f, 1e-4f)
