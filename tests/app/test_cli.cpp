@@ -521,6 +521,47 @@ TEST_F(Cli, ThreadsChangeNothingButTheThreadCount) {
   EXPECT_NE(r.err.find("--threads"), std::string::npos) << describe(r);
 }
 
+// Every feature at once, at sizes where a work-group, a row of lanes or a 5x5 filter tap has
+// nothing beside it (one pixel; one row or column; prime widths; a row shorter than a work-group
+// and one longer than the 16 lanes by one), with the camera moving and several samples a pixel:
+// each run exits 0, every frame's samples are finite and the image is finite and non-negative.
+// Twice: in place with the mixture's MIS density, and with every host transfer packed and both
+// of the device's overlaps on (what a device with memory of its own can run; the sampling's
+// overlap needs the BSDF's MIS density, so that run keeps the default).
+TEST_F(Cli, EveryFeatureAtOddSizesStaysFinite) {
+  const std::string features =
+      "render --spp 3 --frames 4 --camera-path pan --denoise svgf --guide-vertices world -q "
+      "-o out.exr --stats-json stats.json ";
+  struct Way {
+    const char* args;
+    double sample_overlap;
+  };
+  const Way ways[] = {
+      {"--host-transfer in-place --first-bounce-mis mixture", 0.0},
+      {"--host-transfer packed --train-overlap on --sample-overlap on", 1.0},
+  };
+  const std::pair<int, int> sizes[] = {{1, 1},   {1, 7},   {7, 1},   {17, 3},
+                                       {333, 1}, {1, 190}, {129, 65}};
+  for (const Way& way : ways) {
+    for (const auto& [w, h] : sizes) {
+      const std::string res = std::to_string(w) + "x" + std::to_string(h);
+      SCOPED_TRACE(res + " " + way.args);
+      const RunResult r = run_rtpg(dir(), features + "--res " + res + " " + way.args);
+      ASSERT_TRUE(r.exited && r.exit_code == 0) << describe(r);
+      const nlohmann::json stats = nlohmann::json::parse(read_file(dir() / "stats.json"));
+      ASSERT_EQ(stats["frames"].size(), 4u);
+      for (const nlohmann::json& frame : stats["frames"]) {
+        EXPECT_EQ(frame["nonfinite_samples"].get<long long>(), 0);
+        EXPECT_EQ(frame["sample_overlap"].get<double>(), way.sample_overlap);
+      }
+      const ExrImage image = read_exr(dir() / "out.exr");
+      ASSERT_EQ(image.width, w);
+      ASSERT_EQ(image.height, h);
+      for (float v : image.pixels) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << v;
+    }
+  }
+}
+
 TEST_F(Cli, SavesTheRequestedFramesBesideTheOutput) {
   const RunResult r =
       run_rtpg(dir(), "render --res 16x16 --frames 3 --seed 5 -q --save-frames 2,0 -o out.exr");
