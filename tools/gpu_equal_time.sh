@@ -15,9 +15,15 @@
 # (32), REPEATS (5); VARIANT: rtpg arguments for a second guided run against the same path
 # tracing (empty: none); TESTS: the test binaries run at the end (the OpenCL ones by default);
 # T1, T2 (300, 180 s): the time each table may take, so that the tests and results still come
-# back inside the lease's call.
-# OUT gets machine.txt, et.md (and variant.md), et.tgz (every run's stats, no images) and
-# tests.tgz. docs/guiding.md, "Equal time on a GPU", has the first run.
+# back inside the lease's call. FRAME_RUNS (empty: none): after the tests, the bundle's run.sh
+# renders the frames of those runs (its RUNS names: off, pinned, packed, sample-overlap-on, ...)
+# on FRAME_SCENES (the Cornell box and the sunlit room) at RES, ROUNDS (3) interleaved, within
+# T3 (150 s), into frames.md and frames.tgz: the one comparison a table's drift cannot spoil.
+# BENCH (empty: none): a bench_guiding_kernels filter, run last within 60 s, into bench.log.
+# OUT gets machine.txt, et.md (and variant.md), et.tgz (every run's stats, no images),
+# tests.tgz, and frames.md, frames.tgz and bench.log where asked: at most the 8 files a lease's
+# call brings back. docs/guiding.md, "Equal time on a GPU", has the first run, "The bus and the
+# sampling's overlap on an H200" the first with frames.
 set -u
 out=${OUT:?OUT must name the folder for the results}
 bundle=${BUNDLE:-build/gpu.tar.xz} refs=${REFS:-build/gpu-et/references}
@@ -25,7 +31,7 @@ b=/tmp/rtpg-bundle
 [ -d $b/gpub ] || { mkdir -p $b && tar -xJf "$bundle" -C $b; } || exit 2
 g=$b/gpub
 . "$g/opencl_vendors.sh"
-opencl_vendors "$out/vendors"
+opencl_vendors /tmp/et-vendors
 export RTPG_DEVICE=${RTPG_DEVICE:-gpu} RTPG_CACHE_DIR=/tmp/rtpg-cache
 export LD_LIBRARY_PATH=$g/lib PYTHONUNBUFFERED=1 RTPG_BINARY=$g/bin/rtpg
 [ -n "${ASSETS:-}" ] && export RTPG_ASSET_ROOT=$PWD/$ASSETS
@@ -57,4 +63,18 @@ done | xargs -P 8 -I{} sh -c 'timeout 100 "$0/bin/{}" --gtest_color=no > /tmp/et
   echo "== {}: exit $?, $(grep -E "^\[  PASSED  \]|^\[  FAILED  \] [0-9]" /tmp/et-tests/{}.log | tr "\n" " ")"' "$g"
 grep -h -E '^\[  FAILED  \] [A-Za-z]' /tmp/et-tests/*.log | sort -u
 tar -czf "$out/tests.tgz" -C /tmp et-tests
+if [ -n "${FRAME_RUNS:-}" ]; then
+  echo "== frames at $SECONDS s"
+  RENDER=1 NO_BENCH=1 TESTS=" " RUNS="$FRAME_RUNS" SCENES="${FRAME_SCENES:-cornell-box sunlit-room}" \
+    RESOLUTIONS="${RES:-960x540}" ROUNDS="${ROUNDS:-3}" FRAMES=24 OCL_ICD_VENDORS="$OCL_ICD_VENDORS" \
+    timeout "${T3:-150}" bash "$g/run.sh" /tmp/et-frames > /dev/null 2>&1
+  python3 "$g/gpu_frames_summary.py" /tmp/et-frames/frames | tee "$out/frames.md"
+  tar -czf "$out/frames.tgz" --exclude='*.exr' -C /tmp et-frames/frames
+fi
+if [ -n "${BENCH:-}" ]; then
+  echo "== kernels at $SECONDS s"
+  timeout 60 "$g/bin/bench_guiding_kernels" --benchmark_repetitions=1 --benchmark_filter="$BENCH" \
+    > "$out/bench.log" 2>&1
+  grep -E 'manual_time|ERROR' "$out/bench.log"
+fi
 echo "done at $SECONDS s"

@@ -50,7 +50,11 @@ PG_FN pg_lobes pg_make_lobes(pg_material m, float3 wo) {
   float w_spec = pg_luminance(pg_fresnel_schlick(l.f0, fmax(wo.z, 0.0f)));
   float w_diff = pg_luminance(l.diffuse);
   float has_spec = pg_max3(l.f0) > 0.0f ? 1.0f : 0.0f;
-  l.p_specular = has_spec * (w_spec + w_diff > 0.0f ? w_spec / (w_spec + w_diff) : 1.0f);
+  /* Without a diffuse layer (a metal) the specular lobe's share is 1 by definition, not w / w:
+   * a device's division may be 2.5 ulp off (docs/design.md, "Floating point on other devices"),
+   * and a share of 1 - 2^-24 gave the cosine lobe a density that is 1.5e-3 of a sharp metal's
+   * far from its peak on an H200. */
+  l.p_specular = has_spec * (w_diff > 0.0f ? w_spec / (w_spec + w_diff) : 1.0f);
   /* Keep both strategies alive so neither lobe is undersampled. */
   if (has_spec > 0.0f && w_diff > 0.0f) l.p_specular = clamp(l.p_specular, 0.1f, 0.9f);
   return l;

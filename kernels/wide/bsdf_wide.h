@@ -35,7 +35,8 @@ static inline pg_lobes_w pg_make_lobes_w(pg_float3w base_color, pg_floatw roughn
       l.f0.x + (1.0f - l.f0.x) * c5, l.f0.y + (1.0f - l.f0.y) * c5, l.f0.z + (1.0f - l.f0.z) * c5));
   pg_floatw w_diff = pg_luminance3w(l.diffuse);
   pg_intw has_spec = pg_max3w(l.f0) > 0.0f;
-  pg_floatw p = select((pg_floatw)(1.0f), w_spec / (w_spec + w_diff), w_spec + w_diff > 0.0f);
+  /* 1, not w / w, without a diffuse layer (pg_make_lobes). */
+  pg_floatw p = select((pg_floatw)(1.0f), w_spec / (w_spec + w_diff), w_diff > 0.0f);
   /* Keep both strategies alive so neither lobe is undersampled. */
   p = select(p, clamp(p, 0.1f, 0.9f), has_spec & (w_diff > 0.0f));
   l.p_specular = select((pg_floatw)(0.0f), p, has_spec);

@@ -1527,7 +1527,7 @@ TEST(GuidingKernels, UnpackVplsMatchesTheHostUnpack) {
       // A BSDF sample's density is the device's own evaluation of the lobes: near a sharp GGX
       // peak float32 allows it more than 1e-4 (ggx_relative_error). The message on failure
       // splits the density from its conversion to area measure (docs/design.md, "Floating
-      // point on other devices": one pixel off by 1.5e-3 on an H200, not yet explained).
+      // point on other devices": how a metal's density came out 1.5e-3 off on an H200).
       const double density_allowance =
           strategy[i] == PG_STRATEGY_BSDF ? ggx_relative_error(lobes, wo, wi) : 0.0;
       const sh::pg_vpl host =
