@@ -890,7 +890,7 @@ void BM_TransferKernel(benchmark::State& state, Transfer kernel, int w, int h) {
                                      : 10.0 + 20.0 + 16.0 + 64.0 * b + 32.0;
   const double flops_per_pixel = kernel == Transfer::UnpackGBuffer ? 130.0
                                  : kernel == Transfer::PackSamples ? 15.0
-                                                                   : 60.0 + 190.0 * b;
+                                                                   : 120.0 + 190.0 * b;
   const double n = static_cast<double>(in.n), it = static_cast<double>(state.iterations());
   const double bound_ms =
       roofline_ms(bytes_per_pixel * n, flops_per_pixel * n, copy_ms, fma_ms, it);

@@ -3,8 +3,10 @@
  * a pixel and this kernel writes the 32 that train reads, putting each hit at its distance
  * along the direction the pixel's first sample took and taking that sample's densities (the
  * BSDF's evaluated here for a BSDF sample). Per pixel: 10 bytes of VPL, 20 of sample and 16-80
- * of G-buffer read (the BSDF's inputs only for a BSDF sample), 32 written, about 60 operations
- * (250 with the BSDF's density): memory-bound on a GPU. One work-item per pixel. */
+ * of G-buffer read (the BSDF's inputs only for a BSDF sample), 32 written, about 120 operations
+ * (310 with the BSDF's density; counted again on 2026-11-28, when the normal's 8-bit code became
+ * its 16-bit one in integers instead of through a unit vector, which had taken 50 more):
+ * memory-bound on a GPU. One work-item per pixel. */
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
 #include "shared/vpl_packing.h"

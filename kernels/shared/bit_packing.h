@@ -31,6 +31,14 @@ PG_FN float pg_snorm8_of(uint bits) {
   float v = (float)(bits & 0xffu) - (float)((bits & 0x80u) << 1);
   return fmax(v * (1.0f / 127.0f), -1.0f);
 }
+/* The 8-bit value k / 127 as the nearest 16-bit one, round(k 32767 / 127), in integers: the same
+ * bits on every device. (Through the float value the codes k = +-63 and +-64 land within 0.004
+ * of a half, so two devices' roundings could pick different neighbours; no k / 127 is a tie.) */
+PG_FN uint pg_snorm8_to_snorm16_bits(uint bits) {
+  int k = (int)(bits & 0xffu) - (int)((bits & 0x80u) << 1);
+  int q = (k < -127 ? -127 : k) * 32767;
+  return (uint)((q >= 0 ? q + 63 : q - 63) / 127) & 0xffffu; /* halves away from zero */
+}
 
 /* The largest angle between a unit vector and its packed copy, with margin (measured 6.4e-5 rad:
  * tests/guiding/test_vpl_packing.cpp), and for the 8-bit packing (measured 1.65e-2 rad). */
@@ -79,6 +87,13 @@ PG_FN uint pg_pack_unit_vector8(float3 n) {
 PG_FN float3 pg_unpack_unit_vector8(uint bits) {
   float3 v = pg_octahedral_unfold(pg_snorm8_of(bits), pg_snorm8_of(bits >> 8));
   return v * (1.0f / sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
+}
+/* The 16-bit code (pg_pack_unit_vector) of the octahedral point an 8-bit code
+ * (pg_pack_unit_vector8) holds: the same direction within the 16-bit rounding, without a square
+ * root or a division. On the square's border, whose opposite halves fold onto the same
+ * directions, it keeps the side the 8-bit code has. */
+PG_FN uint pg_unit_vector8_to_16(uint bits) {
+  return pg_snorm8_to_snorm16_bits(bits) | (pg_snorm8_to_snorm16_bits(bits >> 8) << 16);
 }
 
 /* v rounded to the nearest bfloat16, ties to even (the low 16 bits of the result). Finite

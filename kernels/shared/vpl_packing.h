@@ -92,7 +92,7 @@ PG_FN pg_vpl pg_unpack_vpl(uint distance, uint radiance, uint normal, float3 x0,
   float density = direction_pdf.w;
   float strategy_pdf = strategy == PG_STRATEGY_BSDF ? bsdf_pdf : density;
   uint info = PG_VPL_VALID | (strategy << PG_VPL_STRATEGY_SHIFT);
-  uint normal_bits = pg_pack_vpl_normal(pg_unpack_unit_vector8(normal)); /* as train reads it */
+  uint normal_bits = pg_unit_vector8_to_16(normal); /* as train reads it */
   float3 y = w;
   if (isfinite(d)) {
     float cos_y = fabs(dot(pg_unpack_unit_vector(normal_bits), w));

@@ -52,6 +52,40 @@ TEST(VplPacking, UnitVectorsWithinTheirAngularBound) {
   EXPECT_EQ(pg_unpack_unit_vector(pg_pack_unit_vector(float3(0.0f))), float3(0.0f, 0.0f, 1.0f));
 }
 
+// Every 8-bit code's 16-bit one (pg_unit_vector8_to_16, what the device's VPL unpacking hands
+// the training): each coordinate the nearest 16-bit value to k / 127, computed here in double,
+// and the same direction as the 8-bit code within the 16-bit packing's bound. Through the unit
+// vector and back (the float path it replaced) the bits agree except on the square's border,
+// whose two halves fold onto the same directions, and where a coordinate lies within float
+// rounding of a half.
+TEST(VplPacking, EightBitNormalsBecomeSixteenBitOnesOfTheSameDirection) {
+  double worst = 0.0;
+  int other_bits = 0;
+  for (uint code = 0; code < 0x10000u; ++code) {
+    const uint bits = pg_unit_vector8_to_16(code);
+    int k[2];
+    for (int c = 0; c < 2; ++c) {
+      k[c] = std::max(static_cast<int>(static_cast<std::int8_t>((code >> (8 * c)) & 0xffu)), -127);
+      const long nearest = std::lround(static_cast<double>(k[c]) * 32767.0 / 127.0);
+      ASSERT_EQ(static_cast<int>(static_cast<std::int16_t>((bits >> (16 * c)) & 0xffffu)), nearest)
+          << std::hex << code;
+    }
+    const float3 n8 = pg_unpack_unit_vector8(code), n16 = pg_unpack_unit_vector(bits);
+    worst = std::max(worst, angle_between(n8, n16));
+    if (bits != pg_pack_unit_vector(n8)) {
+      ++other_bits;
+      const auto border_or_near_half = [](int v) {
+        return std::abs(v) == 127 || std::abs(v) == 63 || std::abs(v) == 64;
+      };
+      EXPECT_TRUE(border_or_near_half(k[0]) || border_or_near_half(k[1]))
+          << std::hex << code << std::dec << ": " << k[0] << " " << k[1];
+    }
+  }
+  EXPECT_LT(worst, PG_OCTAHEDRAL_MAX_ANGLE);
+  std::printf("[ info     ] worst angle %.3g rad; %d codes differ from the float path's bits\n",
+              worst, other_bits);
+}
+
 TEST(VplPacking, Bfloat16RoundsToNearestEven) {
   for (uint b = 0; b < 0x10000u; ++b) {
     const uint exponent = (b >> 7) & 0xffu;
