@@ -16,7 +16,7 @@ echo "== rtpg render (default scene: scenes/cornell-box.json), guiding on"
 ./build/rtpg render --res "$res" --frames 4 -o "$out/default.png"
 
 printf '\n== %s frames at 1 spp, %s, against a %s-spp reference\n' "$frames" "$res" "$ref_spp"
-printf '%-18s %-8s %12s %14s %s\n' scene method "ms/frame" "relMSE(last8)" image
+printf '%-18s %-8s %12s %14s %10s %s\n' scene method "ms/frame" "relMSE(last8)" "s.e." image
 for scene in cornell-box cornell-indirect; do
   ref="$out/$scene-ref-$res-$ref_spp.exr"
   [ -f "$ref" ] || ./build/rtpg reference "scenes/$scene.json" --res "$res" --spp "$ref_spp" -o "$ref" -q
@@ -28,11 +28,16 @@ import json, statistics, sys
 d = json.load(open(sys.argv[1]))
 f = d["frames"]
 ms = statistics.median(x["time_ms"]["total"] for x in f)
-rel = statistics.mean(x["relmse"] for x in f[-8:])
-print(f"{sys.argv[2]:<18} {sys.argv[3]:<8} {ms:12.1f} {rel:14.4f} {sys.argv[4]}")
+last = [x["relmse"] for x in f[-8:]]
+rel = statistics.mean(last)
+se = statistics.stdev(last) / len(last) ** 0.5 if len(last) > 1 else float("nan")
+print(f"{sys.argv[2]:<18} {sys.argv[3]:<8} {ms:12.1f} {rel:14.4f} {se:10.4f} {sys.argv[4]}")
 PY
   done
 done
 echo
 echo "relMSE = mean of (I - R)^2 / (R^2 + 0.01) over pixels and channels, averaged over the last"
-echo "8 frames; 'off' = BSDF sampling of the first bounce, 'pmm' = the guided mixture."
+echo "8 frames, with the standard error of that average (a frame's relMSE is heavy-tailed: one"
+echo "firefly moves it, so differences within two standard errors are noise; bench/experiments.py"
+echo "measures the methods over many frames and seeds); 'off' = BSDF sampling of the first bounce,"
+echo "'pmm' = the guided mixture."
