@@ -264,13 +264,24 @@ PG_ROW_LOAD void pg_store_row_float2_rows(__global float2* row, int x0, int widt
   for (int l = 0; x0 + l < width; ++l) row[x0 + l] = (float2)(v[0][l], v[1][l]);
 }
 
-/* The sum of a float vector's lanes, lane 0 first. */
+/* The sum of a float vector's lanes, by halves (lanes l and l + PG_LANES / 2 first): a lane-by-
+ * lane chain of PG_LANES - 1 dependent additions through memory was 5% of the sample kernel on
+ * PoCL's CPU device. Exact for whole numbers, which is what the counts add up but for pi's sum. */
 static inline float pg_sum_lanes(pg_floatw v) {
-  float a[PG_LANES];
-  pg_vstorew(v, 0, a);
-  float sum = a[0];
-  for (int l = 1; l < PG_LANES; ++l) sum += a[l];
-  return sum;
+#if PG_LANES == 16
+  float8 v8 = v.lo + v.hi;
+  float4 v4 = v8.lo + v8.hi;
+#elif PG_LANES == 8
+  float4 v4 = v.lo + v.hi;
+#elif PG_LANES == 4
+  float4 v4 = v;
+#endif
+#if PG_LANES >= 4
+  float2 v2 = v4.lo + v4.hi;
+#else
+  float2 v2 = v;
+#endif
+  return v2.x + v2.y;
 }
 
 /* The largest lane of an int vector. */
