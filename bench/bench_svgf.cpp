@@ -92,14 +92,16 @@ struct Counts {
   double surface_pixels = 0;
 };
 
-// x^n by repeated squaring (pg_svgf_power): one squaring per bit of n, one multiply per set bit.
+// x^n by repeated squaring as the kernels unroll it (PG_SVGF_CONSTANT_POWER, kernels/shared/
+// svgf.h): a squaring per bit of n below its top one, a multiply per set bit after the first
+// (which is x itself); 7 for the paper's 128.
 double power_flops(int n) {
   int bits = 0, ones = 0;
   for (; n != 0; n >>= 1) {
     ++bits;
     ones += n & 1;
   }
-  return bits + ones;
+  return bits == 0 ? 0 : (bits - 1) + (ones - 1);
 }
 
 Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const SvgfSettings& s) {

@@ -8,8 +8,8 @@
  * Per pixel and iteration (hand count, as svgf_temporal.cl): 11 + 3 per tap of the 3x3
  * prefilter + 6 x 5 for 1 / phi_z at the six tap distances (two multiplies, a multiply and an
  * add, a division) + (38 + P) per tap of the 5x5 kernel inside the image + 5 flops, P the normal
- * weight's power (9 for phi_normal 128): 1248 inside the image; 52 bytes. No surface: 1 flop,
- * 48 bytes. */
+ * weight's power (7 for phi_normal 128, PG_SVGF_CONSTANT_POWER): 1198 inside the image; 52 bytes.
+ * No surface: 1 flop, 48 bytes. */
 /* Multiply-adds allowed (OpenCL C's default): the taps' sums and edge terms fuse, 5-6% of the
  * pass on PoCL's CPU device; no term cancels, so the host reference, which rounds each
  * operation, agrees within rounding (docs/denoising.md, "Multiply-adds in the a-trous pass"). */

@@ -48,8 +48,18 @@ __kernel void svgf_atrous_wide(__global const float* in, __global float* out,
     for (int dy = -1; dy <= 1; ++dy) {
       int qy = y + dy;
       if (qy < 0 || qy >= h) continue;
+      /* The row's three taps, as plain vector loads away from its ends: through the row loader,
+       * a call, the sums went through memory at every tap (docs/denoising.md, "The normal
+       * weight's exponent built in"). */
+      __global const float* variance_row = in + 3 * n + qy * w;
+      pg_floatw taps[3];
+      if (x0 >= 1 && x0 + PG_LANES + 1 <= w) {
+        for (int t = 0; t < 3; ++t) taps[t] = pg_vloadw(0, variance_row + x0 - 1 + t);
+      } else {
+        for (int t = 0; t < 3; ++t) taps[t] = pg_load_row_floats(variance_row, x0 - 1 + t, w);
+      }
       for (int dx = -1; dx <= 1; ++dx) {
-        pg_floatw variance_q = pg_load_row_floats(in + 3 * n + qy * w, x0 + dx, w);
+        pg_floatw variance_q = taps[dx + 1];
         pg_intw inside = (lane_x + dx >= 0) & (lane_x + dx < w);
         float g = pg_svgf_gauss3(dx, dy);
         sum_gv += select((pg_floatw)(0.0f), g * variance_q, inside);
@@ -73,11 +83,11 @@ __kernel void svgf_atrous_wide(__global const float* in, __global float* out,
         pg_load_planar_row(in, n, qy * w, x0 + offset, w, &q, &variance_q);
         pg_load_planar_row(surface, n, qy * w, x0 + offset, w, &n_q, &z_q);
         pg_intw inside = (lane_x + offset >= 0) & (lane_x + offset < w);
-        pg_floatw weight = pg_svgf_atrous_weight(dx, PG_SVGF_ATROUS_RADIUS) *
-                           pg_svgf_atrous_weight(dy, PG_SVGF_ATROUS_RADIUS) *
-                           pg_svgf_edge_weight_w(n_c, z_c, luminance_c, n_q, z_q, pg_luminance3w(q),
-                                                 inverse_phi_z[pg_svgf_squared_distance(dx, dy)],
-                                                 inverse_phi_l, settings);
+        pg_floatw weight =
+            pg_svgf_atrous_weight(dx, PG_SVGF_ATROUS_RADIUS) *
+            pg_svgf_atrous_weight(dy, PG_SVGF_ATROUS_RADIUS) *
+            pg_svgf_edge_weight_w(n_c, z_c, luminance_c, n_q, z_q, pg_luminance3w(q),
+                                  inverse_phi_z[pg_svgf_squared_distance(dx, dy)], inverse_phi_l);
         weight = select((pg_floatw)(0.0f), weight, inside);
         sum_c = pg_add3w(sum_c, pg_scale3w(q, weight));
         sum_v += weight * weight * variance_q;

@@ -6,7 +6,8 @@
  * Per pixel (hand count, as svgf_temporal.cl): 5 flops and 64 bytes where the history is long
  * enough; else 15 + 10 x 5 (1 / phi_z at each squared tap distance: two multiplies, a multiply
  * and an add, a division) + (36 + P) per tap inside the image and 68 bytes, P = the normal weight's
- * power (one per bit of phi_normal and one per set bit: 9 for 128); no surface: 1 flop, 32 bytes.
+ * power (a squaring per bit of phi_normal below the top one, a multiply per set bit after the
+ * first: 7 for 128); no surface: 1 flop, 32 bytes.
  */
 /* Multiply-adds allowed, as in the a-trous pass (docs/denoising.md, "Multiply-adds in the a-trous
  * pass"): 8-9% of the spatial estimate on PoCL's CPU device. */

@@ -59,7 +59,7 @@ __kernel void svgf_variance_wide(__global const float* integrated, __global cons
         pg_intw inside = (lane_x + dx >= 0) & (lane_x + dx < w);
         pg_floatw weight = pg_svgf_edge_weight_w(
             n_c, z_c, luminance_c, n_q, z_q, pg_luminance3w(iq),
-            inverse_phi_z[pg_svgf_squared_distance(dx, dy)], (pg_floatw)(0.0f), settings);
+            inverse_phi_z[pg_svgf_squared_distance(dx, dy)], (pg_floatw)(0.0f));
         weight = select((pg_floatw)(0.0f), weight, inside);
         sum_c = pg_add3w(sum_c, pg_scale3w(iq, weight));
         sum_m1 += weight * mq.x;

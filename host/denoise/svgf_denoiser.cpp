@@ -49,7 +49,10 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
   // no output above 1e-37 (docs/denoising.md, "Denormals"). An OpenCL 1.2 build option, a hint
   // any device may ignore; the guiding kernels keep denormals (their host references carry a
   // decaying sample count through that range).
-  const std::string options = "-cl-denorms-are-zero";
+  // sigma_n, the normal weight's exponent, is a build option of every SVGF kernel (the filters
+  // square it out in straight-line code: kernels/shared/svgf.h, PG_SVGF_CONSTANT_POWER).
+  const std::string options =
+      "-cl-denorms-are-zero -DPG_SVGF_PHI_NORMAL=" + std::to_string(settings.phi_normal);
   temporal_ = runtime.kernel("svgf_temporal.cl", "svgf_temporal", options);
   lanes_ = settings.lanes != 0 ? settings.lanes : runtime.info().simd_lanes();
   const std::string wide_options = options + " -DPG_LANES=" + std::to_string(lanes_);

@@ -187,6 +187,51 @@ PG_FN float pg_svgf_power(float x, uint n) {
   return r;
 }
 
+/* The filter kernels are built with sigma_n as PG_SVGF_PHI_NORMAL (SvgfDenoiser), and
+ * PG_SVGF_CONSTANT_POWER(r, x) turns r = 1 into x^PG_SVGF_PHI_NORMAL in straight-line code: the
+ * products of pg_svgf_power's loop in the same order, so the same bits. As a loop over a kernel
+ * argument's bits (which the compiler did not unroll) its control was a tenth of the wide a-trous
+ * pass on PoCL's CPU device (docs/denoising.md, "The normal weight's exponent built in"). Any
+ * float type; 13 bits, as SvgfSettings caps sigma_n at 4096. */
+#ifdef PG_SVGF_PHI_NORMAL
+#if PG_SVGF_PHI_NORMAL < 0 || PG_SVGF_PHI_NORMAL >= 8192
+#error "PG_SVGF_PHI_NORMAL must lie in [0, 8192)"
+#endif
+#define PG_SVGF_POWER_BIT(r, x, b)                          \
+  do {                                                      \
+    if (((PG_SVGF_PHI_NORMAL >> (b)) & 1) != 0) (r) *= (x); \
+    if ((PG_SVGF_PHI_NORMAL >> ((b) + 1)) != 0) (x) *= (x); \
+  } while (0)
+#define PG_SVGF_CONSTANT_POWER(r, x) \
+  PG_SVGF_POWER_BIT(r, x, 0);        \
+  PG_SVGF_POWER_BIT(r, x, 1);        \
+  PG_SVGF_POWER_BIT(r, x, 2);        \
+  PG_SVGF_POWER_BIT(r, x, 3);        \
+  PG_SVGF_POWER_BIT(r, x, 4);        \
+  PG_SVGF_POWER_BIT(r, x, 5);        \
+  PG_SVGF_POWER_BIT(r, x, 6);        \
+  PG_SVGF_POWER_BIT(r, x, 7);        \
+  PG_SVGF_POWER_BIT(r, x, 8);        \
+  PG_SVGF_POWER_BIT(r, x, 9);        \
+  PG_SVGF_POWER_BIT(r, x, 10);       \
+  PG_SVGF_POWER_BIT(r, x, 11);       \
+  PG_SVGF_POWER_BIT(r, x, 12)
+#elif defined(__OPENCL_VERSION__)
+#error "the SVGF kernels need the build option PG_SVGF_PHI_NORMAL (SvgfDenoiser passes sigma_n)"
+#endif
+
+/* The normal weight's power x^sigma_n: the build option in a kernel, the setting on the host. */
+PG_FN float pg_svgf_normal_power(float x, pg_svgf_settings s) {
+#ifdef PG_SVGF_PHI_NORMAL
+  (void)s;
+  float r = 1.0f;
+  PG_SVGF_CONSTANT_POWER(r, x);
+  return r;
+#else
+  return pg_svgf_power(x, s.phi_normal);
+#endif
+}
+
 /* 1 / phi_z, the depth weight's scale between the centre pixel (depth depth_c, depth slope
  * slope_c) and a tap `distance` pixels away (SVGF eq. 3): phi_z = sigma_z * slope_c * distance +
  * eps * depth_c. The filters take it once per pixel for each squared tap distance
@@ -236,7 +281,7 @@ PG_FN float pg_svgf_edge_weight(float4 surface_c, float luminance_c, float4 surf
   float cos_n = fmin(fmax(dot(pg_float4_xyz(surface_c), pg_float4_xyz(surface_q)), 0.0f), 1.0f);
   float e = fabs(surface_c.w - surface_q.w) * inverse_phi_z +
             fabs(luminance_c - luminance_q) * inverse_phi_l;
-  float w = pg_svgf_power(cos_n, s.phi_normal) * exp(-e);
+  float w = pg_svgf_normal_power(cos_n, s) * exp(-e);
   return surface_q.w > 0.0f ? w : 0.0f;
 }
 

@@ -27,13 +27,10 @@ static inline void pg_load_planar_row(__global const float* image, int n, int ro
   *w = pg_load_row_floats(p + 3 * n, x0, width);
 }
 
-/* x^n by repeated squaring, as pg_svgf_power (n is the same for every lane). */
-static inline pg_floatw pg_svgf_power_w(pg_floatw x, uint n) {
+/* pg_svgf_normal_power in the lanes. */
+static inline pg_floatw pg_svgf_normal_power_w(pg_floatw x) {
   pg_floatw r = (pg_floatw)(1.0f);
-  for (; n != 0u; n >>= 1) {
-    if ((n & 1u) != 0u) r *= x;
-    x *= x;
-  }
+  PG_SVGF_CONSTANT_POWER(r, x);
   return r;
 }
 
@@ -58,11 +55,10 @@ static inline void pg_svgf_inverse_phi_depth_table_w(pg_floatw slope_c, pg_float
  * inverse_phi_l. A tap without a surface gets 0. */
 static inline pg_floatw pg_svgf_edge_weight_w(pg_float3w n_c, pg_floatw z_c, pg_floatw luminance_c,
                                               pg_float3w n_q, pg_floatw z_q, pg_floatw luminance_q,
-                                              pg_floatw inverse_phi_z, pg_floatw inverse_phi_l,
-                                              pg_svgf_settings s) {
+                                              pg_floatw inverse_phi_z, pg_floatw inverse_phi_l) {
   pg_floatw cos_n = fmin(fmax(pg_dot3w(n_c, n_q), 0.0f), 1.0f);
   pg_floatw e = fabs(z_c - z_q) * inverse_phi_z + fabs(luminance_c - luminance_q) * inverse_phi_l;
-  pg_floatw w = pg_svgf_power_w(cos_n, s.phi_normal) * exp(-e);
+  pg_floatw w = pg_svgf_normal_power_w(cos_n) * exp(-e);
   return select((pg_floatw)(0.0f), w, z_q > 0.0f);
 }
 

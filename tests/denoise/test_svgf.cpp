@@ -116,6 +116,7 @@ void expect_close(const std::vector<glm::vec4>& device, const std::vector<glm::v
 struct Case {
   int width, height, local_x, local_y, lanes;
   int atrous_radius = 2, history_atrous_radius = 2;
+  int phi_normal = 128;  // a build option of the kernels (kernels/shared/svgf.h)
 };
 
 // Every stage of three frames of a panning camera, device against host, for each case: the
@@ -129,8 +130,10 @@ void expect_equal_to_the_host_reference(ClRuntime& rt, const std::vector<Case>& 
     SCOPED_TRACE(std::to_string(c.width) + "x" + std::to_string(c.height) + ", local " +
                  std::to_string(c.local_x) + "x" + std::to_string(c.local_y) + ", lanes " +
                  std::to_string(c.lanes) + ", a-trous radius " + std::to_string(c.atrous_radius) +
-                 " (" + std::to_string(c.history_atrous_radius) + " up to the history)");
+                 " (" + std::to_string(c.history_atrous_radius) +
+                 " up to the history), phi_normal " + std::to_string(c.phi_normal));
     SvgfSettings s;
+    s.phi_normal = c.phi_normal;
     s.atrous_radius = c.atrous_radius;
     s.history_atrous_radius = c.history_atrous_radius;
     s.local_x = c.local_x;
@@ -206,6 +209,17 @@ TEST(SvgfKernels, EqualTheHostReferenceWithThe3x3Kernel) {
                                           {37, 23, 16, 16, 1, 1, 2},
                                           {40, 9, 7, 3, 8, 1, 2},
                                           {37, 23, 4, 4, 16, 2, 1}});
+}
+
+// The normal weight's exponent other than the paper's 128: the kernels square it out at build
+// time, the host reference in a loop over its bits (0: no normal weight; odd ones multiply at every
+// bit; 4096, the largest the settings take).
+TEST(SvgfKernels, EqualTheHostReferenceAtOtherNormalExponents) {
+  ClRuntime rt;
+  std::vector<Case> cases;
+  for (int phi : {0, 1, 7, 4096})
+    for (int lanes : {1, 16}) cases.push_back({37, 23, 4, 4, lanes, 2, 2, phi});
+  expect_equal_to_the_host_reference(rt, cases);
 }
 
 // A frame whose illumination is the same everywhere comes out as it went in, texture included:
