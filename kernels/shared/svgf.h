@@ -271,7 +271,7 @@ PG_FN void pg_svgf_inverse_phi_depth_table(float slope_c, float depth_c, float s
 /* The edge-stopping weight between the centre pixel c and a tap q (SVGF eq. 3-5):
  *   depth      exp(-|z_c - z_q| * inverse_phi_z), from pg_svgf_inverse_phi_depth at the tap's
  *              distance;
- *   normal     max(0, n_c . n_q)^sigma_n (sigma_n an integer, pg_svgf_power);
+ *   normal     max(0, n_c . n_q)^sigma_n (sigma_n an integer, pg_svgf_normal_power);
  *   luminance  exp(-|l_c - l_q| * inverse_phi_l), inverse_phi_l from
  *              pg_svgf_inverse_phi_luminance (0: no luminance term).
  * One exp for depth and luminance. A tap without a surface (depth 0) gets 0. */
