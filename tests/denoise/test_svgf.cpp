@@ -300,6 +300,20 @@ TEST(SvgfKernels, AtrousWeightsAreTheSplines) {
     EXPECT_EQ(shared::pg_svgf_atrous_weight(offset, 1), linear[offset + 1]) << offset;
 }
 
+// The squared tap distances the filters' 1 / phi_z tables fill (a constant per radius in
+// kernels/shared/svgf.h) are those of their taps, and no others.
+TEST(SvgfKernels, TapSquaredDistancesAreThoseOfTheTaps) {
+  for (int radius = 0; radius <= 5; ++radius) {
+    std::vector<int> expected(PG_SVGF_SQUARED_DISTANCES(radius) + 8, 0);
+    for (int dy = -radius; dy <= radius; ++dy)
+      for (int dx = -radius; dx <= radius; ++dx)
+        expected[shared::pg_svgf_squared_distance(dx, dy)] = 1;
+    for (int d2 = 0; d2 < static_cast<int>(expected.size()); ++d2)
+      EXPECT_EQ(shared::pg_svgf_is_tap_squared_distance(d2, radius), expected[d2])
+          << "radius " << radius << ", squared distance " << d2;
+  }
+}
+
 // A static camera. The luminance moments are a purely temporal average: with alpha 0 the first
 // moment is exactly the mean of all frames' luminance. The colour history is the filtered
 // illumination (SVGF feeds back the first a-trous output), so its expectation, not its value, is
