@@ -266,7 +266,8 @@ PG_ROW_LOAD void pg_store_row_float2_rows(__global float2* row, int x0, int widt
 
 /* The sum of a float vector's lanes, by halves (lanes l and l + PG_LANES / 2 first): a lane-by-
  * lane chain of PG_LANES - 1 dependent additions through memory was 5% of the sample kernel on
- * PoCL's CPU device. Exact for whole numbers, which is what the counts add up but for pi's sum. */
+ * PoCL's CPU device. Exact for counts (whole numbers); a sum of fractions (pi's, a statistic)
+ * rounds differently from the chain's. */
 static inline float pg_sum_lanes(pg_floatw v) {
 #if PG_LANES == 16
   float8 v8 = v.lo + v.hi;
