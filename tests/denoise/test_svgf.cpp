@@ -217,8 +217,12 @@ TEST(SvgfKernels, EqualTheHostReferenceWithThe3x3Kernel) {
 TEST(SvgfKernels, EqualTheHostReferenceAtOtherNormalExponents) {
   ClRuntime rt;
   std::vector<Case> cases;
-  for (int phi : {0, 1, 7, 4096})
-    for (int lanes : {1, 16}) cases.push_back({37, 23, 4, 4, lanes, 2, 2, phi});
+  if (simulated(rt)) {  // under Oclgrind, one exponent per kernel (the eight cases took 100 s)
+    cases = {{37, 23, 4, 4, 1, 2, 2, 7}, {37, 23, 4, 4, 16, 2, 2, 4096}};
+  } else {
+    for (int phi : {0, 1, 7, 4096})
+      for (int lanes : {1, 16}) cases.push_back({37, 23, 4, 4, lanes, 2, 2, phi});
+  }
   expect_equal_to_the_host_reference(rt, cases);
 }
 
