@@ -11,9 +11,12 @@ one of two ways:
   output).
 Anything else (a signal, another status, an unnamed message, a missing or half-written file) is
 reported with its command line, and the exit status is 1. Fixed seeds: the same --seed draws the
-same runs. A slow check, not part of the test suite: README.md, "Robustness checks".
+same runs. The long sweep is a slow check: README.md, "Robustness checks".
 
     python3 tools/cli_sweep.py [--runs 250] [--seed 3] [--binary build/rtpg] [--out DIR]
+                               [--scenes NAME ...]
+
+The test suite runs a short sweep (ctest cli_sweep_short: 16 runs on the three Cornell boxes).
 """
 import argparse
 import json
@@ -79,9 +82,10 @@ def camera_path(scene):
     return next(iter(paths), None)
 
 
-def draw(r, k, out):
-    """The k-th run's scene and arguments (after `rtpg render`), and its output files."""
-    scene = r.choice(SMALL_SCENES if r.random() < 0.9 else SCENES)
+def draw(r, k, out, scenes=None):
+    """The k-th run's scene (from `scenes` where given) and arguments (after `rtpg render`), and
+    its output files."""
+    scene = r.choice(scenes) if scenes else r.choice(SMALL_SCENES if r.random() < 0.9 else SCENES)
     w, h = r.choice([1, 2, 3, 7, 16, 17, 33, 65]), r.choice([1, 2, 5, 9, 16, 31])
     files = {"output": out / f"o{k}.exr", "stats": out / f"s{k}.json"}
     args = [str(ROOT / "scenes" / f"{scene}.json"), "--res", f"{w}x{h}", "-q",
@@ -133,13 +137,15 @@ def main():
     p.add_argument("--seed", type=int, default=3)
     p.add_argument("--binary", default=str(ROOT / "build" / "rtpg"))
     p.add_argument("--out", help="folder for the runs' files (default: a temporary one, removed)")
+    p.add_argument("--scenes", nargs="+", choices=SCENES,
+                   help="draw the scenes from these (default: the suite's, the large ones rarely)")
     a = p.parse_args()
     out = Path(a.out) if a.out else Path(tempfile.mkdtemp(prefix="rtpg-cli-sweep-"))
     out.mkdir(parents=True, exist_ok=True)
     r = random.Random(a.seed)
     failures, refusals = 0, 0
     for k in range(a.runs):
-        args, files = draw(r, k, out)
+        args, files = draw(r, k, out, a.scenes)
         result = subprocess.run([a.binary, "render", *args], capture_output=True, text=True,
                                 env=os.environ, timeout=600)
         problem = verdict(result, files, args)
