@@ -6,7 +6,7 @@ protocol of the variant tables in docs/guiding.md.
     python3 bench/variant_sweep.py --variants '{"pi 0.1": ["--pg-pi-min", "0.1", "--pg-pi-max", "0.1"]}' --scenes cornell-box sponza
 
 Per scene and seed: `rtpg render` of --frames 1-spp frames with --guiding off and with each variant's
-extra arguments, against a cached reference (`rtpg reference`, --ref-spp, seed 777); the figure is
+extra arguments, against a cached reference (`rtpg reference`, --ref-spp, --ref-seed); the figure is
 the mean relMSE of the last --window frames, PG/PT per seed, then the mean over seeds with the
 standard error of that mean. Renders are cached in --out by scene, variant name and seed, keyed by
 the variant's arguments, the size and frame count, and the binary (runner.binary_fingerprint: the
@@ -58,6 +58,8 @@ def main():
     parser.add_argument("--frames", type=int, default=32)
     parser.add_argument("--window", type=int, default=8, help="last frames whose relMSE is averaged")
     parser.add_argument("--ref-spp", type=int, default=1024)
+    parser.add_argument("--ref-seed", type=int, default=777,
+                        help="the references' seed (1000: those of the equal-time experiment)")
     parser.add_argument("--out", default=str(runner.ROOT / "build" / "variant-sweep"))
     parser.add_argument("--camera-path", action="store_true",
                         help="follow each scene's first camera path; the figure comes from --checkpoints")
@@ -99,7 +101,7 @@ def main():
                                  extra=["--seed", seed, "--camera-path", name, "--save-frames",
                                         ",".join(map(str, checkpoints)), *extra])
         errors = [metrics.relmse(metrics.load_exr(runner.saved_frame(image, f)),
-                                 metrics.load_exr(refs.get(scene, args.res, args.ref_spp, seed=777, camera_path=name,
+                                 metrics.load_exr(refs.get(scene, args.res, args.ref_spp, seed=args.ref_seed, camera_path=name,
                                                            frame=f)))
                   for f in checkpoints]
         value = statistics.fmean(errors)
@@ -110,7 +112,7 @@ def main():
     def relmse(scene, tag, seed, guiding, extra):
         if args.camera_path:
             return path_relmse(scene, tag, seed, guiding, extra)
-        reference = refs.get(scene, args.res, args.ref_spp, seed=777)
+        reference = refs.get(scene, args.res, args.ref_spp, seed=args.ref_seed)
         run_dir = out / scene
         run_tag = f"{tag}-{seed}-{run_key(extra, args.frames)}"
         cached = run_dir / f"{run_tag}.json"

@@ -55,10 +55,24 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES i
     pg_pmm_state_w s;
     pg_load_row_float4_rows(in_state0 + row_start, x0, w, &s.w, &s.s0, &s.sx, &s.sy);
     pg_load_row_float4_rows(in_state1 + row_start, x0, w, &s.sxx, &s.syy, &s.sxy, &s.k);
-    s = pg_pmm_state_select_w(pg_pmm_initial_state_w(), s, applies);
-    int any_model = any(applies & (s.k > 0.0f));
     pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
                             &unused);
+    /* Lanes that share the model of the pixel above them take its state (pg_shares_model). */
+    pg_intw shares =
+        pg_shares_model_w(PG_PASS_GBUFFER x0, y, w,
+                          pg_model_sharable_w(pixel_flags, roughness, metallic, specular, settings),
+                          normal, settings);
+    if (any(shares)) {
+      int model_start = pg_model_row(y, settings) * w;
+      pg_pmm_state_w model;
+      pg_load_row_float4_rows(in_state0 + model_start, x0, w, &model.w, &model.s0, &model.sx,
+                              &model.sy);
+      pg_load_row_float4_rows(in_state1 + model_start, x0, w, &model.sxx, &model.syy, &model.sxy,
+                              &model.k);
+      s = pg_pmm_state_select_w(s, model, shares);
+    }
+    s = pg_pmm_state_select_w(pg_pmm_initial_state_w(), s, applies);
+    int any_model = any(applies & (s.k > 0.0f));
     pg_load_row_float4_rows(view_dir + row_start, x0, w, &view.x, &view.y, &view.z, &unused);
     pg_intw lane_x = min(x0 + pg_lane_numbers(), (pg_intw)(w - 1));
     pg_uintw rng = pg_rng_make_w(seed, pg_convert_uintw(row_start + lane_x), frame, sample_index,

@@ -61,6 +61,18 @@ static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x0, i
   pg_intw mature = k >= 0.25f * settings.k_max;
   if (!run_trains) active &= ~mature;
   if (!any(active)) return 0.0f;
+  pg_floatw metallic, specular, unused;
+  pg_load_row_float4_rows(metallic_specular + row_start, x0, w, &metallic, &specular, &unused,
+                          &unused);
+  pg_float3w normal, view;
+  pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
+                          &unused);
+  /* A lane that samples with the model of the pixel above it trains none of its own. */
+  active &= ~pg_shares_model_w(
+      PG_PASS_GBUFFER x0, y, w,
+      active & pg_model_sharable_w(pixel_flags, roughness, metallic, specular, settings), normal,
+      settings);
+  if (!any(active)) return 0.0f;
   pg_load_row_float4_rows(state0 + row_start, x0, w, &original.w, &original.s0, &original.sx,
                           &original.sy);
   /* pg_pmm_neighbour_count, bounded by the window and the sample array. */
@@ -75,14 +87,8 @@ static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x0, i
   pg_pmm_state_w result = original;
 
   pg_train_pixels_w px;
-  pg_floatw metallic, specular, unused;
   pg_load_row_float4_rows(position_depth + row_start, x0, w, &px.x.x, &px.x.y, &px.x.z, &unused);
-  pg_float3w normal, view;
-  pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
-                          &unused);
   pg_load_row_float4_rows(view_dir + row_start, x0, w, &view.x, &view.y, &view.z, &unused);
-  pg_load_row_float4_rows(metallic_specular + row_start, x0, w, &metallic, &specular, &unused,
-                          &unused);
   px.frame = pg_frame_from_normal_w(normal);
   px.wo = pg_to_local_w(px.frame, view);
   px.lobes = pg_make_lobes_w(base_color, roughness, metallic, specular, px.wo);

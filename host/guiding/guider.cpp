@@ -9,8 +9,8 @@
 namespace rtpg {
 namespace {
 
-static_assert(sizeof(pg_kernel_settings) == 24 * 4,
-              "pg_kernel_settings: 24 plain 4-byte fields, no padding");
+static_assert(sizeof(pg_kernel_settings) == 25 * 4,
+              "pg_kernel_settings: 25 plain 4-byte fields, no padding");
 static_assert(sizeof(pg_gbuffer_cameras) == 34 * 4,
               "pg_gbuffer_cameras must hold only 4-byte fields (include/rtpg/guiding_layout.h)");
 static_assert(sizeof(shared::pg_pmm_state) == 4 * PG_STATE_FLOATS_PER_PIXEL,

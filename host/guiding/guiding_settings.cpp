@@ -64,6 +64,9 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
            "turn (0 = off)"),
       integer("train_interval", &S::train_interval, 1, 64,
               "A mature pixel (k >= k_max/4) trains every this many frames"),
+      integer("rows_per_model", &S::rows_per_model, 1, 8,
+              "1, 2, 4 or 8: pixels of a column's group of this many rows showing the first "
+              "one's surface sample with its model and train none of their own"),
       integer("train_all_samples", &S::train_all_samples, 0, 1,
               "1: train on every VPL at its mixture density; 0: BSDF samples only"),
       integer("pi_learning", &S::pi_learning, 0, 1,
@@ -116,6 +119,9 @@ void validate(const GuidingSettings& s) {
          setting_number(s.pi_max) + ")");
   const std::pair<const char*, int> lanes[] = {{"train_lanes", s.train_lanes},
                                                {"sample_lanes", s.sample_lanes}};
+  if (s.rows_per_model & (s.rows_per_model - 1))
+    fail("rows_per_model = " + setting_number(s.rows_per_model) +
+         " must be a power of two: 1, 2, 4 or 8");
   for (const auto& [name, value] : lanes)
     if (value & (value - 1))
       fail(std::string(name) + " = " + setting_number(value) +
@@ -154,6 +160,7 @@ pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {
   p.train_all_samples = c.train_all_samples;
   p.reseed_samples = c.reseed_samples;
   p.pi_learning = c.pi_learning;
+  p.rows_per_model = c.rows_per_model;
   return p;
 }
 

@@ -223,6 +223,9 @@ typedef struct pg_kernel_settings {
                             0: EM's weight (paper 3.2) */
   float reproject_view_memory; /* a glossy model's k falls by 1/e per this many GGX alphas of
                                   view turn (pg_pmm_view_aged_k); 0: k survives reprojection */
+  int rows_per_model; /* 1, 2, 4 or 8: a pixel samples with the model of the first pixel of its
+                         group of this many rows where the two may share one (pg_shares_model),
+                         and then does not train its own */
 } pg_kernel_settings;
 
 #ifdef __cplusplus

@@ -46,6 +46,11 @@ struct GuidingSettings {
   int train_all_samples = 1;  // 1: every VPL trains, weighted by its full mixture density;
                               // 0: BSDF-strategy VPLs only (paper 3.2); 1 since it costs nothing
                               // in train_wide (docs/guiding.md, "Every VPL trains, revisited")
+  int rows_per_model = 1;     // 1, 2, 4 or 8: the pixels of a column's group of this many rows
+                              // that show the first one's surface (both diffuse or rough:
+                              // shared/guiding_pixel.h, pg_shares_model) sample with its model
+                              // and train none of their own, so train runs on fewer pixels
+                              // (docs/guiding.md, "Models shared by rows")
   int pi_learning = 0;        // 1: the mixing weight is the one that minimises the first
                               // bounce's second moment (a Newton step per frame on the
                               // training samples); 0: EM's weight (paper 3.2)

@@ -8,8 +8,8 @@
 
 int main(void) {
   int failed = 0;
-  if (sizeof(pg_kernel_settings) != 24 * 4) {
-    printf("pg_kernel_settings: %u bytes, expected 96\n", (unsigned)sizeof(pg_kernel_settings));
+  if (sizeof(pg_kernel_settings) != 25 * 4) {
+    printf("pg_kernel_settings: %u bytes, expected 100\n", (unsigned)sizeof(pg_kernel_settings));
     failed = 1;
   }
   if (sizeof(pg_gbuffer_cameras) != 34 * 4) {

@@ -286,7 +286,7 @@ TEST(GuiderApi, HostDistributionHasTheSampleKernelsDensity) {
 TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
   EXPECT_NO_THROW(rtpg::validate(rtpg::GuidingSettings{}));
   const auto& table = rtpg::guiding_settings_table();
-  EXPECT_EQ(table.size(), 27u);
+  EXPECT_EQ(table.size(), 28u);
   for (const rtpg::GuidingSettingInfo& row : table) {
     ASSERT_TRUE((row.float_field != nullptr) != (row.int_field != nullptr)) << row.name;
     EXPECT_TRUE(row.in_range(row.get(rtpg::GuidingSettings{}))) << row.name;
@@ -327,13 +327,25 @@ TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
         EXPECT_THROW(rtpg::validate(s), rtpg::GuiderError) << lanes;
       }
     }
+  // Rows per shared model: a power of two (the kernels find a row's group by y - y % R).
+  for (int rows = 1; rows <= 8; ++rows) {
+    s = rtpg::GuidingSettings{};
+    s.rows_per_model = rows;
+    if (rows == 1 || rows == 2 || rows == 4 || rows == 8) {
+      EXPECT_NO_THROW(rtpg::validate(s)) << rows;
+    } else {
+      EXPECT_THROW(rtpg::validate(s), rtpg::GuiderError) << rows;
+    }
+  }
   // The kernels' block carries the values (integers as floats where the kernels want them).
   s = rtpg::GuidingSettings{};
   s.k_max = 17;
   s.apron = 3;
+  s.rows_per_model = 4;
   const rtpg::pg_kernel_settings k = rtpg::to_kernel_settings(s);
   EXPECT_EQ(k.k_max, 17.0f);
   EXPECT_EQ(k.apron, 3);
+  EXPECT_EQ(k.rows_per_model, 4);
   EXPECT_EQ(k.reproject_position, s.reproject_position);
   // The window walk's stride visits all 49 cells of a 7x7 window: coprime with 49.
   EXPECT_GT(k.stride, 0);

@@ -155,6 +155,23 @@ HostGBuffer random_gbuffer(Random& r, int w, int h) {
   return g;
 }
 
+// For cases with models shared by rows: in the left half of the image every pixel of a group's
+// later rows shows the surface of the pixel above it in the group's first row (its position a
+// hundredth of a pixel away, its normal and material), and keeps its own flags and material
+// parameters, so that it shares that pixel's model where both are sharable (pg_shares_model).
+void share_rows(HostGBuffer& g, int rows_per_model) {
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width / 2; ++x) {
+      const int model_y = y - y % rows_per_model;
+      if (model_y == y) continue;
+      const std::size_t i = static_cast<std::size_t>(y) * g.width + x;
+      const std::size_t m = static_cast<std::size_t>(model_y) * g.width + x;
+      g.position_depth[i] = g.position_depth[m] + float4(1e-4f, 0.0f, 0.0f, 0.0f);
+      g.shading_normal[i] = g.shading_normal[m];
+      g.material[i] = g.material[m];
+    }
+}
+
 // VPLs above the floor: invalid ones, distant ones (a direction and a solid-angle density),
 // ones produced by the guide strategy (which train only with train_all_samples), facing away,
 // zero density, zero and very bright radiance; the mixture density in normal.w.
@@ -285,6 +302,27 @@ struct PixelMixture {
   float pdf(float3 wi) const { return sh::pg_pmm_pdf(model, lobes, wo, wi); }
 };
 
+// What shared/guiding_pixel.h's pg_shares_model reads of host G-buffer pixel i.
+sh::pg_sharing_pixel sharing_pixel(const HostGBuffer& g, std::size_t i) {
+  sh::pg_sharing_pixel s;
+  s.flags = g.flags[i];
+  s.material = g.material[i];
+  s.base_color_roughness = g.base_color_roughness[i];
+  s.metallic_specular = g.metallic_specular[i];
+  s.position_depth = g.position_depth[i];
+  s.normal = sh::pg_float4_xyz(g.shading_normal[i]);
+  return s;
+}
+
+// The kernels' pg_model_pixel: the pixel whose model pixel i samples with.
+std::size_t model_pixel(const HostGBuffer& g, std::size_t i, const pg_kernel_settings& p) {
+  const int y = static_cast<int>(i / static_cast<std::size_t>(g.width));
+  const int model_y = sh::pg_model_row(y, p);
+  if (model_y == y) return i;
+  const std::size_t m = i - static_cast<std::size_t>(y - model_y) * g.width;
+  return sh::pg_shares_model(sharing_pixel(g, i), sharing_pixel(g, m), p) ? m : i;
+}
+
 // sample.cl.
 void host_sample(const std::vector<float>& state, const HostGBuffer& g, std::uint32_t seed,
                  std::uint32_t frame, std::uint32_t sample_index, const pg_kernel_settings& p,
@@ -301,7 +339,7 @@ void host_sample(const std::vector<float>& state, const HostGBuffer& g, std::uin
     }
     const float4 bcr = g.base_color_roughness[i];
     sh::pg_pmm_state s = sh::pg_pmm_initial_state();
-    if (sh::pg_guiding_applies(g.flags[i], bcr.w, p)) s = state_at(state, i);
+    if (sh::pg_guiding_applies(g.flags[i], bcr.w, p)) s = state_at(state, model_pixel(g, i, p));
     PixelMixture& m = mixture[i];
     m.state = s;
     m.model = sh::pg_pmm_model_from_state(s, p);
@@ -439,7 +477,8 @@ std::vector<float> host_train(const std::vector<float>& state, const HostGBuffer
       const float4 bcr = g.base_color_roughness[i];
       sh::pg_pmm_state s = state_at(state, i);
       if (!sh::pg_guiding_applies(g.flags[i], bcr.w, p) ||
-          !sh::pg_train_this_frame(s.s1.w, x, y, frame, p))
+          !sh::pg_train_this_frame(s.s1.w, x, y, frame, p) ||
+          model_pixel(g, static_cast<std::size_t>(i), p) != static_cast<std::size_t>(i))
         continue;
       sh::pg_train_pixel px;
       px.x = sh::pg_float4_xyz(g.position_depth[i]);
@@ -694,11 +733,19 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
     // the GGX lobe.
     if (kc.apron == 3)
       for (std::size_t i = g.n() / 2; i < g.n(); ++i) g.metallic_specular[i] = float4(0.0f);
-    const GuiderGBuffer dg = upload(rt, g);
     GuidingSettings settings;
     settings.local_x = kc.local_x;
     settings.local_y = kc.local_y;
+    // Models shared by pairs of rows and by groups of four in two of the cases.
+    settings.rows_per_model = kc.apron == 1 ? 2 : (kc.apron == 3 ? 4 : 1);
+    share_rows(g, settings.rows_per_model);
+    const GuiderGBuffer dg = upload(rt, g);
     const pg_kernel_settings p = to_kernel_settings(settings);
+    std::size_t sharing = 0;
+    for (std::size_t i = 0; i < g.n(); ++i) sharing += model_pixel(g, i, p) != i;
+    if (settings.rows_per_model > 1) {
+      EXPECT_GT(sharing, g.n() / 20) << name(kc);
+    }
     const std::vector<float> state = random_states(r, g.n(), p.k_max, false);
     const GuiderSamples samples = make_guider_samples(rt.context(), kc.width, kc.height);
     for (std::uint32_t frame = 0; frame < 3 * std::size(lane_counts); ++frame) {
@@ -848,12 +895,21 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
             sh::pg_pack_vpl_normal_radiance(sh::pg_vpl_normal(v.normal_radiance[i]),
                                             sh::pg_vpl_mixture_density(v.normal_radiance[i]),
                                             float3(0.0f), sh::pg_vpl_info(v.normal_radiance[i]));
-    const GuiderGBuffer dg = upload(rt, g);
-    const GuiderVpls dv = upload(rt, v, g.width, g.height);
     GuidingSettings settings;
     settings.local_x = kc.local_x;
     settings.local_y = kc.local_y;
     settings.apron = kc.apron;
+    // Models shared by pairs of rows and by groups of four in two of the cases.
+    settings.rows_per_model = kc.apron == 1 ? 2 : (kc.apron == 3 ? 4 : 1);
+    share_rows(g, settings.rows_per_model);
+    if (settings.rows_per_model > 1) {
+      const pg_kernel_settings sharing_settings = to_kernel_settings(settings);
+      std::size_t sharing = 0;
+      for (std::size_t i = 0; i < g.n(); ++i) sharing += model_pixel(g, i, sharing_settings) != i;
+      EXPECT_GT(sharing, g.n() / 20) << name(kc);
+    }
+    const GuiderGBuffer dg = upload(rt, g);
+    const GuiderVpls dv = upload(rt, v, g.width, g.height);
     // The training options vary with the case (every case has its own apron): every VPL at
     // its mixture density and the weight clamp with apron 2, amortised training of mature pixels
     // and re-seeds that take two samples of a batch with apron 1, the variance-aware mixing weight

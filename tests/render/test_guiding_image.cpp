@@ -49,6 +49,7 @@ struct RunShape {
   bool world_guide = false;      // later vertices sample the world-space guide's cells
   int world_max_depth = WorldGuideSettings{}.max_depth;  // the deepest vertex it guides
   bool pi_learning = false;  // the variance-aware mixing weight (GuidingSettings)
+  int rows_per_model = 1;    // models shared by rows (GuidingSettings)
   FirstBounceMis first_bounce_mis = FirstBounceMis::bsdf;  // PathTracerSettings
   bool direct_light_in_vpls = true;                        // PathTracerSettings
   HostTransfer transfer = HostTransfer::automatic;         // the guided first bounce's
@@ -115,6 +116,7 @@ TileSeries run(const Scene& scene, Method method, int size, int frames, ClRuntim
   if (guided) {
     GuidingSettings guiding;
     guiding.pi_learning = shape.pi_learning ? 1 : 0;
+    guiding.rows_per_model = shape.rows_per_model;
     std::unique_ptr<FirstBounceSampler> sampler =
         std::make_unique<GuidedFirstBounce>(cl, size, size, guiding, shape.transfer);
     if (method == Method::GuidedWithBias)
@@ -323,6 +325,15 @@ TEST(GuidingImage, UnbiasedWithLaterVerticesGuidedAlongCameraPathAtTwoSpp) {
 TEST(GuidingImage, UnbiasedWithLearnedMixingWeightAlongCameraPathAtTwoSpp) {
   RunShape shape{2, "pan"};
   shape.pi_learning = true;
+  expect_same_means("cornell-box.json", 120, 0.0015, shape);
+}
+
+// Models shared by groups of four rows (--pg-rows-per-model 4): a pixel samples with the model of
+// the pixel above it where the two show one surface, and its first bounce's density, in the
+// samples and in next-event MIS, is that model's, along a moving camera.
+TEST(GuidingImage, UnbiasedWithModelsSharedByRowsAlongCameraPathAtTwoSpp) {
+  RunShape shape{2, "pan"};
+  shape.rows_per_model = 4;
   expect_same_means("cornell-box.json", 120, 0.0015, shape);
 }
 
@@ -756,6 +767,7 @@ TEST(GuidingImage, EverySettingAwayFromItsDefaultStillGuides) {
                                                 {"reproject_normal", 0.5},
                                                 {"reproject_view_memory", 2},
                                                 {"train_interval", 4},
+                                                {"rows_per_model", 2},
                                                 {"train_all_samples", 0},
                                                 {"pi_learning", 1},
                                                 {"local_x", 8},
