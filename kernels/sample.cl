@@ -10,8 +10,8 @@
 #include "shared/rng.h"
 #include "shared/work_group_sum.h"
 
-/* One pixel inside the image, sampled with the model of pixel model_index (pg_model_pixel); returns
- * its counts (surface, guided, pi, 0). */
+/* One pixel inside the image, sampled with the model of pixel model_index (pg_model_pixel);
+ * returns its counts (surface, guided, pi, 0). */
 static float4 pg_sample_pixel(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint i,
                               uint model_index, uint seed, uint frame, uint sample_index,
                               uint write_mixture, pg_kernel_settings settings) {

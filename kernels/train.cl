@@ -30,7 +30,8 @@ static int pg_train_pixel_at(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x, i
   if (!pg_guiding_applies(flags[i], bcr.w, settings)) return 0;
   if (!pg_train_this_frame(state1[i].w, x, y, frame, settings)) return 0;
   /* A pixel that samples with the model of the pixel above it trains none of its own. */
-  if (pg_model_pixel(PG_PASS_GBUFFER(uint) x, (uint)y, width, settings) != (uint)i) return 0;
+  uint column = (uint)x, row = (uint)y;
+  if (pg_model_pixel(PG_PASS_GBUFFER column, row, width, settings) != (uint)i) return 0;
   pg_pmm_state state;
   state.s0 = state0[i];
   state.s1 = state1[i];
