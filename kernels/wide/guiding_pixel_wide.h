@@ -49,7 +49,8 @@ static inline pg_intw pg_shares_model_w(PG_ARGS_GBUFFER int x0, int y, int w, pg
                           &model_normal.z, &unused);
   pg_float3w d = pg_sub3w(position, model_position);
   return shares & (depth > 0.0f) & (sqrt(pg_dot3w(d, d)) <= p.reproject_position * depth) &
-         (pg_dot3w(normal, model_normal) >= p.reproject_normal) &
+         (pg_dot3w(normal, model_normal) >=
+          fmax(p.reproject_normal, PG_SHARED_MODEL_MIN_NORMAL_COS)) &
          (pg_load_row_uints(material + row_start, x0, w) ==
           pg_load_row_uints(material + model_start, x0, w)) &
          (model_depth > 0.0f);
