@@ -58,10 +58,12 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES i
     pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
                             &unused);
     /* Lanes that share the model of the pixel above them take its state (pg_shares_model). */
-    pg_intw shares =
-        pg_shares_model_w(PG_PASS_GBUFFER x0, y, w,
-                          pg_model_sharable_w(pixel_flags, roughness, metallic, specular, settings),
-                          normal, settings);
+    pg_intw shares = (pg_intw)(0);
+    if (settings.rows_per_model > 1)
+      shares = pg_shares_model_w(
+          PG_PASS_GBUFFER x0, y, w,
+          pg_model_sharable_w(pixel_flags, roughness, metallic, specular, settings), normal,
+          settings);
     if (any(shares)) {
       int model_start = pg_model_row(y, settings) * w;
       pg_pmm_state_w model;

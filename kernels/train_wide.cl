@@ -68,11 +68,13 @@ static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x0, i
   pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
                           &unused);
   /* A lane that samples with the model of the pixel above it trains none of its own. */
-  active &= ~pg_shares_model_w(
-      PG_PASS_GBUFFER x0, y, w,
-      active & pg_model_sharable_w(pixel_flags, roughness, metallic, specular, settings), normal,
-      settings);
-  if (!any(active)) return 0.0f;
+  if (settings.rows_per_model > 1) {
+    active &= ~pg_shares_model_w(
+        PG_PASS_GBUFFER x0, y, w,
+        active & pg_model_sharable_w(pixel_flags, roughness, metallic, specular, settings), normal,
+        settings);
+    if (!any(active)) return 0.0f;
+  }
   pg_load_row_float4_rows(state0 + row_start, x0, w, &original.w, &original.s0, &original.sx,
                           &original.sy);
   /* pg_pmm_neighbour_count, bounded by the window and the sample array. */
