@@ -12,7 +12,7 @@
 
 /* One pixel inside the image, sampled with the model of pixel model_index (pg_model_pixel);
  * returns its counts (surface, guided, pi, 0). */
-static float4 pg_sample_pixel(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES uint i,
+static float4 pg_sample_pixel(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES uint i,
                               uint model_index, uint seed, uint frame, uint sample_index,
                               uint write_mixture, pg_kernel_settings settings) {
   uint f = flags[i];
@@ -28,8 +28,13 @@ static float4 pg_sample_pixel(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES u
   float4 bcr = base_color_roughness[i];
   pg_pmm_state state = pg_pmm_initial_state();
   if (pg_guiding_applies(f, bcr.w, settings)) {
-    state.s0 = in_state0[model_index];
-    state.s1 = in_state1[model_index];
+    state.s0 = state0[model_index];
+    state.s1 = state1[model_index];
+    /* A pixel that shares its model carries it as its own state (pg_shares_model). */
+    if (model_index != i) {
+      state0[i] = state.s0;
+      state1[i] = state.s1;
+    }
   }
   pg_pmm_model model = pg_pmm_model_from_state(state, settings);
   pg_frame frame_x = pg_frame_from_normal(shading_normal[i].xyz);
@@ -50,13 +55,13 @@ static float4 pg_sample_pixel(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES u
   return model.valid ? (float4)(1.0f, 1.0f, model.pi, 0.0f) : (float4)(1.0f, 0.0f, 0.0f, 0.0f);
 }
 
-__kernel void sample(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES __global float4* counts,
+__kernel void sample(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES __global float4* counts,
                      uint width, uint height, uint seed, uint frame, uint sample_index,
                      uint write_mixture, pg_kernel_settings settings, __local float4* scratch) {
   uint x = get_global_id(0), y = get_global_id(1);
   float4 count = (float4)(0.0f);
   if (x < width && y < height)
-    count = pg_sample_pixel(PG_PASS_GBUFFER PG_PASS_IN_STATE PG_PASS_SAMPLES y * width + x,
+    count = pg_sample_pixel(PG_PASS_GBUFFER PG_PASS_STATE PG_PASS_SAMPLES y * width + x,
                             pg_model_pixel(PG_PASS_GBUFFER x, y, width, settings), seed, frame,
                             sample_index, write_mixture, settings);
   pg_store_work_group_counts(counts, scratch, count);

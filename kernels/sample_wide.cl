@@ -26,7 +26,7 @@
 
 /* The lanes' pixels x0 .. x0 + PG_LANES - 1 of row y (x0 inside the image); returns their
  * counts (surfaces, guided, pi, 0). */
-static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES int x0, int y,
+static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES int x0, int y,
                               uint width, uint seed, uint frame, uint sample_index,
                               uint write_mixture, pg_kernel_settings settings) {
   int w = (int)width, row_start = y * w;
@@ -53,8 +53,8 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES i
   m.pi = m.mx = m.my = m.l11 = m.l21 = m.l22 = zero;
   if (any_surface) {
     pg_pmm_state_w s;
-    pg_load_row_float4_rows(in_state0 + row_start, x0, w, &s.w, &s.s0, &s.sx, &s.sy);
-    pg_load_row_float4_rows(in_state1 + row_start, x0, w, &s.sxx, &s.syy, &s.sxy, &s.k);
+    pg_load_row_float4_rows(state0 + row_start, x0, w, &s.w, &s.s0, &s.sx, &s.sy);
+    pg_load_row_float4_rows(state1 + row_start, x0, w, &s.sxx, &s.syy, &s.sxy, &s.k);
     pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
                             &unused);
     /* Lanes that share the model of the pixel above them take its state (pg_shares_model). */
@@ -67,11 +67,16 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES i
     if (any(shares)) {
       int model_start = pg_model_row(y, settings) * w;
       pg_pmm_state_w model;
-      pg_load_row_float4_rows(in_state0 + model_start, x0, w, &model.w, &model.s0, &model.sx,
+      pg_load_row_float4_rows(state0 + model_start, x0, w, &model.w, &model.s0, &model.sx,
                               &model.sy);
-      pg_load_row_float4_rows(in_state1 + model_start, x0, w, &model.sxx, &model.syy, &model.sxy,
+      pg_load_row_float4_rows(state1 + model_start, x0, w, &model.sxx, &model.syy, &model.sxy,
                               &model.k);
       s = pg_pmm_state_select_w(s, model, shares);
+      /* Lanes that share carry the model as their own state (pg_shares_model); the
+       * others store their own unchanged. No other work-item reads this row's state: a
+       * group's first row, the only one read as a model, never shares. */
+      pg_store_row_float4_rows(state0 + row_start, x0, w, s.w, s.s0, s.sx, s.sy);
+      pg_store_row_float4_rows(state1 + row_start, x0, w, s.sxx, s.syy, s.sxy, s.k);
     }
     s = pg_pmm_state_select_w(pg_pmm_initial_state_w(), s, applies);
     int any_model = any(applies & (s.k > 0.0f));
@@ -113,14 +118,14 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES i
                   pg_sum_lanes(select(zero, m.pi, with_model)), 0.0f);
 }
 
-__kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_IN_STATE PG_ARGS_SAMPLES __global float4* counts,
+__kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES __global float4* counts,
                           uint width, uint height, uint seed, uint frame, uint sample_index,
                           uint write_mixture, pg_kernel_settings settings,
                           __local float4* scratch) {
   int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
   float4 count = (float4)(0.0f);
   if (x0 < (int)width && y < (int)height)
-    count = pg_sample_lanes(PG_PASS_GBUFFER PG_PASS_IN_STATE PG_PASS_SAMPLES x0, y, width, seed,
-                            frame, sample_index, write_mixture, settings);
+    count = pg_sample_lanes(PG_PASS_GBUFFER PG_PASS_STATE PG_PASS_SAMPLES x0, y, width, seed, frame,
+                            sample_index, write_mixture, settings);
   pg_store_work_group_counts(counts, scratch, count);
 }

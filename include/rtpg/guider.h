@@ -286,6 +286,8 @@ class Guider {
   // Carries last frame's state into this frame (previous: last frame's G-buffer).
   void reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous,
                  Wait wait = Wait::finish);
+  // Draws each pixel's first-bounce direction into out. With rows_per_model > 1 it also writes
+  // the state of a pixel that shares its model: the model's, as its own.
   void sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint32_t frame,
               std::uint32_t sample_index, const GuiderSamples& out,
               SampleOutputs outputs = SampleOutputs::directions_and_mixture,

@@ -47,11 +47,11 @@ struct GuidingSettings {
                               // 0: BSDF-strategy VPLs only (paper 3.2); 1 since it costs nothing
                               // in train_wide (docs/guiding.md, "Every VPL trains, revisited")
   int rows_per_model = 1;     // 1, 2, 4 or 8: the pixels of a column's group of this many rows
-                              // that show the first one's surface, normals within 8 degrees,
+                              // that show the first one's surface, normals within 1.1 degrees,
                               // both diffuse or rough (kernels/shared/guiding_pixel.h,
-                              // pg_shares_model), sample with its model and train none of
-                              // their own, so train runs on fewer pixels; off (1) by default
-                              // (docs/guiding.md, "Models shared by rows")
+                              // pg_shares_model), sample with its model, carry it as their own
+                              // state and train none, so train runs on fewer pixels; off (1)
+                              // by default (docs/guiding.md, "Models shared by rows")
   int pi_learning = 0;        // 1: the mixing weight is the one that minimises the first
                               // bounce's second moment (a Newton step per frame on the
                               // training samples); 0: EM's weight (paper 3.2)

@@ -47,9 +47,13 @@ typedef struct {
 
 /* Whether pixel a samples with the model of pixel m, the first of its group's rows: both
  * sharable, the same surface by reprojection's test (pg_same_surface), and shading normals
- * within about 8 degrees (a bump map's normals vary from pixel to pixel: with reprojection's
- * 25 degrees Sponza lost 4.8% of its error at 960x540, with 8 degrees 2.4%). */
-#define PG_SHARED_MODEL_MIN_NORMAL_COS 0.99f
+ * within about 1.1 degrees: the model is used in a's frame as it is, and a bump map's normals
+ * vary from pixel to pixel (Sponza at 960x540, rows in pairs: 25 degrees +4.8% error, 8
+ * degrees +2.4%, 1.1 degrees +0.8%). Where it holds, the sample kernel also writes m's state
+ * as a's own, which train then leaves alone: a pixel that stops sharing (its jittered normal
+ * or position moves, the camera moves) starts from its neighbour's model instead of from the
+ * untrained state it would otherwise have kept (docs/guiding.md, "Models shared by rows"). */
+#define PG_SHARED_MODEL_MIN_NORMAL_COS 0.9998f
 PG_FN int pg_shares_model(pg_sharing_pixel a, pg_sharing_pixel m, pg_kernel_settings p) {
   return pg_model_sharable(a.flags, a.base_color_roughness, a.metallic_specular, p) &&
          pg_model_sharable(m.flags, m.base_color_roughness, m.metallic_specular, p) &&

@@ -32,7 +32,8 @@
 #define PG_ARGS_PACKED_VPLS PG_PACKED_VPL_CHANNELS(PG_ARG_IN_PACKED)
 #define PG_ARGS_IN_STATE PG_STATE_CHANNELS(PG_ARG_IN_STATE)
 #define PG_ARGS_OUT_STATE PG_STATE_CHANNELS(PG_ARG_OUT_STATE)
-/* The state updated in place (train: each work-item reads and writes only its own pixels). */
+/* The state updated in place: train (each work-item reads and writes only its own pixels) and
+ * sample (a pixel sharing its model stores it as its own; kernels/shared/guiding_pixel.h). */
 #define PG_ARGS_STATE PG_STATE_CHANNELS(PG_ARG_STATE)
 #define PG_ARGS_SAMPLES PG_SAMPLE_CHANNELS(PG_ARG_OUT)
 #define PG_ARGS_IN_SAMPLES PG_SAMPLE_CHANNELS(PG_ARG_IN_SAMPLE) /* read by pack_samples */
@@ -42,11 +43,9 @@
  * its own (a kernel with a work-group reduction at its end cannot return early). */
 #define PG_PASS_CHANNEL(name, type, bytes) name,
 #define PG_PASS_VPL_CHANNEL(name, type, bytes) vpl_##name,
-#define PG_PASS_IN_STATE_CHANNEL(name, type, bytes) in_##name,
 #define PG_PASS_GBUFFER PG_GBUFFER_CHANNELS(PG_PASS_CHANNEL)
 #define PG_PASS_VPLS PG_VPL_CHANNELS(PG_PASS_VPL_CHANNEL)
 #define PG_PASS_STATE PG_STATE_CHANNELS(PG_PASS_CHANNEL)
-#define PG_PASS_IN_STATE PG_STATE_CHANNELS(PG_PASS_IN_STATE_CHANNEL)
 #define PG_PASS_SAMPLES PG_SAMPLE_CHANNELS(PG_PASS_CHANNEL)
 
 #endif

@@ -756,6 +756,17 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
       guider.write_state(state);
       const std::uint32_t seed = 7u + frame * 13u;
       guider.sample(dg, seed, frame, frame % 2u, samples);
+      // A pixel that shares its model now holds the model's state as its own, to the bit
+      // (kernels/shared/guiding_pixel.h, pg_shares_model); every other state is untouched.
+      std::vector<float> carried;
+      guider.read_state(carried);
+      std::size_t carried_wrong = 0;
+      for (std::size_t i = 0; i < g.n(); ++i) {
+        const std::size_t from = model_pixel(g, i, p) * PG_STATE_FLOATS_PER_PIXEL;
+        carried_wrong += std::memcmp(carried.data() + i * PG_STATE_FLOATS_PER_PIXEL,
+                                     state.data() + from, PG_STATE_FLOATS_PER_PIXEL * 4) != 0;
+      }
+      EXPECT_EQ(carried_wrong, 0u) << name(kc) << ", " << settings.sample_lanes << " lanes";
       std::vector<float4> got_dir(g.n()), want_dir, got_mixture_a(g.n());
       std::vector<float2> got_mixture_b(g.n());
       std::vector<std::uint32_t> got_strategy(g.n()), want_strategy;
