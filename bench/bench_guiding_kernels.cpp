@@ -442,6 +442,9 @@ std::unique_ptr<Guider> make_guider(int w, int h, int lx, int ly,
   settings.local_y = ly;
   settings.train_memory = memory;
   settings.train_lanes = lanes;
+  // A model per pixel, as the flop and byte counts assume (the synthetic G-buffer's random
+  // normals would rarely let a pixel share one; docs/guiding.md, "Models shared by rows").
+  settings.rows_per_model = 1;
   auto guider = std::make_unique<Guider>(runtime(), w, h, settings);
   Inputs& in = inputs_for(w, h);
   guider->write_state(in.state);  // first launches of all three kernels, untimed

@@ -60,7 +60,7 @@ OPTIONS = [
     lambda r: ["--pg-n-min", "1", "--pg-n-max", str(r.choice([1, 32]))],
     lambda r: ["--pg-pi-learning", "1"],
     lambda r: ["--pg-train-interval", str(r.choice([1, 64]))],
-    lambda r: ["--pg-rows-per-model", str(r.choice([2, 4, 8]))],
+    lambda r: ["--pg-rows-per-model", str(r.choice([0, 1, 2, 4, 8]))],
     lambda r: ["--pg-train-memory", r.choice(["local", "global"])],
     lambda r: ["--pg-local-x", str(r.choice([1, 3, 16])), "--pg-local-y", str(r.choice([1, 5, 16]))],
     lambda r: ["--host-transfer", r.choice(["in-place", "pinned", "packed", "pageable"])],

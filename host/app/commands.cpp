@@ -126,9 +126,11 @@ nlohmann::json settings_json(const std::vector<SettingInfo<Settings>>& table, co
   return out;
 }
 
-nlohmann::json guiding_settings_json(const GuidingSettings& s) {
+nlohmann::json guiding_settings_json(const GuidingSettings& s, int image_height) {
   nlohmann::json out = settings_json(guiding_settings_table(), s);
   out["train_memory"] = train_memory_name(s.train_memory);
+  // What rows_per_model 0 (by the image's height) came to for this image.
+  out["rows_per_model_for_image"] = to_kernel_settings(s, image_height).rows_per_model;
   return out;
 }
 
@@ -414,7 +416,8 @@ int run_render(const RenderCommand& command) {
         {"accumulate", command.accumulate},
         {"camera_path", command.settings.camera_path},
         {"guiding", command.guiding},
-        {"guiding_settings", guiding_settings_json(command.guiding_settings)},
+        {"guiding_settings",
+         guiding_settings_json(command.guiding_settings, command.settings.height)},
         {"denoise", command.denoise},
         {"svgf_settings", settings_json(svgf_settings_table(), command.svgf_settings)},
         {"max_bounces", settings.path_tracer.max_bounces},

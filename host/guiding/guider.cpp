@@ -82,7 +82,9 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
       width_(width),
       height_(height),
       settings_(settings),
-      kernel_settings_(to_kernel_settings(settings)) {
+      kernel_settings_(to_kernel_settings(settings, height)) {
+  // settings() reports what the kernels run with: rows_per_model 0 resolved for this image.
+  settings_.rows_per_model = kernel_settings_.rows_per_model;
   const std::size_t n = pixels(width, height);
   validate(settings);
   const DeviceInfo& info = runtime.info();

@@ -64,9 +64,10 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
            "turn (0 = off)"),
       integer("train_interval", &S::train_interval, 1, 64,
               "A mature pixel (k >= k_max/4) trains every this many frames"),
-      integer("rows_per_model", &S::rows_per_model, 1, 8,
+      integer("rows_per_model", &S::rows_per_model, 0, 8,
               "1, 2, 4 or 8: pixels of a column's group of this many rows showing the first "
-              "one's surface sample with its model and train none of their own"),
+              "one's surface sample with its model and train none of their own (0: 4 from 540 "
+              "rows of image, 2 from 270, else 1)"),
       integer("train_all_samples", &S::train_all_samples, 0, 1,
               "1: train on every VPL at its mixture density; 0: BSDF samples only"),
       integer("pi_learning", &S::pi_learning, 0, 1,
@@ -121,7 +122,7 @@ void validate(const GuidingSettings& s) {
                                                {"sample_lanes", s.sample_lanes}};
   if (s.rows_per_model & (s.rows_per_model - 1))
     fail("rows_per_model = " + setting_number(s.rows_per_model) +
-         " must be a power of two: 1, 2, 4 or 8");
+         " must be 0 (by the image's height) or a power of two: 1, 2, 4 or 8");
   for (const auto& [name, value] : lanes)
     if (value & (value - 1))
       fail(std::string(name) + " = " + setting_number(value) +
@@ -134,7 +135,13 @@ void validate(const GuidingSettings& s) {
          setting_number(s.n_max) + ")");
 }
 
-pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {
+int rows_per_model_for_height(int height) {
+  int rows = 1;
+  while (rows < 4 && 2 * rows * 135 <= height) rows *= 2;
+  return rows;
+}
+
+pg_kernel_settings to_kernel_settings(const GuidingSettings& c, int image_height) {
   pg_kernel_settings p{};
   p.pi_min = c.pi_min;
   p.pi_max = c.pi_max;
@@ -160,7 +167,8 @@ pg_kernel_settings to_kernel_settings(const GuidingSettings& c) {
   p.train_all_samples = c.train_all_samples;
   p.reseed_samples = c.reseed_samples;
   p.pi_learning = c.pi_learning;
-  p.rows_per_model = c.rows_per_model;
+  p.rows_per_model =
+      c.rows_per_model > 0 ? c.rows_per_model : rows_per_model_for_height(image_height);
   return p;
 }
 

@@ -46,12 +46,14 @@ struct GuidingSettings {
   int train_all_samples = 1;  // 1: every VPL trains, weighted by its full mixture density;
                               // 0: BSDF-strategy VPLs only (paper 3.2); 1 since it costs nothing
                               // in train_wide (docs/guiding.md, "Every VPL trains, revisited")
-  int rows_per_model = 1;     // 1, 2, 4 or 8: the pixels of a column's group of this many rows
+  int rows_per_model = 0;     // 1, 2, 4 or 8: the pixels of a column's group of this many rows
                               // that show the first one's surface, normals within 1.1 degrees,
                               // both diffuse or rough (kernels/shared/guiding_pixel.h,
                               // pg_shares_model), sample with its model, carry it as their own
-                              // state and train none, so train runs on fewer pixels; off (1)
-                              // by default (docs/guiding.md, "Models shared by rows")
+                              // state and train none, so train runs on fewer pixels; 1 is the
+                              // paper's model per pixel; 0: by the image's height
+                              // (rows_per_model_for_height; docs/guiding.md, "Models shared by
+                              // rows")
   int pi_learning = 0;        // 1: the mixing weight is the one that minimises the first
                               // bounce's second moment (a Newton step per frame on the
                               // training samples); 0: EM's weight (paper 3.2)
@@ -86,8 +88,16 @@ bool parse_train_memory(const std::string& word, GuidingSettings::TrainMemory& m
 // a broken relation between two rows (pi_min <= pi_max, n_min <= n_max).
 void validate(const GuidingSettings& settings);
 
+// rows_per_model 0's choice for an image `height` pixels high: the largest of 1, 2 and 4 whose
+// group of rows spans at most 1/135 of the height (540 and more rows: 4; 270-539: 2; fewer: 1).
+// A model serves pixels up to that far from its own: at 960x540 groups of 4 cost no measured
+// error on the untextured rooms, at 240x135 groups of 2 and 4 cost them 1-3% (docs/guiding.md,
+// "Models shared by rows, by the image's height").
+int rows_per_model_for_height(int height);
+
 // The block the kernels read. Host code that evaluates the mixture itself (the
-// GuidingDistribution) uses the same block.
-pg_kernel_settings to_kernel_settings(const GuidingSettings& settings);
+// GuidingDistribution) uses the same block. image_height resolves rows_per_model 0
+// (rows_per_model_for_height); 0, for a block that serves no image (the world guide's EM), gives 1.
+pg_kernel_settings to_kernel_settings(const GuidingSettings& settings, int image_height = 0);
 
 }  // namespace rtpg

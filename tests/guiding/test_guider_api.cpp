@@ -9,6 +9,7 @@
 #include <cstring>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rtpg/cl_runtime.h"
@@ -327,11 +328,12 @@ TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
         EXPECT_THROW(rtpg::validate(s), rtpg::GuiderError) << lanes;
       }
     }
-  // Rows per shared model: a power of two (the kernels find a row's group by y - y % R).
-  for (int rows = 1; rows <= 8; ++rows) {
+  // Rows per shared model: a power of two (the kernels find a row's group by y - y % R), or 0
+  // (by the image's height).
+  for (int rows = 0; rows <= 8; ++rows) {
     s = rtpg::GuidingSettings{};
     s.rows_per_model = rows;
-    if (rows == 1 || rows == 2 || rows == 4 || rows == 8) {
+    if (rows == 0 || rows == 1 || rows == 2 || rows == 4 || rows == 8) {
       EXPECT_NO_THROW(rtpg::validate(s)) << rows;
     } else {
       EXPECT_THROW(rtpg::validate(s), rtpg::GuiderError) << rows;
@@ -350,4 +352,30 @@ TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
   // The window walk's stride visits all 49 cells of a 7x7 window: coprime with 49.
   EXPECT_GT(k.stride, 0);
   EXPECT_NE(k.stride % 7, 0);
+}
+
+// rows_per_model 0 (the default) shares a model over at most 1/135 of the image's height, in
+// groups of 1, 2 or 4 rows; an explicit value is kept whatever the height.
+TEST(GuidingSettingsTable, RowsPerModelByTheImagesHeight) {
+  EXPECT_EQ(rtpg::GuidingSettings{}.rows_per_model, 0);
+  const std::pair<int, int> heights[] = {{0, 1},   {1, 1},   {135, 1}, {269, 1},  {270, 2},
+                                         {539, 2}, {540, 4}, {720, 4}, {1080, 4}, {4320, 4}};
+  for (const auto& [height, rows] : heights) {
+    EXPECT_EQ(rtpg::rows_per_model_for_height(height), rows) << height;
+    EXPECT_EQ(rtpg::to_kernel_settings(rtpg::GuidingSettings{}, height).rows_per_model, rows)
+        << height;
+  }
+  rtpg::GuidingSettings one;
+  one.rows_per_model = 1;
+  EXPECT_EQ(rtpg::to_kernel_settings(one, 1080).rows_per_model, 1);
+  rtpg::GuidingSettings eight;
+  eight.rows_per_model = 8;
+  EXPECT_EQ(rtpg::to_kernel_settings(eight, 135).rows_per_model, 8);
+  // The guider runs, and reports, the value for its own image.
+  rtpg::ClRuntime rt;
+  const rtpg::Guider tall(rt, 8, 540, rtpg::GuidingSettings{});
+  EXPECT_EQ(tall.settings().rows_per_model, 4);
+  EXPECT_EQ(tall.kernel_settings().rows_per_model, 4);
+  const rtpg::Guider short_image(rt, 8, 300, rtpg::GuidingSettings{});
+  EXPECT_EQ(short_image.settings().rows_per_model, 2);
 }
