@@ -11,7 +11,9 @@
  * (the lobes, two lengths, an atan2, an exp, a division) and 48 bytes more read where a model ages
  * (reproject_view_memory > 0); 132 bytes read, 32 written: memory-bound. Where the pixel the motion
  * vector lands on fails the history test, each further candidate costs about 20 flops and 36 bytes
- * (mostly from cache). */
+ * (mostly from cache). A pixel that shares its row group's model (rows_per_model > 1) costs the
+ * sharing test instead: about 30 flops and 80 bytes of the model pixel's G-buffer, from cache,
+ * and writes nothing. */
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
 #include "shared/pmm.h"
@@ -25,6 +27,12 @@ __kernel void reproject(PG_ARGS_GBUFFER PG_ARGS_PREV_GBUFFER PG_ARGS_IN_STATE PG
   uint i = y * width + x;
   pg_pmm_state out = pg_pmm_initial_state();
   if (pg_guiding_applies(flags[i], base_color_roughness[i].w, settings)) {
+    /* A pixel that shares the model of the pixel above it (pg_shares_model) gets that model's
+     * state from the sample kernel, which decides the same from the same G-buffer: its own
+     * would be overwritten unread, so it is neither carried nor written (docs/guiding.md,
+     * "Reprojection left to the sample kernel where a model is shared"). */
+    if (settings.rows_per_model > 1 && pg_model_pixel(PG_PASS_GBUFFER x, y, width, settings) != i)
+      return;
     float2 mv = motion[i];
     int px = (int)floor((float)x + 0.5f + mv.x);
     int py = (int)floor((float)y + 0.5f + mv.y);

@@ -283,7 +283,9 @@ class Guider {
   void unpack_vpls(const GuiderPackedVpls& packed, const GuiderGBuffer& gbuffer,
                    const GuiderSamples& first_samples, const GuiderVpls& out,
                    Wait wait = Wait::finish);
-  // Carries last frame's state into this frame (previous: last frame's G-buffer).
+  // Carries last frame's state into this frame (previous: last frame's G-buffer). With
+  // rows_per_model > 1 a pixel that shares its model is skipped: its state is the sample kernel's
+  // to write, so between reproject() and sample() it holds stale contents.
   void reproject(const GuiderGBuffer& current, const GuiderGBuffer& previous,
                  Wait wait = Wait::finish);
   // Draws each pixel's first-bounce direction into out. With rows_per_model > 1 it also writes

@@ -642,11 +642,13 @@ void make_reprojection_pair(Random& r, int w, int h, HostGBuffer& prev, HostGBuf
 // atan2 and exp, which may differ by a few ulp between the device and the host: within 1e-5
 // relative plus twice aged_k_relative_error (the exponent's conditioning; on an NVIDIA H100,
 // with acos then, a k aged by exp(-90) differed by 2e-5 relative, docs/design.md, "Floating
-// point on other devices").
+// point on other devices"). Two cases share models by rows (rows_per_model 2 and 4, on
+// G-buffers whose left halves repeat each group's first row): there reproject leaves a sharing
+// pixel alone, and after the sample kernel it holds its model pixel's reprojected state.
 TEST(GuidingKernels, ReprojectMatchesHostReference) {
   ClRuntime rt;
   Random r(101);
-  std::size_t pixels = 0, count[5] = {0, 0, 0, 0, 0}, aged = 0;
+  std::size_t pixels = 0, count[5] = {0, 0, 0, 0, 0}, aged = 0, sharing = 0;
   const std::vector<KernelCase> cases = kernel_cases(rt);
   for (std::size_t c_index = 0; c_index < cases.size(); ++c_index) {
     const KernelCase& kc = cases[c_index];
@@ -655,53 +657,85 @@ TEST(GuidingKernels, ReprojectMatchesHostReference) {
     settings.local_x = kc.local_x;
     settings.local_y = kc.local_y;
     settings.apron = kc.apron;
+    // Models shared by pairs of rows and by groups of four in two of the cases.
+    settings.rows_per_model = kc.apron == 1 ? 2 : (kc.apron == 3 ? 4 : 1);
     const pg_kernel_settings p = to_kernel_settings(settings);
     Guider guider(rt, kc.width, kc.height, settings);
     HostGBuffer prev(1, 1), cur(1, 1);
     make_reprojection_pair(r, kc.width, kc.height, prev, cur);
+    share_rows(cur, settings.rows_per_model);
     const std::vector<float> prev_state = random_states(r, prev.n(), p.k_max, true);
     std::vector<int> outcome;
     std::vector<double> k_conditioning;
     const std::vector<float> expected =
         host_reproject(prev_state, prev, cur, p, outcome, &aged, &k_conditioning);
+    // Whether pixel `at` of `got` holds the host's reprojected state of pixel e.
+    const auto agrees = [&](const std::vector<float>& got, std::size_t at, std::size_t e) {
+      const sh::pg_pmm_state want = state_at(expected, e), have = state_at(got, at);
+      const float k_rel = settings.reproject_view_memory > 0.0f
+                              ? 1e-5f + static_cast<float>(2.0 * k_conditioning[e])
+                              : 0.0f;
+      if (outcome[e] == kReframed) return states_agree(want, have, 1e-3f, k_rel);
+      bool ok = true;
+      for (int c = 0; c < 7; ++c) ok = ok && same_bits(expected[8 * e + c], got[8 * at + c]);
+      const float ek = expected[8 * e + 7], gk = got[8 * at + 7];
+      return ok && (same_bits(ek, gk) || std::fabs(ek - gk) <= k_rel * std::fabs(ek));
+    };
+    const GuiderGBuffer current = upload(rt, cur);
     guider.write_state(prev_state);
-    guider.reproject(upload(rt, cur), upload(rt, prev));
+    guider.reproject(current, upload(rt, prev));
     std::vector<float> got;
     guider.read_state(got);
     ASSERT_EQ(got.size(), expected.size());
-    std::size_t mismatched = 0;
+    std::size_t mismatched = 0, shared_here = 0;
     for (std::size_t i = 0; i < cur.n(); ++i) {
-      const sh::pg_pmm_state e = state_at(expected, i), d = state_at(got, i);
+      const bool shares = model_pixel(cur, i, p) != i;
+      shared_here += shares;
+      // A pixel that shares its model is left to the sample kernel: its state in reproject's
+      // destination is what was there (a new guider's zeros), not a carried one.
       bool ok = true;
-      const bool reframed = outcome[i] == kReframed;
-      const std::size_t k_index = 8 * i + 7;
-      const float k_rel = settings.reproject_view_memory > 0.0f
-                              ? 1e-5f + static_cast<float>(2.0 * k_conditioning[i])
-                              : 0.0f;
-      if (reframed) {
-        ok = states_agree(e, d, 1e-3f, k_rel);
-      } else {
-        for (int c = 0; c < 7; ++c) ok = ok && same_bits(expected[8 * i + c], got[8 * i + c]);
-        ok = ok &&
-             (same_bits(expected[k_index], got[k_index]) ||
-              std::fabs(expected[k_index] - got[k_index]) <= k_rel * std::fabs(expected[k_index]));
-      }
+      if (shares)
+        for (int c = 0; c < 8; ++c) ok = ok && same_bits(got[8 * i + c], 0.0f);
+      else
+        ok = agrees(got, i, i);
       if (!ok && ++mismatched <= 5) {
-        ADD_FAILURE() << name(kc) << " pixel " << i << (reframed ? " (reframed)" : "") << ": host "
-                      << describe(e) << " device " << describe(d);
+        ADD_FAILURE() << name(kc) << " pixel " << i
+                      << (shares ? " (sharing: to be left as it was, zeros)" : "")
+                      << (outcome[i] == kReframed ? " (reframed)" : "") << ": host "
+                      << describe(state_at(expected, i)) << " device "
+                      << describe(state_at(got, i));
       }
       ++count[outcome[i]];
     }
-    pixels += cur.n();
     EXPECT_EQ(mismatched, 0u) << name(kc);
+    if (settings.rows_per_model > 1) {
+      EXPECT_GT(shared_here, 0u) << name(kc);
+    }
+    sharing += shared_here;
+    // After sampling, every pixel holds the state reprojection carries to its model pixel (its
+    // own where it shares none): what reprojecting every pixel and then sampling gave.
+    const GuiderSamples samples = make_guider_samples(rt.context(), kc.width, kc.height);
+    guider.sample(current, 17u, 3u, 0u, samples);
+    std::vector<float> sampled;
+    guider.read_state(sampled);
+    std::size_t after_sampling = 0;
+    for (std::size_t i = 0; i < cur.n(); ++i) {
+      const std::size_t from = model_pixel(cur, i, p);
+      if (!agrees(sampled, i, from) && ++after_sampling <= 5)
+        ADD_FAILURE() << name(kc) << " pixel " << i << " after sampling (model pixel " << from
+                      << "): host " << describe(state_at(expected, from)) << " device "
+                      << describe(state_at(sampled, i));
+    }
+    EXPECT_EQ(after_sampling, 0u) << name(kc);
+    pixels += cur.n();
   }
   // The inputs exercised every path.
   for (int o = kSkipped; o <= kReframed; ++o) EXPECT_GT(count[o] * 30, pixels) << "outcome " << o;
   EXPECT_GT(aged * 30, pixels) << "glossy models aged by a turned view";
   std::printf(
       "[ info     ] reproject: %zu pixels: %zu skipped, %zu outside, %zu rejected, %zu "
-      "copied, %zu reframed, %zu aged\n",
-      pixels, count[0], count[1], count[2], count[3], count[4], aged);
+      "copied, %zu reframed, %zu aged, %zu sharing a model\n",
+      pixels, count[0], count[1], count[2], count[3], count[4], aged, sharing);
 }
 
 // ---- sample --------------------------------------------------------------------------------
