@@ -984,5 +984,6 @@ void register_all(bool full) {
 }  // namespace rtpg::bench
 
 int main(int argc, char** argv) {
+  rtpg::request_pinned_cpu_device_threads();  // as rtpg itself, before any OpenCL call
   return rtpg::bench::bench_main(argc, argv, rtpg::bench::register_all);
 }

@@ -11,6 +11,7 @@
 
 #include "app/commands.h"
 #include "rtpg/cl_error.h"
+#include "rtpg/cl_runtime.h"
 #include "rtpg/errors.h"
 
 namespace {
@@ -166,6 +167,7 @@ bool parse_resolution(const std::string& text, int& w, int& h) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  rtpg::request_pinned_cpu_device_threads();  // before any OpenCL call
   CLI::App app{"rtpg: real-time screen-space path guiding (Embree + OpenCL)"};
   app.require_subcommand(1);
 

@@ -135,4 +135,12 @@ cl::Buffer read_in_place(const cl::Context& context, const Container& host) {
                     const_cast<T*>(host.data()));
 }
 
+// Asks a CPU OpenCL device to keep one worker thread per core: sets POCL_AFFINITY=1 (read by
+// PoCL's CPU device when it first loads; ignored by every other implementation) unless the
+// environment already sets it, 0 included. Without it, on the 2-core test machine PoCL's two
+// workers shared one core for a whole kernel in up to half the frames, and those kernels took
+// twice their time (docs/design.md, "CPU devices' worker threads pinned"). Call before the
+// process's first OpenCL call; returns whether it set the variable.
+bool request_pinned_cpu_device_threads();
+
 }  // namespace rtpg

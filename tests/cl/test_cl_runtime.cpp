@@ -1,9 +1,11 @@
 // Device selection, the program cache (memory and disk), and how OpenCL failures read.
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -292,6 +294,25 @@ TEST(ClRuntimeDeathTest, DestroyedBeforeItsUsersStopsWithAMessage) {
     EXPECT_EQ(runtime->users(), 1);
   }
   EXPECT_EQ(runtime->users(), 0);
+}
+
+// The CPU device's worker threads are asked to stay one per core, unless the user's environment
+// already decides (docs/design.md, "CPU devices' worker threads pinned"). Only the variable is
+// checked here: PoCL reads it once per process, and what it changes is time, which the
+// benchmarks measure.
+TEST(CpuDeviceThreads, PinnedUnlessTheEnvironmentSaysOtherwise) {
+  {
+    test::ScopedEnv unset("POCL_AFFINITY", std::nullopt);
+    EXPECT_TRUE(request_pinned_cpu_device_threads());
+    ASSERT_NE(std::getenv("POCL_AFFINITY"), nullptr);
+    EXPECT_STREQ(std::getenv("POCL_AFFINITY"), "1");
+    EXPECT_FALSE(request_pinned_cpu_device_threads());  // set now: left as it is
+  }
+  for (const char* users : {"0", "1"}) {
+    test::ScopedEnv set("POCL_AFFINITY", std::string(users));
+    EXPECT_FALSE(request_pinned_cpu_device_threads());
+    EXPECT_STREQ(std::getenv("POCL_AFFINITY"), users);
+  }
 }
 
 }  // namespace
