@@ -170,6 +170,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "minimal_guiding: need frames >= 8 and size >= 1\n");
       return 2;
     }
+    rtpg::request_pinned_cpu_device_threads();  // before the first OpenCL call
     rtpg::ClRuntime rt(argc > 3 ? argv[3] : "");
     const double plain = run(rt, size, frames, false);
     const double guided = run(rt, size, frames, true);
