@@ -11,27 +11,33 @@
  * (the lobes, two lengths, an atan2, an exp, a division) and 48 bytes more read where a model ages
  * (reproject_view_memory > 0); 132 bytes read, 32 written: memory-bound. Where the pixel the motion
  * vector lands on fails the history test, each further candidate costs about 20 flops and 36 bytes
- * (mostly from cache). A pixel that shares its row group's model (rows_per_model > 1) costs the
- * sharing test instead: about 30 flops and 80 bytes of the model pixel's G-buffer, from cache,
- * and writes nothing. */
+ * (mostly from cache). With rows_per_model > 1 every guided pixel outside a group's first row
+ * also costs the sharing test, about 30 flops and 80 bytes of the model pixel's G-buffer, from
+ * cache, and every pixel writes its 1-byte decision; a pixel that shares writes nothing else. */
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"
 #include "shared/pmm.h"
 
 /* clang-format off */
 __kernel void reproject(PG_ARGS_GBUFFER PG_ARGS_PREV_GBUFFER PG_ARGS_IN_STATE PG_ARGS_OUT_STATE
-                        uint width, uint height, pg_kernel_settings settings) {
+                        __global uchar* shares_model, uint width, uint height,
+                        pg_kernel_settings settings) {
   /* clang-format on */
   uint x = get_global_id(0), y = get_global_id(1);
   if (x >= width || y >= height) return;
   uint i = y * width + x;
   pg_pmm_state out = pg_pmm_initial_state();
-  if (pg_guiding_applies(flags[i], base_color_roughness[i].w, settings)) {
+  int guided = pg_guiding_applies(flags[i], base_color_roughness[i].w, settings);
+  /* The frame's first kernel: it decides which pixels share their group's model for the
+   * frame's sample and train kernels (include/rtpg/guiding_layout.h, "Shared models"); a pixel
+   * guiding skips shares none. */
+  if (settings.rows_per_model > 1 && !guided) shares_model[i] = 0;
+  if (guided) {
     /* A pixel that shares the model of the pixel above it (pg_shares_model) gets that model's
-     * state from the sample kernel, which decides the same from the same G-buffer: its own
-     * would be overwritten unread, so it is neither carried nor written (docs/guiding.md,
-     * "Reprojection left to the sample kernel where a model is shared"). */
-    if (settings.rows_per_model > 1 && pg_model_pixel(PG_PASS_GBUFFER x, y, width, settings) != i)
+     * state from the sample kernel, which reads the decision made here: its own would be
+     * overwritten unread, so it is neither carried nor written (docs/guiding.md, "Reprojection
+     * left to the sample kernel where a model is shared"). */
+    if (pg_frame_model_pixel(PG_PASS_GBUFFER shares_model, 0u, 1, x, y, width, settings) != i)
       return;
     float2 mv = motion[i];
     int px = (int)floor((float)x + 0.5f + mv.x);

@@ -55,14 +55,19 @@ static float4 pg_sample_pixel(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES uint
   return model.valid ? (float4)(1.0f, 1.0f, model.pi, 0.0f) : (float4)(1.0f, 0.0f, 0.0f, 0.0f);
 }
 
-__kernel void sample(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES __global float4* counts,
-                     uint width, uint height, uint seed, uint frame, uint sample_index,
-                     uint write_mixture, pg_kernel_settings settings, __local float4* scratch) {
+/* sharing_decided: 1 where this frame's shares_model is already decided (by reproject or an
+ * earlier sample of the frame) and is read, 0 where it is decided and written here
+ * (include/rtpg/guiding_layout.h, "Shared models"). */
+__kernel void sample(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES __global uchar* shares_model,
+                     __global float4* counts, uint width, uint height, uint seed, uint frame,
+                     uint sample_index, uint write_mixture, uint sharing_decided,
+                     pg_kernel_settings settings, __local float4* scratch) {
   uint x = get_global_id(0), y = get_global_id(1);
   float4 count = (float4)(0.0f);
   if (x < width && y < height)
     count = pg_sample_pixel(PG_PASS_GBUFFER PG_PASS_STATE PG_PASS_SAMPLES y * width + x,
-                            pg_model_pixel(PG_PASS_GBUFFER x, y, width, settings), seed, frame,
-                            sample_index, write_mixture, settings);
+                            pg_frame_model_pixel(PG_PASS_GBUFFER shares_model, sharing_decided, 1,
+                                                 x, y, width, settings),
+                            seed, frame, sample_index, write_mixture, settings);
   pg_store_work_group_counts(counts, scratch, count);
 }

@@ -26,9 +26,12 @@
 
 /* The lanes' pixels x0 .. x0 + PG_LANES - 1 of row y (x0 inside the image); returns their
  * counts (surfaces, guided, pi, 0). */
-static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES int x0, int y,
-                              uint width, uint seed, uint frame, uint sample_index,
-                              uint write_mixture, pg_kernel_settings settings) {
+/* clang-format off */
+static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES
+                              __global uchar* shares_model, int x0, int y, uint width, uint seed,
+                              uint frame, uint sample_index, uint write_mixture,
+                              uint sharing_decided, pg_kernel_settings settings) {
+  /* clang-format on */
   int w = (int)width, row_start = y * w;
 
   /* The lanes' inputs, loaded as vectors (kernels/wide/lanes.h). A lane past the row's end
@@ -48,6 +51,11 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES int 
   pg_float3w direction = pg_make_float3w(0.0f, 0.0f, 1.0f);
   pg_floatw zero = (pg_floatw)(0.0f), pdf = zero;
   pg_uintw strategy_w = (pg_uintw)(PG_STRATEGY_NONE);
+  /* Lanes that share the model of the pixel above them (pg_shares_model), as this frame's
+   * earlier kernels decided or, where none did, decided here (sample.cl). */
+  int sharing = settings.rows_per_model > 1;
+  pg_intw shares = (pg_intw)(0);
+  if (sharing && sharing_decided) shares = pg_load_row_flags(shares_model + row_start, x0, w);
   pg_pmm_model_w m;
   m.valid = (pg_intw)(0);
   m.pi = m.mx = m.my = m.l11 = m.l21 = m.l22 = zero;
@@ -57,9 +65,8 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES int 
     pg_load_row_float4_rows(state1 + row_start, x0, w, &s.sxx, &s.syy, &s.sxy, &s.k);
     pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
                             &unused);
-    /* Lanes that share the model of the pixel above them take its state (pg_shares_model). */
-    pg_intw shares = (pg_intw)(0);
-    if (settings.rows_per_model > 1)
+    /* Lanes that share take the model's state. */
+    if (sharing && !sharing_decided)
       shares = pg_shares_model_w(
           PG_PASS_GBUFFER x0, y, w,
           pg_model_sharable_w(pixel_flags, roughness, metallic, specular, settings), normal,
@@ -100,6 +107,7 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES int 
     m.valid &= ~sky;
   }
 
+  if (sharing && !sharing_decided) pg_store_row_flags(shares_model + row_start, x0, w, shares);
   pg_store_row_float4_rows(direction_pdf + row_start, x0, w, direction.x, direction.y, direction.z,
                            pdf);
   pg_store_row_uints(strategy + row_start, x0, w, strategy_w);
@@ -118,14 +126,18 @@ static float4 pg_sample_lanes(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES int 
                   pg_sum_lanes(select(zero, m.pi, with_model)), 0.0f);
 }
 
-__kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES __global float4* counts,
-                          uint width, uint height, uint seed, uint frame, uint sample_index,
-                          uint write_mixture, pg_kernel_settings settings,
+/* clang-format off */
+__kernel void sample_wide(PG_ARGS_GBUFFER PG_ARGS_STATE PG_ARGS_SAMPLES
+                          __global uchar* shares_model, __global float4* counts, uint width,
+                          uint height, uint seed, uint frame, uint sample_index,
+                          uint write_mixture, uint sharing_decided, pg_kernel_settings settings,
                           __local float4* scratch) {
+  /* clang-format on */
   int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
   float4 count = (float4)(0.0f);
   if (x0 < (int)width && y < (int)height)
-    count = pg_sample_lanes(PG_PASS_GBUFFER PG_PASS_STATE PG_PASS_SAMPLES x0, y, width, seed, frame,
-                            sample_index, write_mixture, settings);
+    count =
+        pg_sample_lanes(PG_PASS_GBUFFER PG_PASS_STATE PG_PASS_SAMPLES shares_model, x0, y, width,
+                        seed, frame, sample_index, write_mixture, sharing_decided, settings);
   pg_store_work_group_counts(counts, scratch, count);
 }

@@ -17,21 +17,29 @@
 
 /* Pixel (x, y) inside the image, its window's VPLs in the tile (PG_TRAIN_LOCAL_TILE 1) or in
  * global memory; returns 1 where its state changed. */
-static int pg_train_pixel_at(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x, int y, uint width,
-                             uint height, uint seed, uint frame, pg_kernel_settings settings,
-                             __local const float4* tile_position,
+/* clang-format off */
+static int pg_train_pixel_at(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE
+                             __global const uchar* shares_model, int x, int y, uint width,
+                             uint height, uint seed, uint frame, uint sharing_decided,
+                             pg_kernel_settings settings, __local const float4* tile_position,
                              __local const uint4* tile_normal_radiance) {
+  /* clang-format on */
   int apron = settings.apron;
 #if PG_TRAIN_LOCAL_TILE
   int tw = (int)get_local_size(0) + 2 * apron;
 #endif
   int i = y * (int)width + x;
+  /* A pixel that samples with the model of the pixel above it trains none of its own: as this
+   * frame's reproject or sample kernel decided (include/rtpg/guiding_layout.h, "Shared
+   * models"), read first, or, where neither did, decided here. */
+  int sharing = settings.rows_per_model > 1;
+  if (sharing && sharing_decided && shares_model[i] != 0) return 0;
   float4 bcr = base_color_roughness[i];
   if (!pg_guiding_applies(flags[i], bcr.w, settings)) return 0;
   if (!pg_train_this_frame(state1[i].w, x, y, frame, settings)) return 0;
-  /* A pixel that samples with the model of the pixel above it trains none of its own. */
-  uint column = (uint)x, row = (uint)y;
-  if (pg_model_pixel(PG_PASS_GBUFFER column, row, width, settings) != (uint)i) return 0;
+  if (sharing && !sharing_decided &&
+      pg_model_pixel(PG_PASS_GBUFFER(uint) x, (uint)y, width, settings) != (uint)i)
+    return 0;
   pg_pmm_state state;
   state.s0 = state0[i];
   state.s1 = state1[i];
@@ -69,8 +77,9 @@ static int pg_train_pixel_at(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x, i
   return updated;
 }
 
-__kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global float4* counts, uint width,
-                    uint height, uint seed, uint frame, pg_kernel_settings settings,
+__kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global const uchar* shares_model,
+                    __global float4* counts, uint width, uint height, uint seed, uint frame,
+                    uint sharing_decided, pg_kernel_settings settings,
                     __local float4* tile_position, __local uint4* tile_normal_radiance,
                     __local float4* scratch) {
   int x = (int)get_global_id(0), y = (int)get_global_id(1);
@@ -96,8 +105,8 @@ __kernel void train(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global float4* 
 #endif
   float trained = 0.0f;
   if (x < (int)width && y < (int)height)
-    trained =
-        (float)pg_train_pixel_at(PG_PASS_GBUFFER PG_PASS_VPLS PG_PASS_STATE x, y, width, height,
-                                 seed, frame, settings, tile_position, tile_normal_radiance);
+    trained = (float)pg_train_pixel_at(PG_PASS_GBUFFER PG_PASS_VPLS PG_PASS_STATE shares_model, x,
+                                       y, width, height, seed, frame, sharing_decided, settings,
+                                       tile_position, tile_normal_radiance);
   pg_store_work_group_counts(counts, scratch, (float4)(trained, 0.0f, 0.0f, 0.0f));
 }

@@ -34,22 +34,37 @@
 
 /* The lanes' pixels x0 .. x0 + PG_LANES - 1 of row y (x0 inside the image); returns how many
  * of them changed their state. */
-static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x0, int y, uint width,
-                            uint height, uint seed, uint frame, pg_kernel_settings settings) {
+/* clang-format off */
+static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE
+                            __global const uchar* shares_model, int x0, int y, uint width,
+                            uint height, uint seed, uint frame, uint sharing_decided,
+                            pg_kernel_settings settings) {
+  /* clang-format on */
   int w = (int)width, row_start = y * w, apron = settings.apron, side = 2 * apron + 1;
 
   /* Per lane, as train.cl per work-item, loaded as vectors (kernels/wide/lanes.h): whether
    * the pixel trains, the state, its N and passes, and what it knows about itself. A lane
    * past the row's end computes on its last pixel, trains nothing and stores nothing. */
+  pg_intw lane = pg_lane_numbers();
+  pg_intw inside = x0 + lane < w;
+  /* A lane that samples with the model of the pixel above it trains none of its own. Where this
+   * frame's reproject or sample kernel decided which lanes do (include/rtpg/guiding_layout.h,
+   * "Shared models"), a work-item all of whose lanes share reads nothing more; where neither
+   * did, it is decided below, as train.cl decides. */
+  int sharing = settings.rows_per_model > 1;
+  pg_intw shares = (pg_intw)(0);
+  if (sharing && sharing_decided) {
+    shares = pg_load_row_flags(shares_model + row_start, x0, w);
+    if (!any(inside & ~shares)) return 0.0f;
+  }
   pg_float3w base_color;
   pg_floatw roughness;
   pg_load_row_float4_rows(base_color_roughness + row_start, x0, w, &base_color.x, &base_color.y,
                           &base_color.z, &roughness);
   pg_uintw pixel_flags = pg_load_row_uints(flags + row_start, x0, w);
-  pg_intw lane = pg_lane_numbers();
   /* pg_guiding_applies and pg_train_this_frame per lane; the lanes share one run of
    * PG_TRAIN_RUN pixels, so the frame's rotation decides for all of them at once. */
-  pg_intw active = (x0 + lane < w) & pg_guiding_applies_w(pixel_flags, roughness, settings);
+  pg_intw active = inside & ~shares & pg_guiding_applies_w(pixel_flags, roughness, settings);
   if (!any(active)) return 0.0f;
   pg_pmm_state_w original;
   pg_load_row_float4_rows(state1 + row_start, x0, w, &original.sxx, &original.syy, &original.sxy,
@@ -67,8 +82,7 @@ static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x0, i
   pg_float3w normal, view;
   pg_load_row_float4_rows(shading_normal + row_start, x0, w, &normal.x, &normal.y, &normal.z,
                           &unused);
-  /* A lane that samples with the model of the pixel above it trains none of its own. */
-  if (settings.rows_per_model > 1) {
+  if (sharing && !sharing_decided) {
     active &= ~pg_shares_model_w(
         PG_PASS_GBUFFER x0, y, w,
         active & pg_model_sharable_w(pixel_flags, roughness, metallic, specular, settings), normal,
@@ -216,13 +230,16 @@ static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE int x0, i
   return trained;
 }
 
-__kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE __global float4* counts,
-                         uint width, uint height, uint seed, uint frame,
+/* clang-format off */
+__kernel void train_wide(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE
+                         __global const uchar* shares_model, __global float4* counts, uint width,
+                         uint height, uint seed, uint frame, uint sharing_decided,
                          pg_kernel_settings settings, __local float4* scratch) {
+  /* clang-format on */
   int x0 = (int)get_global_id(0) * PG_LANES, y = (int)get_global_id(1);
   float trained = 0.0f;
   if (x0 < (int)width && y < (int)height)
-    trained = pg_train_lanes(PG_PASS_GBUFFER PG_PASS_VPLS PG_PASS_STATE x0, y, width, height, seed,
-                             frame, settings);
+    trained = pg_train_lanes(PG_PASS_GBUFFER PG_PASS_VPLS PG_PASS_STATE shares_model, x0, y, width,
+                             height, seed, frame, sharing_decided, settings);
   pg_store_work_group_counts(counts, scratch, (float4)(trained, 0.0f, 0.0f, 0.0f));
 }

@@ -164,6 +164,7 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
       s.state0 = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, n * 16);
       s.state1 = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, n * 16);
     }
+    shares_model_ = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE, n * PG_SHARES_MODEL_BYTES);
     sample_counts_ = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE,
                                 sample_launch_.groups * PG_COUNT_RECORD_BYTES);
     train_counts_ = cl::Buffer(runtime.context(), CL_MEM_READ_WRITE,
@@ -191,8 +192,13 @@ void Guider::reset() {
                                         zeros.data());
     runtime_.queue().enqueueWriteBuffer(train_counts_, CL_FALSE, 0, train_count_record_bytes(),
                                         zeros.data());
+    // No pixel shares before a kernel decides (and a kernel that read the flags undecided would
+    // read zeros, not uninitialised memory, under Oclgrind).
+    runtime_.queue().enqueueWriteBuffer(shares_model_, CL_FALSE, 0, n * PG_SHARES_MODEL_BYTES,
+                                        zeros.data());
     runtime_.queue().finish();  // the host vectors must outlive the writes
   });
+  sharing_ = Sharing::undecided;
 }
 
 void Guider::check_buffer(const cl::Buffer& b, std::size_t element_size,
@@ -284,6 +290,7 @@ void Guider::unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuff
                       std::to_string(width_) + "x" + std::to_string(height_));
   require_kernel_access(out.position_depth, CL_MEM_READ_ONLY,
                         "unpack_gbuffer: the G-buffer to write is read-only for kernels");
+  sharing_ = Sharing::undecided;  // a new G-buffer: a new frame's decision
   translate_cl_errors([&] {
     run_per_pixel(
         unpack_, "unpack_gbuffer.cl", "unpack_gbuffer",
@@ -359,12 +366,13 @@ void Guider::reproject(const GuiderGBuffer& current, const GuiderGBuffer& previo
   const State &from = state_[current_], &to = state_[1 - current_];
   translate_cl_errors([&] {
     KernelArgs(reproject_) << current << previous << from.state0 << from.state1 << to.state0
-                           << to.state1 << static_cast<cl_uint>(width_)
+                           << to.state1 << shares_model_ << static_cast<cl_uint>(width_)
                            << static_cast<cl_uint>(height_) << kernel_settings_;
     const Launch launch = launch_of(1, /*pixel_kernel=*/true);
     run(reproject_, launch.global, launch.local, wait, &times_.reproject_ms);
   });
   current_ = 1 - current_;
+  sharing_ = Sharing::by_reproject;
 }
 
 void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint32_t frame,
@@ -375,15 +383,23 @@ void Guider::sample(const GuiderGBuffer& current, std::uint32_t seed, std::uint3
   PG_SAMPLE_CHANNELS(RTPG_CHECK)
 #undef RTPG_CHECK
   const State& state = state_[current_];
+  // The frame's decision of which pixels share a model (guider.h, above reproject()).
+  const bool decided =
+      sharing_ == Sharing::by_reproject ||
+      (sharing_ == Sharing::by_sample && sharing_frame_ == frame && sample_index != 0);
   translate_cl_errors([&] {
     const cl_uint write_mixture = outputs == SampleOutputs::directions_and_mixture ? 1 : 0;
-    KernelArgs(sample_) << current << state.state0 << state.state1 << out << sample_counts_
-                        << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
-                        << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame)
-                        << static_cast<cl_uint>(sample_index) << write_mixture << kernel_settings_
+    KernelArgs(sample_) << current << state.state0 << state.state1 << out << shares_model_
+                        << sample_counts_ << static_cast<cl_uint>(width_)
+                        << static_cast<cl_uint>(height_) << static_cast<cl_uint>(seed)
+                        << static_cast<cl_uint>(frame) << static_cast<cl_uint>(sample_index)
+                        << write_mixture << static_cast<cl_uint>(decided ? 1 : 0)
+                        << kernel_settings_
                         << cl::Local(sample_launch_.group_items * PG_COUNT_RECORD_BYTES);
     run(sample_, sample_launch_.global, sample_launch_.local, wait, &times_.sample_ms);
   });
+  sharing_ = Sharing::by_sample;
+  sharing_frame_ = frame;
 }
 
 void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::uint32_t seed,
@@ -398,11 +414,15 @@ void Guider::train(const GuiderGBuffer& current, const GuiderVpls& vpls, std::ui
   const std::size_t tile = local_tile_ ? static_cast<std::size_t>(group_x_ + 2 * settings_.apron) *
                                              (group_y_ + 2 * settings_.apron) * 16
                                        : 16;
+  const bool decided = sharing_ == Sharing::by_reproject ||
+                       (sharing_ == Sharing::by_sample && sharing_frame_ == frame);
+  sharing_ = Sharing::undecided;  // the frame ends here
   translate_cl_errors([&] {
     KernelArgs args(train_);
-    args << current << vpls << state.state0 << state.state1 << train_counts_
+    args << current << vpls << state.state0 << state.state1 << shares_model_ << train_counts_
          << static_cast<cl_uint>(width_) << static_cast<cl_uint>(height_)
-         << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame) << kernel_settings_;
+         << static_cast<cl_uint>(seed) << static_cast<cl_uint>(frame)
+         << static_cast<cl_uint>(decided ? 1 : 0) << kernel_settings_;
     if (train_lanes_ == 1) args << cl::Local(tile) << cl::Local(tile);
     args << cl::Local(train_launch_.group_items * PG_COUNT_RECORD_BYTES);
     if (wait == Wait::finish) {

@@ -283,6 +283,14 @@ class Guider {
   void unpack_vpls(const GuiderPackedVpls& packed, const GuiderGBuffer& gbuffer,
                    const GuiderSamples& first_samples, const GuiderVpls& out,
                    Wait wait = Wait::finish);
+  // With rows_per_model > 1, which pixels share their group's model is decided once a frame
+  // (include/rtpg/guiding_layout.h, "Shared models"): by reproject(), else by the frame's first
+  // sample(); the frame's later sample() calls (the same frame, a sample_index other than 0) and
+  // its train() read that decision, and train() ends the frame. So a frame's calls must all take
+  // the same G-buffer, and a frame's sample() calls and train() the same frame number (they do
+  // in the order above); a sample() with sample_index 0, or with another frame number, decides
+  // again, and so does a train() with a frame number no sample() of the frame had.
+  //
   // Carries last frame's state into this frame (previous: last frame's G-buffer). With
   // rows_per_model > 1 a pixel that shares its model is skipped: its state is the sample kernel's
   // to write, so between reproject() and sample() it holds stale contents.
@@ -368,6 +376,13 @@ class Guider {
   Launch sample_launch_, train_launch_;
   cl::Buffer sample_counts_, train_counts_;
   int current_ = 0;  // index of the buffers holding this frame's state
+  // One byte per pixel (include/rtpg/guiding_layout.h, "Shared models") and who decided it for
+  // the frame now running: nobody (the next kernel decides), reproject() (the next sample() or
+  // train() reads it, whatever its frame number), or a sample() of frame sharing_frame_.
+  cl::Buffer shares_model_;
+  enum class Sharing { undecided, by_reproject, by_sample };
+  Sharing sharing_ = Sharing::undecided;
+  std::uint32_t sharing_frame_ = 0;
   cl::Kernel reproject_, sample_, train_;
   cl::Kernel unpack_;        // built at the first unpack_gbuffer()
   cl::Kernel pack_samples_;  // built at the first pack_samples()

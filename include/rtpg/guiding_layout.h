@@ -141,6 +141,16 @@
   X(state1, float4, 16)
 #define PG_STATE_FLOATS_PER_PIXEL 8
 
+/* ---- Shared models: which pixels sample with their row group's model, kept by the guider ---
+ * With rows_per_model > 1 (docs/guiding.md, "Models shared by rows"), one byte per pixel:
+ * shares_model  1 where the pixel samples with the model of the pixel above it in its group's
+ *               first row (pg_model_pixel, kernels/shared/guiding_pixel.h), else 0 (every
+ *               pixel of a group's first row, every pixel guiding skips)
+ * Decided once a frame, by the frame's first kernel that needs it (reproject, else the first
+ * sample), from the frame's G-buffer, and read by the frame's later sample and train kernels
+ * instead of deciding again (docs/guiding.md, "Which pixels share, decided once a frame"). */
+#define PG_SHARES_MODEL_BYTES 1
+
 /* ---- Random streams ---------------------------------------------------------------------
  * Every consumer draws from its own stream per (seed, pixel, frame, sample) (kernels/shared/
  * rng.h): these tags keep the consumers independent. */

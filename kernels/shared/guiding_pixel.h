@@ -89,6 +89,20 @@ static inline uint pg_model_pixel(PG_ARGS_GBUFFER uint x, uint y, uint width,
              ? m
              : i;
 }
+
+/* pg_model_pixel where the frame's decision may already be made (include/rtpg/guiding_layout.h,
+ * "Shared models"): read from shares_model where `decided`, else made here and, where `record`,
+ * written there for the frame's later kernels. */
+static inline uint pg_frame_model_pixel(PG_ARGS_GBUFFER __global uchar* shares_model, uint decided,
+                                        int record, uint x, uint y, uint width,
+                                        pg_kernel_settings p) {
+  uint i = y * width + x;
+  if (p.rows_per_model <= 1) return i;
+  if (decided) return shares_model[i] != 0 ? (uint)pg_model_row((int)y, p) * width + x : i;
+  uint m = pg_model_pixel(PG_PASS_GBUFFER x, y, width, p);
+  if (record) shares_model[i] = (uchar)(m != i);
+  return m;
+}
 #endif
 
 PG_FN pg_material pg_material_from_gbuffer(float4 base_color_roughness, float4 metallic_specular) {

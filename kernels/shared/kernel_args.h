@@ -3,8 +3,10 @@
  * and the buffers themselves come from one description. OpenCL C only.
  *
  * A guiding kernel's parameters come in this order: the current G-buffer (every channel, in
- * list order), then whatever lists the kernel needs (PG_ARGS_*), then its per-work-group
- * counts (include/rtpg/guiding_layout.h, "Counts"), then its scalars, then its local memory. */
+ * list order), then whatever lists the kernel needs (PG_ARGS_*), then the shared-model flags
+ * where it reads or writes them (include/rtpg/guiding_layout.h, "Shared models"), then its
+ * per-work-group counts (include/rtpg/guiding_layout.h, "Counts"), then its scalars, then its local
+ * memory. */
 #ifndef RTPG_SHARED_KERNEL_ARGS_H
 #define RTPG_SHARED_KERNEL_ARGS_H
 

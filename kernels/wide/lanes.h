@@ -37,6 +37,8 @@
 #define pg_convert_uintw PG_PASTE(convert_uint, PG_LANES)
 #define pg_convert_intw PG_PASTE(convert_int, PG_LANES)
 #define pg_convert_floatw PG_PASTE(convert_float, PG_LANES)
+#define pg_ucharw PG_PASTE(uchar, PG_LANES)
+#define pg_convert_ucharw PG_PASTE(convert_uchar, PG_LANES)
 
 /* Three coordinates of PG_LANES points or directions. */
 typedef struct {
@@ -151,6 +153,15 @@ static inline pg_uintw pg_load_row_uints(__global const uint* row, int x0, int w
   return pg_vloadw(0, v);
 }
 
+/* A byte flag channel of the same pixels (the same rule) as a mask: -1 where the byte is not
+ * 0 (include/rtpg/guiding_layout.h, "Shared models"). */
+static inline pg_intw pg_load_row_flags(__global const uchar* row, int x0, int width) {
+  if (x0 >= 0 && x0 + PG_LANES <= width) return pg_convert_intw(pg_vloadw(0, row + x0)) != 0;
+  uchar v[PG_LANES];
+  for (int l = 0; l < PG_LANES; ++l) v[l] = row[clamp(x0 + l, 0, width - 1)];
+  return pg_convert_intw(pg_vloadw(0, v)) != 0;
+}
+
 /* A float channel of the same pixels (the same rule). At a row's end (and a row of at least
  * PG_LANES pixels) one vector load from inside the row, placed in a private row of 2 PG_LANES
  * floats beside copies of the end pixel, and one load from there at the lanes' offset, instead
@@ -174,7 +185,7 @@ static inline pg_floatw pg_load_row_floats(__global const float* row, int x0, in
   return pg_vloadw(0, v);
 }
 
-/* Stores v to the pixels x0 .. x0 + PG_LANES - 1 of a float (uint) row (x0 >= 0): one vector
+/* Stores v to the pixels x0 .. x0 + PG_LANES - 1 of a float (uint, byte) row (x0 >= 0): one vector
  * store where every lane lies inside the row, lane by lane up to its end otherwise. One body for
  * both element types (OpenCL C has no templates). */
 #define PG_STORE_ROW(name, type, typew)                                     \
@@ -189,7 +200,13 @@ static inline pg_floatw pg_load_row_floats(__global const float* row, int x0, in
   }
 PG_STORE_ROW(pg_store_row_floats, float, pg_floatw)
 PG_STORE_ROW(pg_store_row_uints, uint, pg_uintw)
+PG_STORE_ROW(pg_store_row_bytes, uchar, pg_ucharw)
 #undef PG_STORE_ROW
+
+/* Stores a mask as the byte flags pg_load_row_flags reads: 1 where it is set, else 0. */
+static inline void pg_store_row_flags(__global uchar* row, int x0, int width, pg_intw mask) {
+  pg_store_row_bytes(row, x0, width, pg_convert_ucharw(mask & 1));
+}
 
 /* The x, y, z and w of four lanes (a, b, c, d: their swizzle digits), interleaved. */
 #define PG_XYZW_OF_4(a, b, c, d)                                                            \

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -826,7 +827,11 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
       EXPECT_NEAR(counts.pi_sum, pi_sum, 1e-5 * pi_sum)
           << name(kc) << ", " << settings.sample_lanes;
       // Without the mixture the kernel draws the same samples and leaves the mixture's
-      // channels as they were.
+      // channels as they were. The states as they were before the first call, so that a pixel
+      // that shares draws from its model's state only if this call finds it sharing: in odd
+      // frames (sample_index 1 of the same frame) by the first call's decision, read from
+      // shares_model (include/rtpg/guiding_layout.h, "Shared models").
+      guider.write_state(state);
       const std::vector<float4> marker(g.n(), float4(-7.0f));
       rt.queue().enqueueWriteBuffer(samples.mixture_a, CL_TRUE, 0, g.n() * 16, marker.data());
       guider.sample(dg, seed, frame, frame % 2u, samples, SampleOutputs::directions);
@@ -921,7 +926,8 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
 // threshold, gamma = 1e-3, or a weight at max_weight); none does with these seeds, and any
 // mismatch fails the test. In
 // one case the lower half of the image is Lambert only, so that whole work-items of the wide
-// kernel skip the GGX lobe.
+// kernel skip the GGX lobe. In the two cases whose models are shared by rows, train decides
+// which pixels share in the first frame and reads the sample kernel's decision in the second.
 TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
   ClRuntime rt;
   Random r(303);
@@ -967,6 +973,7 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
     const pg_kernel_settings p = to_kernel_settings(settings);
     std::vector<float> state = random_states(r, g.n(), p.k_max, false);
     std::vector<float> per_variant[2];
+    const GuiderSamples samples = make_guider_samples(rt.context(), kc.width, kc.height);
     const int lanes[] = {1, 1, 2, 4, 8, 16};
     for (int variant = 0; variant < 6; ++variant) {
       settings.train_memory =
@@ -987,9 +994,21 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
         const std::uint32_t seed = 11u + frame;
         std::vector<int> trained;
         std::vector<double> conditioning;
+        // Where models are shared, the second frame samples first: the sample kernel decides
+        // which pixels share and carries the models into them, and train reads its decision
+        // (include/rtpg/guiding_layout.h, "Shared models"); in the first frame train decides.
+        const bool sampled_first = frame == 1 && settings.rows_per_model > 1;
+        if (sampled_first)
+          for (std::size_t i = 0; i < g.n(); ++i) {
+            const std::size_t from = model_pixel(g, i, p);
+            std::copy_n(s.begin() + static_cast<std::ptrdiff_t>(from * PG_STATE_FLOATS_PER_PIXEL),
+                        PG_STATE_FLOATS_PER_PIXEL,
+                        s.begin() + static_cast<std::ptrdiff_t>(i * PG_STATE_FLOATS_PER_PIXEL));
+          }
         const std::vector<float> expected =
             host_train(s, g, v, seed, frame, p, trained, &conditioning);
         guider.write_state(s);
+        if (sampled_first) guider.sample(dg, seed, frame, 0u, samples);
         guider.train(dg, dv, seed, frame);
         std::vector<float> got;
         guider.read_state(got);
