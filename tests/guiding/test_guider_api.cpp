@@ -228,6 +228,98 @@ TEST(GuiderApi, KernelsLeftRunningComputeTheSame) {
   EXPECT_EQ(state[0], state[1]);
 }
 
+// With models shared by rows, which pixels share is decided once a frame and read by the frame's
+// later calls (include/rtpg/guider.h, above reproject()): a frame's own decision is what counts,
+// never another frame's. Two floors: on A a pixel shares its pair's model (rows 3, 5, ...: row 1's
+// model row is sky); on B the lower row of every pair is another material, so none does. A
+// pixel that shares is seen by the sample kernel carrying its model pixel's state.
+TEST(GuiderApi, EachFrameDecidesWhichPixelsShareFromItsOwnGBuffer) {
+  rtpg::ClRuntime rt;
+  const bool small = rt.info().platform_name.find("Oclgrind") != std::string::npos;
+  const int w = small ? 11 : 37, h = small ? 7 : 23;
+  const std::size_t n = static_cast<std::size_t>(w) * h;
+  const FloorHost host_a = floor_host(w, h);
+  FloorHost host_b = host_a;
+  for (int y = 1; y < h; y += 2)
+    for (int x = 0; x < w; ++x) host_b.material[static_cast<std::size_t>(y) * w + x] = 2u;
+  const rtpg::GuiderGBuffer a = floor_gbuffer(rt, host_a), b = floor_gbuffer(rt, host_b);
+  // A state of its own at every pixel (k = 5 + the pixel's index), so that a carried one shows.
+  std::vector<float> own(8 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float s0 = 1.0f, pi = 0.4f, var = 0.004f;
+    const float v[8] = {s0 / pi,
+                        s0,
+                        0.5f * s0,
+                        0.5f * s0,
+                        s0 * (var + 0.25f),
+                        s0 * (var + 0.25f),
+                        0.25f * s0,
+                        5.0f + static_cast<float>(i)};
+    std::memcpy(&own[8 * i], v, sizeof v);
+  }
+  // Pixels whose state is not their own after sampling: the shared ones on floor A. (Not the sky
+  // row, whose state reproject() resets.)
+  const auto carried = [&](rtpg::Guider& guider) {
+    std::vector<float> state;
+    guider.read_state(state);
+    std::size_t count = 0;
+    for (std::size_t i = static_cast<std::size_t>(w); i < n; ++i) {
+      const std::size_t y = i / static_cast<std::size_t>(w);
+      const std::size_t from = y >= 3 && y % 2 == 1 ? i - static_cast<std::size_t>(w) : i;
+      EXPECT_EQ(state[8 * i + 7], own[8 * from + 7]) << "pixel " << i;
+      count += from != i && state[8 * i + 7] == own[8 * from + 7];
+    }
+    return count;
+  };
+  const auto kept_own = [&](rtpg::Guider& guider) {
+    std::vector<float> state;
+    guider.read_state(state);
+    std::size_t changed = 0;
+    for (std::size_t i = 0; i < n; ++i) changed += state[8 * i + 7] != own[8 * i + 7];
+    return changed == 0;
+  };
+  const std::size_t shared_on_a = static_cast<std::size_t>((h - 2) / 2) * w;
+  rtpg::GuidingSettings settings;
+  settings.rows_per_model = 2;
+  rtpg::Guider guider(rt, w, h, settings);
+  const rtpg::GuiderSamples samples = rtpg::make_guider_samples(rt.context(), w, h);
+
+  // Frame 0 samples floor A, deciding: the shared pixels carry their models.
+  guider.write_state(own);
+  guider.sample(a, 1u, 0u, 0u, samples);
+  EXPECT_EQ(carried(guider), shared_on_a);
+  // Frame 1, floor B, with no reproject() and no train() between: its first sample decides again
+  // (none shares), and its second sample reads that decision.
+  guider.write_state(own);
+  guider.sample(b, 1u, 1u, 0u, samples);
+  EXPECT_TRUE(kept_own(guider));
+  guider.sample(b, 1u, 1u, 1u, samples);
+  EXPECT_TRUE(kept_own(guider));
+  // Frame 2 on floor A: reproject() decides, the frame's sample reads it.
+  guider.write_state(own);
+  guider.reproject(a, a);
+  guider.sample(a, 1u, 2u, 0u, samples);
+  EXPECT_EQ(carried(guider), shared_on_a);
+  // A train() of another frame on floor B decides for itself: every surface pixel trains (from
+  // bright VPLs above it), the lower rows too, which floor A's decision would have skipped.
+  std::vector<float> vp(4 * n);
+  std::vector<std::uint32_t> vnr(4 * n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const float pos[4] = {0.1f * x + 0.3f, 0.1f * y, 2.0f, 1.0f};
+      const std::array<std::uint32_t, 4> packed = rtpg::pack_vpl_normal_radiance(
+          {0.0f, 0.0f, -1.0f}, 1.0f, {5.0f, 5.0f, 5.0f}, y == 0 ? 0u : kValidBsdfVpl);
+      std::memcpy(&vp[4 * i], pos, sizeof pos);
+      std::memcpy(&vnr[4 * i], packed.data(), sizeof packed);
+    }
+  std::vector<float> young = own;  // k = 0: young pixels, which train in every frame
+  for (std::size_t i = 0; i < n; ++i) young[8 * i + 7] = 0.0f;
+  guider.write_state(young);
+  guider.train(b, {upload(rt, vp), upload(rt, vnr)}, 1u, 5u);
+  EXPECT_EQ(guider.count_trained(), n - static_cast<std::size_t>(w));
+}
+
 // The host distribution (include/rtpg/guiding_distribution.h) is the device sampler's: for every
 // direction the sample kernel drew, its density is the kernel's, and its own samples carry
 // their own density.
