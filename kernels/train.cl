@@ -37,8 +37,9 @@ static int pg_train_pixel_at(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE
   float4 bcr = base_color_roughness[i];
   if (!pg_guiding_applies(flags[i], bcr.w, settings)) return 0;
   if (!pg_train_this_frame(state1[i].w, x, y, frame, settings)) return 0;
+  uint column = (uint)x, row = (uint)y;
   if (sharing && !sharing_decided &&
-      pg_model_pixel(PG_PASS_GBUFFER(uint) x, (uint)y, width, settings) != (uint)i)
+      pg_model_pixel(PG_PASS_GBUFFER column, row, width, settings) != (uint)i)
     return 0;
   pg_pmm_state state;
   state.s0 = state0[i];
