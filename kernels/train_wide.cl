@@ -8,7 +8,9 @@
  * caches hold the window). The work-group's record counts the pixels whose state changed
  * (include/rtpg/guiding_layout.h, "Counts"). The state is updated in place, as in train.cl: a
  * work-item none of whose lanes trains this frame reads the lanes' flags, roughness and k and
- * writes nothing. */
+ * writes nothing; one all of whose lanes share their row group's model, as this frame's reproject
+ * or sample kernel decided, reads that decision alone (include/rtpg/guiding_layout.h, "Shared
+ * models"). */
 /* No fused multiply-adds, here or in the shared functions: the host reference runs them
  * unfused, and near the peak of a narrow GGX lobe (alpha 0.03) D's denominator is a difference
  * of nearly equal numbers, where one fused product moves D, and a sample's weight, by 1e-4
@@ -22,7 +24,7 @@
  * pi_learning 8 flops and 2 divisions more per neighbour and pass. Bytes: 116 of its own + 32 N
  * of neighbour VPLs read (each VPL once per image from memory, the rest from cache), 32
  * written: compute-bound. A pixel that does not train this frame: 36 read (20 where guiding
- * does not apply), none written. */
+ * does not apply; 1 where it shares a model by the frame's decision), none written. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "shared/guiding_pixel.h"
 #include "shared/kernel_args.h"

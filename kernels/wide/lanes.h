@@ -145,21 +145,23 @@ PG_ROW_LOAD void pg_load_row_float4_rows(__global const float4* row, int x0, int
   *w = pg_vloadw(0, v[3]);
 }
 
-/* A uint channel of the same pixels (pg_load_row_float4_rows' rule at the row's ends). */
-static inline pg_uintw pg_load_row_uints(__global const uint* row, int x0, int width) {
-  if (x0 >= 0 && x0 + PG_LANES <= width) return pg_vloadw(0, row + x0);
-  uint v[PG_LANES];
-  for (int l = 0; l < PG_LANES; ++l) v[l] = row[clamp(x0 + l, 0, width - 1)];
-  return pg_vloadw(0, v);
-}
+/* A uint (byte) channel of the same pixels (pg_load_row_float4_rows' rule at the row's ends).
+ * One body for both element types, as PG_STORE_ROW below. */
+#define PG_LOAD_ROW(name, type, typew)                                          \
+  static inline typew name(__global const type* row, int x0, int width) {       \
+    if (x0 >= 0 && x0 + PG_LANES <= width) return pg_vloadw(0, row + x0);       \
+    type v[PG_LANES];                                                           \
+    for (int l = 0; l < PG_LANES; ++l) v[l] = row[clamp(x0 + l, 0, width - 1)]; \
+    return pg_vloadw(0, v);                                                     \
+  }
+PG_LOAD_ROW(pg_load_row_uints, uint, pg_uintw)
+PG_LOAD_ROW(pg_load_row_bytes, uchar, pg_ucharw)
+#undef PG_LOAD_ROW
 
-/* A byte flag channel of the same pixels (the same rule) as a mask: -1 where the byte is not
- * 0 (include/rtpg/guiding_layout.h, "Shared models"). */
+/* A byte flag channel of the same pixels as a mask: -1 where the byte is not 0
+ * (include/rtpg/guiding_layout.h, "Shared models"). */
 static inline pg_intw pg_load_row_flags(__global const uchar* row, int x0, int width) {
-  if (x0 >= 0 && x0 + PG_LANES <= width) return pg_convert_intw(pg_vloadw(0, row + x0)) != 0;
-  uchar v[PG_LANES];
-  for (int l = 0; l < PG_LANES; ++l) v[l] = row[clamp(x0 + l, 0, width - 1)];
-  return pg_convert_intw(pg_vloadw(0, v)) != 0;
+  return pg_convert_intw(pg_load_row_bytes(row, x0, width)) != 0;
 }
 
 /* A float channel of the same pixels (the same rule). At a row's end (and a row of at least
@@ -185,9 +187,9 @@ static inline pg_floatw pg_load_row_floats(__global const float* row, int x0, in
   return pg_vloadw(0, v);
 }
 
-/* Stores v to the pixels x0 .. x0 + PG_LANES - 1 of a float (uint, byte) row (x0 >= 0): one vector
- * store where every lane lies inside the row, lane by lane up to its end otherwise. One body for
- * both element types (OpenCL C has no templates). */
+/* Stores v to the pixels x0 .. x0 + PG_LANES - 1 of a float (uint, byte) row (x0 >= 0): one
+ * vector store where every lane lies inside the row, lane by lane up to its end otherwise. One
+ * body for every element type (OpenCL C has no templates). */
 #define PG_STORE_ROW(name, type, typew)                                     \
   static inline void name(__global type* row, int x0, int width, typew v) { \
     if (x0 + PG_LANES <= width) {                                           \
