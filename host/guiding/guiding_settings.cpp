@@ -66,8 +66,8 @@ const std::vector<GuidingSettingInfo>& guiding_settings_table() {
               "A mature pixel (k >= k_max/4) trains every this many frames"),
       integer("rows_per_model", &S::rows_per_model, 0, 8,
               "1, 2, 4 or 8: pixels of a column's group of this many rows showing the first "
-              "one's surface sample with its model and train none of their own (0: 4 from 540 "
-              "rows of image, 2 from 270, else 1)"),
+              "one's surface sample with its model and train none of their own (0: 8 from 1080 "
+              "rows of image, 4 from 540, 2 from 270, else 1)"),
       integer("train_all_samples", &S::train_all_samples, 0, 1,
               "1: train on every VPL at its mixture density; 0: BSDF samples only"),
       integer("pi_learning", &S::pi_learning, 0, 1,
@@ -137,7 +137,7 @@ void validate(const GuidingSettings& s) {
 
 int rows_per_model_for_height(int height) {
   int rows = 1;
-  while (rows < 4 && 2 * rows * 135 <= height) rows *= 2;
+  while (rows < 8 && 2 * rows * 135 <= height) rows *= 2;
   return rows;
 }
 

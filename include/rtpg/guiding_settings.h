@@ -88,11 +88,12 @@ bool parse_train_memory(const std::string& word, GuidingSettings::TrainMemory& m
 // a broken relation between two rows (pi_min <= pi_max, n_min <= n_max).
 void validate(const GuidingSettings& settings);
 
-// rows_per_model 0's choice for an image `height` pixels high: the largest of 1, 2 and 4 whose
-// group of rows spans at most 1/135 of the height (540 and more rows: 4; 270-539: 2; fewer: 1).
-// A model serves pixels up to that far from its own: at 960x540 groups of 4 cost no measured
-// error on the untextured rooms, at 240x135 groups of 2 and 4 cost them 1-3% (docs/guiding.md,
-// "Models shared by rows, by the image's height").
+// rows_per_model 0's choice for an image `height` pixels high: the largest of 1, 2, 4 and 8
+// whose group of rows spans at most 1/135 of the height (1080 and more rows: 8; 540-1079: 4;
+// 270-539: 2; fewer: 1). A model serves pixels up to that far from its own: at 960x540 groups of
+// 4 and at 1920x1080 groups of 8 cost no measured error, at 240x135 groups of 2 and 4 cost the
+// untextured rooms 1-3% (docs/guiding.md, "Models shared by rows, by the image's height", "Eight
+// rows per model from 1080 rows").
 int rows_per_model_for_height(int height);
 
 // The block the kernels read. Host code that evaluates the mixture itself (the

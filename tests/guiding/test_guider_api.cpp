@@ -447,11 +447,12 @@ TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
 }
 
 // rows_per_model 0 (the default) shares a model over at most 1/135 of the image's height, in
-// groups of 1, 2 or 4 rows; an explicit value is kept whatever the height.
+// groups of 1, 2, 4 or 8 rows; an explicit value is kept whatever the height.
 TEST(GuidingSettingsTable, RowsPerModelByTheImagesHeight) {
   EXPECT_EQ(rtpg::GuidingSettings{}.rows_per_model, 0);
-  const std::pair<int, int> heights[] = {{0, 1},   {1, 1},   {135, 1}, {269, 1},  {270, 2},
-                                         {539, 2}, {540, 4}, {720, 4}, {1080, 4}, {4320, 4}};
+  const std::pair<int, int> heights[] = {{0, 1},    {1, 1},    {135, 1},  {269, 1},
+                                         {270, 2},  {539, 2},  {540, 4},  {720, 4},
+                                         {1079, 4}, {1080, 8}, {2160, 8}, {4320, 8}};
   for (const auto& [height, rows] : heights) {
     EXPECT_EQ(rtpg::rows_per_model_for_height(height), rows) << height;
     EXPECT_EQ(rtpg::to_kernel_settings(rtpg::GuidingSettings{}, height).rows_per_model, rows)
