@@ -569,13 +569,17 @@ struct KernelCase {
   int local_x, local_y;
   int width, height;
   int apron;
+  int rows_per_model;  // models shared by groups of this many rows (GuidingSettings)
 };
 
+// Every row-sharing setting the default chooses (rows_per_model_for_height: 1, 2, 4 and, from
+// 1080 rows, 8) in one case or another, each over a last group cut short by the image's height.
 std::vector<KernelCase> kernel_cases(const ClRuntime& rt) {
   if (simulated(rt))
-    return {{8, 8, 13, 9, 2}, {16, 16, 19, 5, 1}, {12, 6, 14, 8, 3}, {0, 0, 21, 7, 2}};
+    return {{8, 8, 13, 9, 2, 8}, {16, 16, 19, 5, 1, 2}, {12, 6, 14, 8, 3, 4}, {0, 0, 21, 7, 2, 1}};
   // 300 pixels a row: three row groups of 100 work-items for one pixel per work-item.
-  return {{8, 8, 93, 61, 3}, {16, 16, 101, 77, 2}, {12, 6, 98, 47, 1}, {0, 0, 300, 29, 2}};
+  return {
+      {8, 8, 93, 61, 3, 4}, {16, 16, 101, 77, 2, 8}, {12, 6, 98, 47, 1, 2}, {0, 0, 300, 29, 2, 1}};
 }
 
 std::string name(const KernelCase& c) {
@@ -643,7 +647,7 @@ void make_reprojection_pair(Random& r, int w, int h, HostGBuffer& prev, HostGBuf
 // atan2 and exp, which may differ by a few ulp between the device and the host: within 1e-5
 // relative plus twice aged_k_relative_error (the exponent's conditioning; on an NVIDIA H100,
 // with acos then, a k aged by exp(-90) differed by 2e-5 relative, docs/design.md, "Floating
-// point on other devices"). Two cases share models by rows (rows_per_model 2 and 4, on
+// point on other devices"). Three cases share models by rows (rows_per_model 2, 4 and 8, on
 // G-buffers whose left halves repeat each group's first row): there reproject leaves a sharing
 // pixel alone, and after the sample kernel it holds its model pixel's reprojected state.
 TEST(GuidingKernels, ReprojectMatchesHostReference) {
@@ -658,8 +662,7 @@ TEST(GuidingKernels, ReprojectMatchesHostReference) {
     settings.local_x = kc.local_x;
     settings.local_y = kc.local_y;
     settings.apron = kc.apron;
-    // Models shared by pairs of rows and by groups of four in two of the cases.
-    settings.rows_per_model = kc.apron == 1 ? 2 : (kc.apron == 3 ? 4 : 1);
+    settings.rows_per_model = kc.rows_per_model;
     const pg_kernel_settings p = to_kernel_settings(settings);
     Guider guider(rt, kc.width, kc.height, settings);
     HostGBuffer prev(1, 1), cur(1, 1);
@@ -771,8 +774,7 @@ TEST(GuidingKernels, SampleMatchesHostReference) {
     GuidingSettings settings;
     settings.local_x = kc.local_x;
     settings.local_y = kc.local_y;
-    // Models shared by pairs of rows and by groups of four in two of the cases.
-    settings.rows_per_model = kc.apron == 1 ? 2 : (kc.apron == 3 ? 4 : 1);
+    settings.rows_per_model = kc.rows_per_model;
     share_rows(g, settings.rows_per_model);
     const GuiderGBuffer dg = upload(rt, g);
     const pg_kernel_settings p = to_kernel_settings(settings);
@@ -950,8 +952,7 @@ TEST(GuidingKernels, TrainMatchesHostReferenceInEveryVariant) {
     settings.local_x = kc.local_x;
     settings.local_y = kc.local_y;
     settings.apron = kc.apron;
-    // Models shared by pairs of rows and by groups of four in two of the cases.
-    settings.rows_per_model = kc.apron == 1 ? 2 : (kc.apron == 3 ? 4 : 1);
+    settings.rows_per_model = kc.rows_per_model;
     share_rows(g, settings.rows_per_model);
     if (settings.rows_per_model > 1) {
       const pg_kernel_settings sharing_settings = to_kernel_settings(settings);
