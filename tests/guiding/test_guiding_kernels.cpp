@@ -573,7 +573,8 @@ struct KernelCase {
 };
 
 // Every row-sharing setting the default chooses (rows_per_model_for_height: 1, 2, 4 and, from
-// 1080 rows, 8) in one case or another, each over a last group cut short by the image's height.
+// 1080 rows, 8) in one case or another; at full size each sharing case's image ends in a group
+// its height cuts short.
 std::vector<KernelCase> kernel_cases(const ClRuntime& rt) {
   if (simulated(rt))
     return {{8, 8, 13, 9, 2, 8}, {16, 16, 19, 5, 1, 2}, {12, 6, 14, 8, 3, 4}, {0, 0, 21, 7, 2, 1}};
