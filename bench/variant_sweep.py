@@ -20,6 +20,12 @@ the frames listed in --checkpoints against a reference of each of those frames (
 static ones):
 
     python3 bench/variant_sweep.py --camera-path --checkpoints 23 31 --variants '{"default": []}'
+
+--window equal to --frames gives the ratio of the errors summed over every frame, what the
+equal-time experiment's accumulated image sees (docs/guiding.md, "How fast the guide learns"); --curve N
+prints the ratio of each N-frame window, the guide's learning curve:
+
+    python3 bench/variant_sweep.py --frames 128 --curve 8 --variants '{"default": []}' --scenes cornell-box
 """
 import argparse
 import hashlib
@@ -39,6 +45,18 @@ def window_relmse(stats, window):
     return statistics.fmean(f["relmse"] for f in frames)
 
 
+def window_curve(pg_runs, pt_runs, n):
+    """PG/PT of each consecutive n-frame window, the mean over seeds of each seed's ratio of the
+    windows' summed relMSE."""
+    frames = min(len(r["frames"]) for r in pg_runs + pt_runs)
+    curve = []
+    for start in range(0, frames - n + 1, n):
+        ratios = [sum(f["relmse"] for f in pg["frames"][start:start + n]) /
+                  sum(f["relmse"] for f in pt["frames"][start:start + n]) for pg, pt in zip(pg_runs, pt_runs)]
+        curve.append((start + 1, start + n, statistics.fmean(ratios)))
+    return curve
+
+
 def markdown_table(scenes, table):
     """table[variant][scene] = (mean, se): a row per variant, the mean over scenes last."""
     lines = ["| variant | " + " | ".join(scenes) + " | mean |", "|---" * (len(scenes) + 2) + "|"]
@@ -56,7 +74,13 @@ def main():
     parser.add_argument("--seeds", nargs="+", type=int, default=[1, 2, 3])
     parser.add_argument("--res", default="240x135")
     parser.add_argument("--frames", type=int, default=32)
-    parser.add_argument("--window", type=int, default=8, help="last frames whose relMSE is averaged")
+    parser.add_argument("--window", type=int, default=8,
+                        help="last frames whose relMSE is averaged (--window equal to --frames: the "
+                             "ratio of the summed per-frame errors, the accumulated image's error "
+                             "ratio where frames are independent)")
+    parser.add_argument("--curve", type=int, metavar="N",
+                        help="also print PG/PT per consecutive N-frame window (mean over seeds): "
+                             "how fast the guide learns")
     parser.add_argument("--ref-spp", type=int, default=1024)
     parser.add_argument("--ref-seed", type=int, default=777,
                         help="the references' seed (1000: those of the equal-time experiment)")
@@ -70,6 +94,8 @@ def main():
     variants = runner.parse_variants(parser, args.variants, '{"default": []}')
     if not 1 <= args.window <= args.frames:
         parser.error(f"--window {args.window} must be between 1 and --frames {args.frames}")
+    if args.curve is not None and (args.camera_path or not 1 <= args.curve <= args.frames):
+        parser.error("--curve N needs a static run (no --camera-path) and 1 <= N <= --frames")
     if args.checkpoints and not args.camera_path:
         parser.error("--checkpoints needs --camera-path")
     checkpoints = sorted(set(args.checkpoints or range(args.frames - args.window, args.frames)))
@@ -109,19 +135,21 @@ def main():
                                       "relmse": value}) + "\n")
         return value
 
-    def relmse(scene, tag, seed, guiding, extra):
-        if args.camera_path:
-            return path_relmse(scene, tag, seed, guiding, extra)
+    def static_stats(scene, tag, seed, guiding, extra):
         reference = refs.get(scene, args.res, args.ref_spp, seed=args.ref_seed)
         run_dir = out / scene
         run_tag = f"{tag}-{seed}-{run_key(extra, args.frames)}"
         cached = run_dir / f"{run_tag}.json"
         if cached.exists():
-            stats = json.loads(cached.read_text())
-        else:
-            stats, _ = runner.render(scene, args.res, args.frames, guiding, run_dir, run_tag, reference=reference,
-                                     extra=["--seed", seed, *extra])
-        return window_relmse(stats, args.window)
+            return json.loads(cached.read_text())
+        stats, _ = runner.render(scene, args.res, args.frames, guiding, run_dir, run_tag, reference=reference,
+                                 extra=["--seed", seed, *extra])
+        return stats
+
+    def relmse(scene, tag, seed, guiding, extra):
+        if args.camera_path:
+            return path_relmse(scene, tag, seed, guiding, extra)
+        return window_relmse(static_stats(scene, tag, seed, guiding, extra), args.window)
 
     table = {name: {} for name in variants}
     for scene in args.scenes:
@@ -132,6 +160,10 @@ def main():
             table[name][scene] = runner.mean_sem([a / b for a, b in zip(pg, pt)])
             m, se = table[name][scene]
             print(f"{scene:18s} {name:24s} PT {statistics.fmean(pt):.4g}  PG/PT {m:.3f} ± {se:.3f}", flush=True)
+            if args.curve:
+                curve = window_curve([static_stats(scene, tag, s, "pmm", extra) for s in args.seeds],
+                                     [static_stats(scene, "pt", s, "off", []) for s in args.seeds], args.curve)
+                print(f"{'':18s} {'':24s} " + " ".join(f"{a}-{b}: {r:.3f}" for a, b, r in curve), flush=True)
     print(markdown_table(args.scenes, table))
     (out / "sweep.json").write_text(json.dumps({"settings": vars(args), "table": table}, indent=1) + "\n")
 

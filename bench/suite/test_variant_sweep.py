@@ -31,6 +31,16 @@ class Statistics(unittest.TestCase):
         self.assertEqual(variant_sweep.window_relmse(stats, 3), 8.0)  # frames 7, 8, 9
         self.assertEqual(variant_sweep.window_relmse(stats, 10), 4.5)
 
+    def test_curve_is_each_windows_ratio_of_sums(self):
+        def run(errors):
+            return {"frames": [{"relmse": e} for e in errors]}
+        # Seed 1: windows (1+3)/(2+2) = 1 and (2+2)/(4+4) = 0.5; seed 2: 4/8 and 2/4 = 0.5.
+        pg = [run([1.0, 3.0, 2.0, 2.0, 9.0]), run([2.0, 2.0, 1.0, 1.0, 9.0])]
+        pt = [run([2.0, 2.0, 4.0, 4.0, 1.0]), run([4.0, 4.0, 2.0, 2.0, 1.0])]
+        # The fifth frame is no whole window: left out.
+        self.assertEqual(variant_sweep.window_curve(pg, pt, 2), [(1, 2, 0.75), (3, 4, 0.5)])
+        self.assertEqual(variant_sweep.window_curve(pg, pt, 5), [(1, 5, (17 / 13 + 15 / 13) / 2)])
+
     def test_table_has_a_row_per_variant_and_the_mean(self):
         table = {"a": {"s1": (0.5, 0.01), "s2": (1.0, 0.02)}}
         text = variant_sweep.markdown_table(["s1", "s2"], table)
@@ -83,6 +93,23 @@ class EndToEnd(unittest.TestCase):
             subprocess.run(cmd, check=True, capture_output=True, text=True)
             run = json.loads(next((Path(out) / "cornell-box").glob("path-pg-guided-1-*.relmse.json")).read_text())
             self.assertEqual(run["checkpoints"], [2, 3])
+
+    def test_tiny_sweep_with_a_curve(self):
+        with tempfile.TemporaryDirectory() as out:
+            cmd = [sys.executable, str(BENCH / "variant_sweep.py"), "--scenes", "cornell-box", "--seeds", "1",
+                   "--res", "24x16", "--frames", "4", "--window", "4", "--curve", "2", "--ref-spp", "16", "--out",
+                   out, "--variants", json.dumps({"guided": []})]
+            text = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+            curve = next(line for line in text.splitlines() if "1-2:" in line).split()
+            self.assertEqual([curve[0], curve[2]], ["1-2:", "3-4:"])
+            self.assertTrue(all(math.isfinite(float(curve[i])) and float(curve[i]) > 0 for i in (1, 3)), curve)
+
+    def test_bad_curve_is_refused(self):
+        base = [sys.executable, str(BENCH / "variant_sweep.py"), "--variants", "{}", "--frames", "4", "--window", "2"]
+        for extra in (["--curve", "0"], ["--curve", "5"], ["--curve", "2", "--camera-path"]):
+            r = subprocess.run(base + extra, capture_output=True, text=True)
+            self.assertEqual(r.returncode, 2, extra)
+            self.assertIn("--curve", r.stderr)
 
     def test_bad_checkpoints_are_refused(self):
         base = [sys.executable, str(BENCH / "variant_sweep.py"), "--variants", "{}", "--frames", "4", "--window", "2"]
