@@ -56,8 +56,7 @@ std::size_t Distribution1D::sample_discrete(float u, float* probability, float* 
 }
 
 float Distribution1D::remap(float u, std::size_t i) const {
-  if (only_cell_ < weights_.size())
-    return static_cast<float>(std::clamp(static_cast<double>(u), 0.0, 1.0 - 1e-7));
+  if (only_cell_ < weights_.size()) return remap_in_only_cell(u);
   const double target = static_cast<double>(u) * cdf_.back();
   const double width = cdf_[i + 1] - cdf_[i];
   const double r = width > 0.0 ? (target - cdf_[i]) / width : 0.5;

@@ -2,6 +2,7 @@
 // (pbrt's Distribution1D/2D): sample in proportion to non-negative weights, return the density.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -21,6 +22,10 @@ class Distribution1D {
   // The remapped number sample_discrete gives for u, which picked cell i: for a caller that
   // needs it for some cells only (its double division is a fifth of a light sample).
   float remap(float u, std::size_t i) const;
+  // What remap gives in a distribution whose weight is all in one cell: u, kept below 1.
+  static float remap_in_only_cell(float u) {
+    return static_cast<float>(std::clamp(static_cast<double>(u), 0.0, 1.0 - 1e-7));
+  }
   // 0 for an index outside the distribution (an empty one has no cells).
   float probability(std::size_t i) const {
     return i < probabilities_.size() ? probabilities_[i] : 0.0f;

@@ -97,6 +97,15 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
     kinds[kEnvironment] = kPi * mean_radiance * disc;
   }
   selection_ = Distribution1D(kinds);
+  triangles_only_ =
+      kinds[kTriangles] > 0.0f && !(kinds[kSun] > 0.0f) && !(kinds[kEnvironment] > 0.0f);
+  triangles_only_probability_ = selection_.probability(kTriangles);
+  // escaped_radiance and pdf_escaped are 0 without an environment (none, a map that did not
+  // load, or a black constant, whose selection probability is 0 too) and without a sun of finite
+  // size (a delta sun is only ever sampled, never found).
+  has_sky_ = env_map_ != nullptr ||
+             (env.kind == Environment::Kind::Constant && env.color != glm::vec3(0.0f)) ||
+             sun_solid_angle_ > 0.0f;
 }
 
 glm::vec2 Lights::direction_to_equirect(const glm::vec3& d) const {
@@ -136,34 +145,42 @@ float Lights::environment_pdf(const glm::vec3& d) const {
   return 0.0f;
 }
 
+inline bool Lights::sample_triangle(const glm::vec3& p, float u_triangle, float p_kind, float u1,
+                                    float u2, LightSample& out) const {
+  float p_tri = 0.0f;
+  const std::size_t i = triangle_selection_.sample_discrete(u_triangle, &p_tri);
+  const EmissiveTriangle& e = triangles_[i];
+  // Uniform point on the triangle (pbrt's square-root parameterisation).
+  const float su = std::sqrt(u1);
+  const float b1 = u2 * su;
+  const glm::vec3 y = e.p0 + e.e1 * (1.0f - su) + e.e2 * b1;
+  const glm::vec3 to = y - p;
+  const float d2 = glm::dot(to, to);
+  if (!(d2 > 0.0f)) return false;
+  const float d = std::sqrt(d2);
+  out.direction = to / d;
+  const float cos_light = -glm::dot(out.direction, e.normal);
+  if (cos_light <= 0.0f) return false;  // one-sided emitters
+  out.distance = d;
+  out.radiance = e.radiance;
+  out.pdf = p_kind * p_tri * d2 / (cos_light * e.area);
+  out.delta = false;
+  return true;
+}
+
 bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2,
                     LightSample& out) const {
+  // u_select's place inside the kind's cell chooses the triangle (only this kind needs it).
+  // With triangles the only kind, what sample_discrete and remap give for it, without calling
+  // them: its probability (1) and u.
+  if (triangles_only_)
+    return sample_triangle(p, Distribution1D::remap_in_only_cell(u_select),
+                           triangles_only_probability_, u1, u2, out);
   if (empty()) return false;
   float p_kind = 0.0f;
   const std::size_t kind = selection_.sample_discrete(u_select, &p_kind);
-  if (kind == kTriangles) {
-    // u_select's place inside the kind's cell chooses the triangle (only this kind needs it).
-    float p_tri = 0.0f;
-    const std::size_t i =
-        triangle_selection_.sample_discrete(selection_.remap(u_select, kind), &p_tri);
-    const EmissiveTriangle& e = triangles_[i];
-    // Uniform point on the triangle (pbrt's square-root parameterisation).
-    const float su = std::sqrt(u1);
-    const float b1 = u2 * su;
-    const glm::vec3 y = e.p0 + e.e1 * (1.0f - su) + e.e2 * b1;
-    const glm::vec3 to = y - p;
-    const float d2 = glm::dot(to, to);
-    if (!(d2 > 0.0f)) return false;
-    const float d = std::sqrt(d2);
-    out.direction = to / d;
-    const float cos_light = -glm::dot(out.direction, e.normal);
-    if (cos_light <= 0.0f) return false;  // one-sided emitters
-    out.distance = d;
-    out.radiance = e.radiance;
-    out.pdf = p_kind * p_tri * d2 / (cos_light * e.area);
-    out.delta = false;
-    return true;
-  }
+  if (kind == kTriangles)
+    return sample_triangle(p, selection_.remap(u_select, kind), p_kind, u1, u2, out);
   if (kind == kSun) {
     const glm::vec3 axis = sun_axis_;
     out.distance = kInfinity;
@@ -217,12 +234,14 @@ float Lights::pdf_triangle(std::uint32_t mesh, std::uint32_t triangle, const glm
 }
 
 glm::vec3 Lights::escaped_radiance(const glm::vec3& d) const {
+  if (!has_sky_) return glm::vec3(0.0f);
   glm::vec3 l = environment_radiance(d);
   if (sun_solid_angle_ > 0.0f && glm::dot(d, sun_axis_) >= sun_cos_max_) l += sun_radiance_;
   return l;
 }
 
 float Lights::pdf_escaped(const glm::vec3& d) const {
+  if (!has_sky_) return 0.0f;
   float pdf = selection_.probability(kEnvironment) * environment_pdf(d);
   if (sun_solid_angle_ > 0.0f && glm::dot(d, sun_axis_) >= sun_cos_max_)
     pdf += selection_.probability(kSun) / sun_solid_angle_;

@@ -57,6 +57,10 @@ class Lights {
   };
   enum Kind : std::size_t { kTriangles = 0, kSun = 1, kEnvironment = 2 };
 
+  // Inline in both callers: where triangles are the only lights, sample is little more than it.
+  [[gnu::always_inline]] inline bool sample_triangle(const glm::vec3& p, float u_triangle,
+                                                     float p_kind, float u1, float u2,
+                                                     LightSample& out) const;
   glm::vec3 environment_radiance(const glm::vec3& direction) const;
   float environment_pdf(const glm::vec3& direction) const;
   glm::vec2 direction_to_equirect(const glm::vec3& d) const;
@@ -66,7 +70,13 @@ class Lights {
   std::vector<EmissiveTriangle> triangles_;
   std::vector<std::vector<std::int32_t>> triangle_index_;  // [mesh][triangle] -> light or -1
   Distribution1D triangle_selection_;
-  Distribution1D selection_;     // over Kind
+  Distribution1D selection_;  // over Kind
+  // What a scene without them skips (docs/host-path-tracer.md, "What a scene does not use,
+  // skipped"): the choice of a kind where emissive triangles are the only one, and the sky's
+  // radiance and density where there is neither an environment nor a sun of finite size.
+  bool triangles_only_ = false;
+  float triangles_only_probability_ = 0.0f;  // selection_.probability(kTriangles): 1
+  bool has_sky_ = true;
   glm::vec3 sun_axis_{0, 1, 0};  // normalize(scene.sun.direction), once: every escaped ray asks
   glm::vec3 sun_frame_t_{1, 0, 0}, sun_frame_b_{0, 1, 0};
   float sun_cos_max_ = 1.0f;

@@ -68,7 +68,10 @@ glm::vec3 offset_ray_origin(const glm::vec3& p, const glm::vec3& n, float offset
   return out;
 }
 
-TriangleFacts triangle_facts(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2) {
+TriangleFacts triangle_facts(const Mesh& mesh, std::uint32_t triangle) {
+  const glm::uvec3 tri = mesh.triangles[triangle];
+  const glm::vec3 &p0 = mesh.positions[tri.x], &p1 = mesh.positions[tri.y],
+                  &p2 = mesh.positions[tri.z];
   // The bound gamma(7) * max|p_i| per coordinate covers a hit's interpolation from its
   // barycentrics and their own rounding (b0 = 1 - u - v); the offset distance is its projection
   // on the normal (docs/robustness.md, "Scale invariance").
@@ -79,6 +82,24 @@ TriangleFacts triangle_facts(const glm::vec3& p0, const glm::vec3& p1, const glm
   f.normal = glm::normalize(glm::cross(p1 - p0, p2 - p0));
   f.offset_distance = glm::dot(glm::abs(f.normal), error);
   f.flat_shading_normal = glm::normalize(f.normal);
+  f.constant_shading_normal = mesh.normals.empty() ? 1u : 0u;
+  if (!mesh.normals.empty()) {
+    // Three equal vertex normals (a flat quad or box face from scene/shapes.h, a flat-shaded
+    // mesh): the shading normal is that normal, put on the side surface_point would put it. A
+    // vertex normal too short to normalise, or one within about 0.06 degrees of the triangle's
+    // plane (where the interpolated one's rounding could decide the side), stays per hit.
+    const glm::vec3 n = mesh.normals[tri.x];
+    const float length2 = glm::dot(n, n);
+    if (n == mesh.normals[tri.y] && n == mesh.normals[tri.z] && length2 >= 1e-10f &&
+        std::isfinite(length2)) {
+      const glm::vec3 shading = glm::normalize(n);
+      const float side = glm::dot(shading, f.normal);
+      if (std::fabs(side) > 1e-3f) {
+        f.flat_shading_normal = side < 0.0f ? -shading : shading;
+        f.constant_shading_normal = 1u;
+      }
+    }
+  }
   return f;
 }
 
@@ -87,45 +108,21 @@ TriangleTable::TriangleTable(const Scene& scene) {
   for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
     facts_[m].resize(mesh.triangles.size());
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-      const glm::uvec3 tri = mesh.triangles[t];
-      facts_[m][t] =
-          triangle_facts(mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z]);
-    }
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+      facts_[m][t] = triangle_facts(mesh, static_cast<std::uint32_t>(t));
   }
 }
 
 namespace {
 
-SurfacePoint surface_point(const Scene& scene, const TriangleFacts& facts, const Ray& ray,
-                           const Hit& hit) {
-  const Mesh& mesh = scene.meshes[hit.mesh];
-  const glm::uvec3 tri = mesh.triangles[hit.triangle];
-  const Material& mat = scene.materials[mesh.material];
-  SurfacePoint sp;
-  sp.material_id = mesh.material;
-  // The hit from its barycentrics, not from origin + t * direction: its rounding error then
-  // depends on the triangle's coordinates only, not on how far the ray came (TriangleFacts).
-  sp.position = (1.0f - hit.u - hit.v) * mesh.positions[tri.x] + hit.u * mesh.positions[tri.y] +
-                hit.v * mesh.positions[tri.z];
-  const bool front = glm::dot(facts.normal, ray.direction) < 0.0f;
-  const glm::vec3 ng = front ? facts.normal : -facts.normal;
-  glm::vec3 ns;
-  if (mesh.normals.empty()) {
-    // normalize(ng), as below; negation commutes with it exactly.
-    ns = front ? facts.flat_shading_normal : -facts.flat_shading_normal;
-  } else {
-    ns = interpolate(mesh.normals, tri, hit.u, hit.v);
-    if (glm::dot(ns, ns) < 1e-12f) ns = ng;
-    ns = glm::normalize(ns);
-    if (glm::dot(ns, ng) < 0.0f) ns = -ns;
-  }
-
+// The textures of `mat` at the hit: base colour, roughness and metallic scaled, the shading
+// normal ns perturbed by a normal or bump map (kept on ng's side).
+[[gnu::noinline]] void apply_textures(const Scene& scene, const Mesh& mesh, const Material& mat,
+                                      const glm::uvec3& tri, const Hit& hit, const glm::vec3& ng,
+                                      glm::vec3& ns, glm::vec3& base, float& roughness,
+                                      float& metallic) {
   glm::vec2 uv(0.0f);
   if (!mesh.uvs.empty()) uv = interpolate(mesh.uvs, tri, hit.u, hit.v);
-
-  glm::vec3 base = mat.base_color;
-  float roughness = mat.roughness, metallic = mat.metallic;
   if (mat.base_color_texture >= 0)
     base *= glm::vec3(scene.textures[mat.base_color_texture].sample(uv));
   if (mat.roughness_texture >= 0)
@@ -154,6 +151,38 @@ SurfacePoint surface_point(const Scene& scene, const TriangleFacts& facts, const
       if (glm::dot(perturbed, ng) > 0.05f) ns = perturbed;
     }
   }
+}
+
+SurfacePoint surface_point(const Scene& scene, const TriangleFacts& facts, const Ray& ray,
+                           const Hit& hit) {
+  const Mesh& mesh = scene.meshes[hit.mesh];
+  const glm::uvec3 tri = mesh.triangles[hit.triangle];
+  const Material& mat = scene.materials[mesh.material];
+  SurfacePoint sp;
+  sp.material_id = mesh.material;
+  // The hit from its barycentrics, not from origin + t * direction: its rounding error then
+  // depends on the triangle's coordinates only, not on how far the ray came (TriangleFacts).
+  sp.position = (1.0f - hit.u - hit.v) * mesh.positions[tri.x] + hit.u * mesh.positions[tri.y] +
+                hit.v * mesh.positions[tri.z];
+  const bool front = glm::dot(facts.normal, ray.direction) < 0.0f;
+  const glm::vec3 ng = front ? facts.normal : -facts.normal;
+  glm::vec3 ns;
+  if (facts.constant_shading_normal != 0u) {
+    // On normal's side (TriangleFacts): negation commutes with normalisation exactly.
+    ns = front ? facts.flat_shading_normal : -facts.flat_shading_normal;
+  } else {
+    ns = interpolate(mesh.normals, tri, hit.u, hit.v);
+    if (glm::dot(ns, ns) < 1e-12f) ns = ng;
+    ns = glm::normalize(ns);
+    if (glm::dot(ns, ng) < 0.0f) ns = -ns;
+  }
+
+  glm::vec3 base = mat.base_color;
+  float roughness = mat.roughness, metallic = mat.metallic;
+  // Out of line: a material without textures pays one test (docs/host-path-tracer.md, "What a
+  // scene does not use, skipped").
+  if (mat.has_textures())
+    apply_textures(scene, mesh, mat, tri, hit, ng, ns, base, roughness, metallic);
   sp.geometric_normal = ng;
   sp.offset_distance = facts.offset_distance;
   sp.shading_normal = ns;
@@ -212,11 +241,7 @@ void prefetch_surface_texels(const Scene& scene, const Hit& hit) {
 }
 
 SurfacePoint make_surface_point(const Scene& scene, const Ray& ray, const Hit& hit) {
-  const Mesh& mesh = scene.meshes[hit.mesh];
-  const glm::uvec3 tri = mesh.triangles[hit.triangle];
-  return surface_point(
-      scene, triangle_facts(mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z]),
-      ray, hit);
+  return surface_point(scene, triangle_facts(scene.meshes[hit.mesh], hit.triangle), ray, hit);
 }
 
 SurfacePoint make_surface_point(const Scene& scene, const TriangleTable& triangles, const Ray& ray,

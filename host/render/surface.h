@@ -34,11 +34,17 @@ struct alignas(16) TriangleFacts {
   glm::vec3 normal{0.0f, 0.0f, 1.0f};  // normalize(cross(p1 - p0, p2 - p0)), facing no ray yet
   // dot(|normal|, gamma(7) * max|p_i|): SurfacePoint::offset_distance of every point on it
   float offset_distance = 0.0f;
-  // normalize(normal): the shading normal of a mesh without vertex normals, as make_surface_point
-  // normalises it once more (so that the table gives the same bits as the per-hit code)
+  // The shading normal wherever it is the same over the whole triangle, on normal's side:
+  // normalize(normal) for a mesh without vertex normals (normalised once more, as the per-hit
+  // code does), and for a triangle whose three vertex normals are the same vector, that vector
+  // normalised (then interpolating it would only round it; docs/host-path-tracer.md, "What a
+  // scene does not use, skipped").
   glm::vec3 flat_shading_normal{0.0f, 0.0f, 1.0f};
+  // 1 where flat_shading_normal is the shading normal (no interpolation), else 0.
+  std::uint32_t constant_shading_normal = 1;
 };
-TriangleFacts triangle_facts(const glm::vec3& p0, const glm::vec3& p1, const glm::vec3& p2);
+// The facts of triangle `triangle` of `mesh`, from its positions and vertex normals.
+TriangleFacts triangle_facts(const Mesh& mesh, std::uint32_t triangle);
 
 // The facts of every triangle of a scene, from its positions as they are when the table is built
 // (the renderer builds it with its BVH; a scene changed afterwards needs both rebuilt).

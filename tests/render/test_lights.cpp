@@ -330,12 +330,60 @@ TEST(Distribution1D, OneCellWithWeightKeepsUAsItsRemappedNumber) {
         EXPECT_EQ(probability, 1.0f);
         EXPECT_EQ(remapped, static_cast<float>(std::min(static_cast<double>(u), 1.0 - 1e-7)))
             << "u " << u;
+        // What Lights::sample uses instead of asking, where triangles are the only lights.
+        EXPECT_EQ(Distribution1D::remap_in_only_cell(u), remapped) << "u " << u;
       }
       EXPECT_EQ(dist.probability(cell), 1.0f);
       EXPECT_EQ(dist.probability(size), 0.0f);  // outside the distribution
     }
   }
   EXPECT_EQ(Distribution1D().probability(0), 0.0f);
+}
+
+// The sky's radiance and density are 0 without an environment and a sun of finite size, and
+// Lights says so without looking (its has_sky_): no environment, a black constant one (which
+// light selection never picks), a delta sun; a dim constant sky and a sun's cone are seen.
+TEST(Lights, NoSkyWithoutAnEnvironmentOrASunsDisc) {
+  Scene scene = floor_scene();
+  Material light;
+  light.emission = glm::vec3(3.0f);
+  scene.materials.push_back(light);
+  Mesh lamp = make_quad({-0.2f, 1.0f, -0.2f}, {0.0f, 0.0f, 0.4f}, {0.4f, 0.0f, 0.0f});
+  lamp.material = 1;
+  scene.meshes.push_back(lamp);
+  const glm::vec3 up(0.0f, 1.0f, 0.0f), side = glm::normalize(glm::vec3(1.0f, 0.2f, 0.0f));
+  const auto dark = [&](const Scene& s) {
+    const Lights lights(s);
+    for (const glm::vec3& d : {up, side, -up}) {
+      EXPECT_EQ(lights.escaped_radiance(d), glm::vec3(0.0f));
+      EXPECT_EQ(lights.pdf_escaped(d), 0.0f);
+    }
+  };
+  dark(scene);
+  Scene black = scene;
+  black.environment.kind = Environment::Kind::Constant;
+  black.environment.color = glm::vec3(0.0f);
+  dark(black);
+  Scene delta_sun = scene;
+  delta_sun.sun.enabled = true;
+  delta_sun.sun.direction = up;
+  delta_sun.sun.irradiance = glm::vec3(2.0f);
+  delta_sun.sun.angular_radius = 0.0f;
+  dark(delta_sun);
+
+  Scene dim = scene;
+  dim.environment.kind = Environment::Kind::Constant;
+  dim.environment.color = glm::vec3(1e-3f);
+  const Lights dim_lights(dim);
+  EXPECT_EQ(dim_lights.escaped_radiance(side), glm::vec3(1e-3f));
+  EXPECT_GT(dim_lights.pdf_escaped(side), 0.0f);
+  Scene sun = scene;
+  sun.sun = delta_sun.sun;
+  sun.sun.angular_radius = 0.1f;
+  const Lights sun_lights(sun);
+  EXPECT_GT(sun_lights.escaped_radiance(up).x, 0.0f);
+  EXPECT_GT(sun_lights.pdf_escaped(up), 0.0f);
+  EXPECT_EQ(sun_lights.escaped_radiance(side), glm::vec3(0.0f));
 }
 
 // Distribution2D: samples fall in cells in proportion to their weights, and the density it

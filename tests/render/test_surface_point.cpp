@@ -94,6 +94,63 @@ TEST(SurfacePoint, TheTriangleTableGivesThePerHitBits) {
   }
 }
 
+// Triangles whose three vertex normals are one vector take their shading normal from the table
+// (TriangleFacts::constant_shading_normal) instead of interpolating it: the same normal up to the
+// interpolation's rounding, on the same side, from the front and from behind. Four quads: normals
+// along the winding's normal, against it (the interpolating code turns those to the ray's side),
+// tilted by 30 degrees, and within 0.01 degrees of the plane (left to the interpolating code,
+// where its rounding could decide the side); the same quads with their normals differing in the
+// last bit of one vertex interpolate as before.
+TEST(SurfacePoint, ConstantVertexNormalsAreTheInterpolatedOnes) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  const glm::vec3 tilted = glm::normalize(glm::vec3(0.5f, 0.0f, 0.866f));
+  const glm::vec3 grazing = glm::normalize(glm::vec3(1.0f, 0.0f, 1.7e-4f));
+  const glm::vec3 normals[] = {glm::vec3(0.0f, 0.0f, 1.0f), glm::vec3(0.0f, 0.0f, -1.0f), tilted,
+                               grazing};
+  for (int copy = 0; copy < 2; ++copy) {
+    for (int k = 0; k < 4; ++k) {
+      // Quads in z = const planes, the winding's normal +z (make_quad: edge1 x edge2).
+      Mesh quad = make_quad(glm::vec3(-1.0f, -1.0f, -3.0f + 2.0f * k + 0.5f * copy),
+                            glm::vec3(2.0f, 0.0f, 0.0f), glm::vec3(0.0f, 2.0f, 0.0f));
+      for (glm::vec3& n : quad.normals) n = normals[k];
+      if (copy == 1) quad.normals[0].x = std::nextafter(quad.normals[0].x, 2.0f);
+      scene.meshes.push_back(quad);
+    }
+  }
+  const TriangleTable table(scene);
+  for (std::uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const bool constant = m < 4 && m != 3;  // not the grazing one, nor the last-bit copies
+    for (std::uint32_t t = 0; t < 2; ++t) {
+      ASSERT_NEAR(table.at(m, t).normal.z, 1.0f, 1e-6f) << m;
+      EXPECT_EQ(table.at(m, t).constant_shading_normal, constant ? 1u : 0u) << m << " " << t;
+    }
+  }
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> u(0.02f, 0.98f);
+  for (std::uint32_t m = 0; m < 4; ++m) {
+    for (const float side : {1.0f, -1.0f}) {  // the ray from above (behind the winding) or below
+      for (int k = 0; k < 200; ++k) {
+        Hit hit;
+        hit.mesh = m;
+        hit.triangle = static_cast<std::uint32_t>(k % 2);
+        hit.u = 0.5f * u(gen);
+        hit.v = 0.5f * u(gen);
+        Ray ray;
+        ray.origin = glm::vec3(0.0f, 0.0f, 10.0f * side);
+        ray.direction = glm::vec3(0.1f, -0.2f, -side);
+        const SurfacePoint a = make_surface_point(scene, table, ray, hit);
+        // The interpolating code: the same triangle with its normals one bit apart.
+        hit.mesh = m + 4;
+        const SurfacePoint b = make_surface_point(scene, table, ray, hit);
+        EXPECT_LT(glm::length(a.shading_normal - b.shading_normal), 1e-6f) << m << " " << side;
+        EXPECT_GT(glm::dot(a.shading_normal, a.geometric_normal), 0.0f) << m << " " << side;
+        EXPECT_TRUE(same_bits(a.geometric_normal, b.geometric_normal)) << m;
+      }
+    }
+  }
+}
+
 // next_float_up and next_float_down against std::nextafter: zeros, subnormals, the extremes,
 // infinities, NaN (compared as NaN) and a million random bit patterns.
 TEST(SurfacePoint, NextFloatIsStdNextafter) {
