@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -376,21 +377,33 @@ float PathTracer::first_bounce_mis_density(std::size_t i, const glm::vec3& direc
 
 void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays) {
   const bool nee = next_event_on_;
-  // The world guide's vertices at this depth: sampled from it, and recorded to train it.
-  const bool world_here = world_guide_ && depth <= world_depths_;
+  // The options that add work at a vertex beyond the first bounce's hit: guiding it (borrowed
+  // pixel mixtures or the world guide's cells), recording it for the world guide, the second
+  // vertex's shared random numbers. All off by default; the loop is compiled twice, and without
+  // them it holds none of their code (docs/host-path-tracer.md, "What a scene does not use,
+  // skipped").
+  // (The world guide at every depth: the vertex after its last recorded one adds the light found
+  // since to the record.)
+  const bool extras_on = settings_.guide_secondary || world_guide_ != nullptr ||
+                         (depth == 1 && settings_.shared_randoms == SharedRandoms::second_vertex);
   std::atomic<std::uint64_t> guided_vertices{0};
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
+  // extras: std::true_type or std::false_type, whether extras_on.
+  const auto shade_range = [&](auto extras, const auto& range) __attribute__((flatten)) {
+    constexpr bool kExtras = decltype(extras)::value;
+    const bool guide_secondary = kExtras && settings_.guide_secondary;
+    // The world guide's vertices at this depth: sampled from it, and recorded to train it.
+    const bool world_here = kExtras && world_guide_ && depth <= world_depths_;
     std::uint64_t guided_here = 0;
     // The pixel each of the next vertices projects to, found once where its entry is
     // prefetched.
     std::size_t borrow_from[kBorrowRing];
-    if (settings_.guide_secondary) {
+    if (guide_secondary) {
       for (std::size_t j = range.begin(); j < std::min(range.end(), range.begin() + kPrefetchAhead);
            ++j)
         borrow_from[j % kBorrowRing] = prefetch_borrowable(j);
     }
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
-      if (settings_.guide_secondary && j + kPrefetchAhead < range.end())
+      if (guide_secondary && j + kPrefetchAhead < range.end())
         borrow_from[(j + kPrefetchAhead) % kBorrowRing] = prefetch_borrowable(j + kPrefetchAhead);
       if (j + kPathPrefetchAhead < range.end()) prefetch_path(active_[j + kPathPrefetchAhead]);
       if (world_here && j + kPrefetchAhead < range.end() && hits_[j + kPrefetchAhead].valid()) {
@@ -403,7 +416,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       PathState& p = paths_[i];
       // The previous vertex's light sample is in the path's radiance now (the compaction added
       // it); what comes after is the light its bounce found.
-      if (world_guide_ && depth >= 2 && world_depth_[i] == depth - 1)
+      if (kExtras && world_guide_ && depth >= 2 && world_depth_[i] == depth - 1)
         world_vertices_[i * world_stride_ + (depth - 2)].radiance_before = p.radiance;
       const Ray ray = rays_[j];
       const Hit& hit = hits_[j];
@@ -467,7 +480,8 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       // it (SharedRandoms; `own` then moves past the numbers y draws).
       shared::pg_rng own;
       own.state = p.rng;
-      const bool shared_y = depth == 1 && settings_.shared_randoms == SharedRandoms::second_vertex;
+      const bool shared_y =
+          kExtras && depth == 1 && settings_.shared_randoms == SharedRandoms::second_vertex;
       shared::pg_rng rng = shared_y ? second_vertex_stream(i, own) : own;
       const shared::pg_frame frame = shared::pg_frame_from_normal(sp.shading_normal);
       const glm::vec3 wo = shared::pg_to_local(frame, -dir);
@@ -486,7 +500,7 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       const std::uint64_t cell = world_here && diffuse_enough
                                      ? world_guide_->cell_of(sp.position, sp.shading_normal)
                                      : WorldGuide::kNoCell;
-      const bool guided = (settings_.guide_secondary && diffuse_enough &&
+      const bool guided = (guide_secondary && diffuse_enough &&
                            borrow_guide(borrow_from[j % kBorrowRing], sp, guide)) ||
                           (cell != WorldGuide::kNoCell && world_guide_->guide(cell, guide));
       guided_here += guided;
@@ -596,6 +610,12 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       }
     }
     guided_vertices += guided_here;
+  };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
+    if (extras_on)
+      shade_range(std::true_type{}, range);
+    else
+      shade_range(std::false_type{}, range);
   });
   rays.guided_vertices += guided_vertices.load();
 }
