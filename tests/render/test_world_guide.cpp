@@ -1,5 +1,6 @@
 // The world-space guide of later path vertices (host/render/world_guide.h): its cells, its
-// training from samples, its table's growth and its determinism. Whole-image unbiasedness with
+// training from samples, its table's growth and its determinism, and what the path tracer
+// records for it. Whole-image unbiasedness with
 // it is checked in test_guiding_image.cpp (GuidingImage.UnbiasedWithTheWorldGuide*).
 #include <gtest/gtest.h>
 
@@ -9,7 +10,9 @@
 
 #include <tbb/global_control.h>
 
+#include "render/renderer.h"
 #include "render/world_guide.h"
+#include "scene/shapes.h"
 #include "rtpg/guiding_settings.h"
 #include "shared/rng.h"
 
@@ -138,6 +141,43 @@ TEST(WorldGuide, TrainsTheSameWhateverTheThreadCount) {
   const std::vector<float> one = train(1), many = train(4);
   ASSERT_EQ(one.size(), 3000u * 6u);
   EXPECT_EQ(one, many);
+}
+
+// A record's training sample weighs the light the path found after the vertex, not before
+// (host/render/path_tracer.cpp, radiance_before, which the vertex after the record writes). A
+// floor and a wall lit by a delta sun, no emitter and no sky: light arrives only through
+// next-event estimation. With 2 bounces and the world guide recording the first bounce's hit y,
+// what comes after y's bounce is the next vertex's emission, always 0: no cell learns a lobe,
+// and the next frame guides no vertex. With 3 bounces that vertex's light sample adds light
+// after y: cells learn and guide (the control that the first check is not vacuous).
+TEST(WorldGuide, RecordsWeighOnlyTheLightFoundAfterTheVertex) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  scene.materials.back().specular = 0.0f;
+  scene.meshes.push_back(make_quad({-2.0f, 0.0f, -2.0f}, {0.0f, 0.0f, 4.0f}, {4.0f, 0.0f, 0.0f}));
+  scene.meshes.push_back(make_quad({-2.0f, 0.0f, -1.0f}, {4.0f, 0.0f, 0.0f}, {0.0f, 3.0f, 0.0f}));
+  scene.sun.enabled = true;
+  scene.sun.direction = glm::normalize(glm::vec3(0.3f, 1.0f, 0.8f));
+  scene.sun.irradiance = glm::vec3(3.0f);
+  scene.sun.angular_radius = 0.0f;
+  scene.camera.view.position = glm::vec3(0.0f, 1.5f, 4.0f);
+  scene.camera.view.look_at = glm::vec3(0.0f, 0.5f, -1.0f);
+  const auto guided_in_second_frame = [&](int bounces) {
+    RenderSettings settings;
+    settings.width = 96;
+    settings.height = 64;
+    settings.seed = 3;
+    settings.path_tracer.max_bounces = bounces;
+    settings.world_guide = true;
+    settings.world_guide_settings.em = to_kernel_settings(GuidingSettings{});
+    settings.world_guide_settings.max_depth = 1;
+    Renderer renderer(scene, settings);
+    const FrameStats first = renderer.render_frame(0);
+    EXPECT_GT(first.extra.at("world_samples"), 100.0) << bounces;  // y was recorded
+    return renderer.render_frame(1).guided_vertices;
+  };
+  EXPECT_EQ(guided_in_second_frame(2), 0u);
+  EXPECT_GT(guided_in_second_frame(3), 20u);
 }
 
 }  // namespace
