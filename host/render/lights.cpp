@@ -99,7 +99,6 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
   selection_ = Distribution1D(kinds);
   triangles_only_ =
       kinds[kTriangles] > 0.0f && !(kinds[kSun] > 0.0f) && !(kinds[kEnvironment] > 0.0f);
-  triangles_only_probability_ = selection_.probability(kTriangles);
   // escaped_radiance and pdf_escaped are 0 without an environment (none, a map that did not
   // load, or a black constant, whose selection probability is 0 too) and without a sun of finite
   // size (a delta sun is only ever sampled, never found).
@@ -175,7 +174,7 @@ bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2,
   // them: its probability (1) and u.
   if (triangles_only_)
     return sample_triangle(p, Distribution1D::remap_in_only_cell(u_select),
-                           triangles_only_probability_, u1, u2, out);
+                           selection_.probability(kTriangles), u1, u2, out);
   if (empty()) return false;
   float p_kind = 0.0f;
   const std::size_t kind = selection_.sample_discrete(u_select, &p_kind);

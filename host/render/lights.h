@@ -75,7 +75,6 @@ class Lights {
   // skipped"): the choice of a kind where emissive triangles are the only one, and the sky's
   // radiance and density where there is neither an environment nor a sun of finite size.
   bool triangles_only_ = false;
-  float triangles_only_probability_ = 0.0f;  // selection_.probability(kTriangles): 1
   bool has_sky_ = true;
   glm::vec3 sun_axis_{0, 1, 0};  // normalize(scene.sun.direction), once: every escaped ray asks
   glm::vec3 sun_frame_t_{1, 0, 0}, sun_frame_b_{0, 1, 0};

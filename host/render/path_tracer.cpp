@@ -378,12 +378,10 @@ float PathTracer::first_bounce_mis_density(std::size_t i, const glm::vec3& direc
 void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays) {
   const bool nee = next_event_on_;
   // The options that add work at a vertex beyond the first bounce's hit: guiding it (borrowed
-  // pixel mixtures or the world guide's cells), recording it for the world guide, the second
-  // vertex's shared random numbers. All off by default; the loop is compiled twice, and without
-  // them it holds none of their code (docs/host-path-tracer.md, "What a scene does not use,
-  // skipped").
-  // (The world guide at every depth: the vertex after its last recorded one adds the light found
-  // since to the record.)
+  // pixel mixtures or the world guide's cells), recording it for the world guide (at every
+  // depth: the vertex after the last recorded one completes that record), the second vertex's
+  // shared random numbers. All off by default; the loop is compiled twice, and without them it
+  // holds none of their code (docs/host-path-tracer.md, "What a scene does not use, skipped").
   const bool extras_on = settings_.guide_secondary || world_guide_ != nullptr ||
                          (depth == 1 && settings_.shared_randoms == SharedRandoms::second_vertex);
   std::atomic<std::uint64_t> guided_vertices{0};
