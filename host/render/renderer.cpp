@@ -214,6 +214,12 @@ FrameStats Renderer::render_frame(int index) {
     // the image before the loop (docs/host-path-tracer.md, "Empty shadow rays skipped;
     // per-frame fills").
     const bool first_sample = s == 0;
+    if (settings_.spp == 1) {
+      // One sample: the pass is the image (x * 1 + 0 is x), so the buffers trade places.
+      image_.swap(pass_);
+      stats.time_ms["accumulate"] += ms_since(t);
+      continue;
+    }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         const glm::vec3 sum = first_sample ? glm::vec3(0.0f) : image_[i];
