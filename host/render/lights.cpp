@@ -18,6 +18,50 @@ float luminance(const glm::vec3& c) {
 
 }  // namespace
 
+bool Lights::parallelogram_of(const glm::uvec3& a, const glm::uvec3& b,
+                              const std::vector<glm::vec3>& positions, const glm::vec3& normal,
+                              EmissiveTriangle& out) {
+  // Triangle b shares two corners (a diagonal) with triangle a; the corners off it, o_a and
+  // o_b, then make a parallelogram with it where the diagonals bisect each other:
+  // o_a + o_b = s1 + s2.
+  const std::uint32_t ia[3] = {a.x, a.y, a.z}, ib[3] = {b.x, b.y, b.z};
+  int shared = 0, off_a = -1, off_b = -1;
+  for (int i = 0; i < 3; ++i) {
+    bool in_b = false;
+    for (int j = 0; j < 3; ++j) in_b = in_b || ia[i] == ib[j];
+    if (in_b) {
+      ++shared;
+    } else {
+      off_a = i;
+    }
+  }
+  for (int j = 0; j < 3; ++j) {
+    bool in_a = false;
+    for (int i = 0; i < 3; ++i) in_a = in_a || ib[j] == ia[i];
+    if (!in_a) off_b = j;
+  }
+  if (shared != 2 || off_a < 0 || off_b < 0) return false;
+  const glm::vec3 o = positions[ia[off_a]], q = positions[ib[off_b]];
+  const glm::vec3 s1 = positions[ia[(off_a + 1) % 3]], s2 = positions[ia[(off_a + 2) % 3]];
+  glm::vec3 e1 = s1 - o, e2 = s2 - o;
+  const float size = glm::length(e1) + glm::length(e2);
+  if (!(glm::length(o + q - s1 - s2) <= 1e-6f * size)) return false;
+  // Triangle b must face the way a does (emitters are one-sided) and have its area.
+  const glm::vec3 cb =
+      glm::cross(positions[ib[1]] - positions[ib[0]], positions[ib[2]] - positions[ib[0]]);
+  const float area_b = 0.5f * glm::length(cb);
+  if (!(area_b > 0.0f) || !(glm::dot(cb / (2.0f * area_b), normal) > 0.99999f)) return false;
+  // a's winding from o is (o, s1, s2): cross(e1, e2) is a's normal, as sampling assumes.
+  const glm::vec3 c = glm::cross(e1, e2);
+  if (glm::dot(c, normal) < 0.0f) std::swap(e1, e2);
+  out.p0 = o;
+  out.e1 = e1;
+  out.e2 = e2;
+  out.area = glm::length(c);
+  out.parallelogram = true;
+  return true;
+}
+
 void set_shadow_ray(Ray& r, const glm::vec3& origin, const LightSample& sample) {
   set_ray(r, origin, sample.direction, 0.0f,
           std::isinf(sample.distance) ? kInfinity : sample.distance * (1.0f - 1e-4f));
@@ -30,7 +74,11 @@ Ray shadow_ray(const glm::vec3& origin, const LightSample& sample) {
 }
 
 Lights::Lights(const Scene& scene) : scene_(scene) {
-  // Emissive triangles, weighted by their emitted power (area * luminance of Le).
+  // Emissive triangles, weighted by their emitted power (area * luminance of Le). Two
+  // consecutive triangles of a mesh that form a parallelogram (a quad light, scene/shapes.h, or
+  // an OBJ quad) become one emitter, sampled without the triangle's square root and without a
+  // choice between the two: the same density, half the light choices (docs/host-path-tracer.md,
+  // "Quad lights sampled as parallelograms").
   std::vector<float> weights;
   triangle_index_.resize(scene.meshes.size());
   for (std::size_t m = 0; m < scene.meshes.size(); ++m) {
@@ -38,7 +86,7 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
     const Material& mat = scene.materials[mesh.material];
     if (!mat.is_emissive()) continue;
     triangle_index_[m].assign(mesh.triangles.size(), -1);
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto emitter = [&](std::size_t t) {
       const glm::uvec3 tri = mesh.triangles[t];
       EmissiveTriangle e;
       e.p0 = mesh.positions[tri.x];
@@ -46,10 +94,22 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
       e.e2 = mesh.positions[tri.z] - e.p0;
       const glm::vec3 c = glm::cross(e.e1, e.e2);
       e.area = 0.5f * glm::length(c);
-      if (!(e.area > 0.0f)) continue;
-      e.normal = glm::normalize(c);
+      e.normal = e.area > 0.0f ? glm::normalize(c) : glm::vec3(0.0f);
       e.radiance = mat.emission;
+      return e;
+    };
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      EmissiveTriangle e = emitter(t);
+      if (!(e.area > 0.0f)) continue;
+      const bool pair =
+          t + 1 < mesh.triangles.size() &&
+          parallelogram_of(mesh.triangles[t], mesh.triangles[t + 1], mesh.positions, e.normal, e);
       triangle_index_[m][t] = static_cast<std::int32_t>(triangles_.size());
+      if (pair) {
+        triangle_index_[m][t + 1] = static_cast<std::int32_t>(triangles_.size());
+        ++parallelograms_;
+        ++t;
+      }
       triangles_.push_back(e);
       weights.push_back(e.area * luminance(e.radiance));
     }
@@ -149,10 +209,15 @@ inline bool Lights::sample_triangle(const glm::vec3& p, float u_triangle, float 
   float p_tri = 0.0f;
   const std::size_t i = triangle_selection_.sample_discrete(u_triangle, &p_tri);
   const EmissiveTriangle& e = triangles_[i];
-  // Uniform point on the triangle (pbrt's square-root parameterisation).
-  const float su = std::sqrt(u1);
-  const float b1 = u2 * su;
-  const glm::vec3 y = e.p0 + e.e1 * (1.0f - su) + e.e2 * b1;
+  glm::vec3 y;
+  if (e.parallelogram) {
+    y = e.p0 + e.e1 * u1 + e.e2 * u2;
+  } else {
+    // Uniform point on the triangle (pbrt's square-root parameterisation).
+    const float su = std::sqrt(u1);
+    const float b1 = u2 * su;
+    y = e.p0 + e.e1 * (1.0f - su) + e.e2 * b1;
+  }
   const glm::vec3 to = y - p;
   const float d2 = glm::dot(to, to);
   if (!(d2 > 0.0f)) return false;

@@ -1,5 +1,6 @@
 // Light sampling for next-event estimation and the densities MIS needs when a BSDF-sampled
-// ray finds a light by itself: emissive triangles (chosen by power, uniform by area), the sun
+// ray finds a light by itself: emissive triangles (chosen by power, uniform by area; two that
+// make a parallelogram, as a quad light's do, sampled as one), the sun
 // (a cone of finite angular radius, or a delta direction) and the environment (constant, or
 // an equirectangular map sampled by luminance times sin(theta)).
 #pragma once
@@ -46,17 +47,28 @@ class Lights {
   glm::vec3 escaped_radiance(const glm::vec3& direction) const;
   float pdf_escaped(const glm::vec3& direction) const;
 
-  std::size_t emissive_triangle_count() const { return triangles_.size(); }
+  // The emitters light sampling chooses from: each emissive triangle, or two of them as one
+  // parallelogram (docs/host-path-tracer.md, "Quad lights sampled as parallelograms").
+  std::size_t emitter_count() const { return triangles_.size(); }
+  std::size_t parallelogram_count() const { return parallelograms_; }
 
  private:
+  // An emissive triangle (p0, p0 + e1, p0 + e2), or the parallelogram p0 + s e1 + t e2 of two
+  // triangles of one mesh that share its diagonal p0 + e1, p0 + e2.
   struct EmissiveTriangle {
     glm::vec3 p0, e1, e2;
     glm::vec3 normal;  // unit, front side
     float area;
     glm::vec3 radiance;
+    bool parallelogram = false;
   };
   enum Kind : std::size_t { kTriangles = 0, kSun = 1, kEnvironment = 2 };
 
+  // Whether triangles a and b (of one mesh, a's unit normal `normal`) make a parallelogram;
+  // if so, `out` becomes it (its corner, edges and area; out's other fields are left).
+  static bool parallelogram_of(const glm::uvec3& a, const glm::uvec3& b,
+                               const std::vector<glm::vec3>& positions, const glm::vec3& normal,
+                               EmissiveTriangle& out);
   // Inline in both callers: where triangles are the only lights, sample is little more than it.
   [[gnu::always_inline]] inline bool sample_triangle(const glm::vec3& p, float u_triangle,
                                                      float p_kind, float u1, float u2,
@@ -68,6 +80,7 @@ class Lights {
 
   const Scene& scene_;
   std::vector<EmissiveTriangle> triangles_;
+  std::size_t parallelograms_ = 0;
   std::vector<std::vector<std::int32_t>> triangle_index_;  // [mesh][triangle] -> light or -1
   Distribution1D triangle_selection_;
   Distribution1D selection_;  // over Kind

@@ -191,7 +191,8 @@ TEST(Lights, EmissiveTrianglesMatchTheirDensity) {
   scene.meshes.push_back(small);
   scene.meshes.push_back(away);
   const Lights lights(scene);
-  ASSERT_EQ(lights.emissive_triangle_count(), 6u);
+  ASSERT_EQ(lights.emitter_count(), 3u);  // three quads, each one parallelogram
+  ASSERT_EQ(lights.parallelogram_count(), 3u);
   const glm::vec3 p(0.1f, 0.3f, 0.1f);
   // Which way each emitter faces, from the test's own geometry.
   auto facing_p = [&](const TriangleHit& h) {
@@ -229,6 +230,75 @@ TEST(Lights, EmissiveTrianglesMatchTheirDensity) {
   const auto wrong = test::chi_square_test(
       sampler, [&](const glm::vec3& d) { return pdf(d) * 1.05; }, kSamples / 4, 40, 80, 12);
   EXPECT_LT(wrong.p_value, 1e-6) << wrong.describe();
+}
+
+// Two triangles of a mesh that make a parallelogram are one emitter (Lights::parallelogram_of),
+// whichever diagonal they share and in whichever order their corners come; a kite, a second
+// triangle facing the other way, or two triangles apart stay two emitters. The parallelogram's
+// samples land on the quad, in its two halves equally often, each with the density
+// pdf_triangle gives the direction through either triangle.
+TEST(Lights, QuadLightsAreSampledAsOneParallelogram) {
+  Material lamp;
+  lamp.emission = glm::vec3(2.0f);
+  const glm::vec3 c(-0.5f, 1.0f, -0.5f), e1(1.0f, 0.0f, 0.0f), e2(0.0f, 0.0f, 1.0f);
+  // Corners 0..3 of a quad facing down (cross(e1, e2) = -y), or 3 moved off it (a kite).
+  const auto lamp_scene = [&](std::vector<glm::uvec3> triangles, bool kite) {
+    Scene scene = floor_scene();
+    scene.materials.push_back(lamp);
+    Mesh mesh;
+    mesh.positions = {c, c + e1, c + e1 + e2, kite ? c + 1.3f * e2 : c + e2};
+    mesh.triangles = std::move(triangles);
+    mesh.material = 1;
+    scene.meshes.push_back(mesh);
+    return scene;
+  };
+  struct Case {
+    const char* name;
+    std::vector<glm::uvec3> triangles;
+    bool kite;
+    std::size_t emitters, parallelograms;
+  };
+  const std::vector<Case> cases = {
+      {"diagonal 0-2", {{0, 1, 2}, {0, 2, 3}}, false, 1, 1},
+      {"diagonal 1-3", {{0, 1, 3}, {1, 2, 3}}, false, 1, 1},
+      {"corners rotated", {{2, 0, 1}, {3, 0, 2}}, false, 1, 1},
+      {"kite", {{0, 1, 2}, {0, 2, 3}}, true, 2, 0},
+      {"second faces up", {{0, 1, 2}, {0, 3, 2}}, false, 2, 0},
+      {"no shared diagonal", {{0, 1, 2}, {1, 2, 1}}, false, 1, 0},  // the second has no area
+  };
+  const glm::vec3 p(0.1f, 0.2f, -0.05f);
+  for (const Case& k : cases) {
+    const Scene scene = lamp_scene(k.triangles, k.kite);
+    const Lights lights(scene);
+    EXPECT_EQ(lights.emitter_count(), k.emitters) << k.name;
+    EXPECT_EQ(lights.parallelogram_count(), k.parallelograms) << k.name;
+    if (k.parallelograms == 0) continue;
+    // Samples on the quad (y = 1, inside its square), half in the first triangle (below the
+    // diagonal it shares: z < x, or x + z < 0 for the diagonal 1-3), each with the density
+    // pdf_triangle gives through either triangle.
+    std::size_t in_first = 0, samples = 0;
+    for (std::size_t i = 0; i < 20000; ++i) {
+      shared::pg_rng rng = shared::pg_rng_make(3u, static_cast<shared::uint>(i), 0u, 0u, 5u);
+      const float a = shared::pg_rng_next(&rng), b = shared::pg_rng_next(&rng),
+                  d = shared::pg_rng_next(&rng);
+      LightSample s;
+      ASSERT_TRUE(lights.sample(p, a, b, d, s)) << k.name;
+      const glm::vec3 y = p + s.direction * s.distance;
+      ASSERT_NEAR(y.y, 1.0f, 1e-5f) << k.name;
+      ASSERT_GE(y.x, -0.5f - 1e-5f);
+      ASSERT_LE(y.x, 0.5f + 1e-5f);
+      ASSERT_GE(y.z, -0.5f - 1e-5f);
+      ASSERT_LE(y.z, 0.5f + 1e-5f);
+      for (std::uint32_t t = 0; t < 2; ++t)
+        ASSERT_NEAR(lights.pdf_triangle(1, t, p, y, glm::vec3(0, -1, 0)), s.pdf, 1e-4f * s.pdf)
+            << k.name << " triangle " << t;
+      ++samples;
+      const bool first = k.triangles[0] == glm::uvec3(0, 1, 3) ? y.x + y.z < 0.0f : y.z < y.x;
+      in_first += first ? 1 : 0;
+    }
+    // Binomial(20000, 1/2): 5 standard deviations are 354.
+    EXPECT_NEAR(static_cast<double>(in_first), samples / 2.0, 354.0) << k.name;
+  }
 }
 
 // Distribution1D::sample_discrete on a fine uniform grid of u: each cell takes its share of the
