@@ -25,25 +25,22 @@ bool Lights::parallelogram_of(const glm::uvec3& a, const glm::uvec3& b,
   // o_b, then make a parallelogram with it where the diagonals bisect each other:
   // o_a + o_b = s1 + s2.
   const std::uint32_t ia[3] = {a.x, a.y, a.z}, ib[3] = {b.x, b.y, b.z};
-  int shared = 0, off_a = -1, off_b = -1;
-  for (int i = 0; i < 3; ++i) {
-    bool in_b = false;
-    for (int j = 0; j < 3; ++j) in_b = in_b || ia[i] == ib[j];
-    if (in_b) {
-      ++shared;
-    } else {
-      off_a = i;
+  // The one corner of x that y lacks (-1: none, or more than one).
+  const auto off = [](const std::uint32_t* x, const std::uint32_t* y) {
+    int found = -1, count = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (x[i] != y[0] && x[i] != y[1] && x[i] != y[2]) {
+        found = i;
+        ++count;
+      }
     }
-  }
-  for (int j = 0; j < 3; ++j) {
-    bool in_a = false;
-    for (int i = 0; i < 3; ++i) in_a = in_a || ib[j] == ia[i];
-    if (!in_a) off_b = j;
-  }
-  if (shared != 2 || off_a < 0 || off_b < 0) return false;
+    return count == 1 ? found : -1;
+  };
+  const int off_a = off(ia, ib), off_b = off(ib, ia);
+  if (off_a < 0 || off_b < 0) return false;
   const glm::vec3 o = positions[ia[off_a]], q = positions[ib[off_b]];
   const glm::vec3 s1 = positions[ia[(off_a + 1) % 3]], s2 = positions[ia[(off_a + 2) % 3]];
-  glm::vec3 e1 = s1 - o, e2 = s2 - o;
+  const glm::vec3 e1 = s1 - o, e2 = s2 - o;
   const float size = glm::length(e1) + glm::length(e2);
   if (!(glm::length(o + q - s1 - s2) <= 1e-6f * size)) return false;
   // Triangle b must face the way a does (emitters are one-sided) and have its area.
@@ -51,9 +48,8 @@ bool Lights::parallelogram_of(const glm::uvec3& a, const glm::uvec3& b,
       glm::cross(positions[ib[1]] - positions[ib[0]], positions[ib[2]] - positions[ib[0]]);
   const float area_b = 0.5f * glm::length(cb);
   if (!(area_b > 0.0f) || !(glm::dot(cb / (2.0f * area_b), normal) > 0.99999f)) return false;
-  // a's winding from o is (o, s1, s2): cross(e1, e2) is a's normal, as sampling assumes.
+  // (o, s1, s2) is a's winding turned: cross(e1, e2) points along a's normal, the emitter's front.
   const glm::vec3 c = glm::cross(e1, e2);
-  if (glm::dot(c, normal) < 0.0f) std::swap(e1, e2);
   out.p0 = o;
   out.e1 = e1;
   out.e2 = e2;
@@ -86,7 +82,7 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
     const Material& mat = scene.materials[mesh.material];
     if (!mat.is_emissive()) continue;
     triangle_index_[m].assign(mesh.triangles.size(), -1);
-    const auto emitter = [&](std::size_t t) {
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       const glm::uvec3 tri = mesh.triangles[t];
       EmissiveTriangle e;
       e.p0 = mesh.positions[tri.x];
@@ -94,13 +90,9 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
       e.e2 = mesh.positions[tri.z] - e.p0;
       const glm::vec3 c = glm::cross(e.e1, e.e2);
       e.area = 0.5f * glm::length(c);
-      e.normal = e.area > 0.0f ? glm::normalize(c) : glm::vec3(0.0f);
-      e.radiance = mat.emission;
-      return e;
-    };
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-      EmissiveTriangle e = emitter(t);
       if (!(e.area > 0.0f)) continue;
+      e.normal = glm::normalize(c);
+      e.radiance = mat.emission;
       const bool pair =
           t + 1 < mesh.triangles.size() &&
           parallelogram_of(mesh.triangles[t], mesh.triangles[t + 1], mesh.positions, e.normal, e);

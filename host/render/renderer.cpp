@@ -209,17 +209,17 @@ FrameStats Renderer::render_frame(int index) {
     path_tracer_->trace(gbuffer, source, *sampler_, at, pass_, keep_vpls ? &vpls_ : nullptr,
                         stats.nonfinite_samples, rays, times);
     t = Clock::now();
-    const float weight = 1.0f / static_cast<float>(settings_.spp);
-    // The first sample starts the sum from zero here, in parallel, instead of a serial fill of
-    // the image before the loop (docs/host-path-tracer.md, "Empty shadow rays skipped;
-    // per-frame fills").
-    const bool first_sample = s == 0;
     if (settings_.spp == 1) {
       // One sample: the pass is the image (x * 1 + 0 is x), so the buffers trade places.
       image_.swap(pass_);
       stats.time_ms["accumulate"] += ms_since(t);
       continue;
     }
+    const float weight = 1.0f / static_cast<float>(settings_.spp);
+    // The first sample starts the sum from zero here, in parallel, instead of a serial fill of
+    // the image before the loop (docs/host-path-tracer.md, "Empty shadow rays skipped;
+    // per-frame fills").
+    const bool first_sample = s == 0;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
         const glm::vec3 sum = first_sample ? glm::vec3(0.0f) : image_[i];
