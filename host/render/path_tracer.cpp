@@ -170,7 +170,9 @@ void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
   }
   shadow_rays_.resize(n);
   shadow_contribution_.resize(n);
-  has_shadow_.resize(n);
+  shadow_path_.resize(n);
+  occluded_.resize(n);
+  shadow_counts_.resize((n + kShadowBlock - 1) / kShadowBlock);
   rays_.resize(n);
   hits_.resize(n);
   alive_.assign(n, 0);
@@ -234,13 +236,19 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
   const bool mis_with_bsdf =
       settings_.first_bounce_mis == FirstBounceMis::bsdf && !sampler.samples_the_bsdf();
   const SampleCoordinates first_at = first_bounce_coordinates(at, settings_.shared_randoms);
+  static_assert(kShadowBlock == kGrain, "a block of pixels is one chunk of stream starts");
+  const std::size_t n = g.pixel_count();
   tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, g.pixel_count(), kGrain), [&](const auto& range) {
+      tbb::blocked_range<std::size_t>(0, (n + kShadowBlock - 1) / kShadowBlock),
+      [&](const auto& blocks) {
         // The pixels' path streams (and first-bounce streams where the BSDF's first bounce is
-        // drawn here) started in vector lanes, a chunk at a time (render/stream_starts.h).
+        // drawn here) started in vector lanes, a block at a time (render/stream_starts.h).
         std::uint32_t path_starts[kGrain], first_starts[kGrain];
-        for (std::size_t chunk = range.begin(); chunk < range.end(); chunk += kGrain) {
-          const std::size_t chunk_end = std::min(range.end(), chunk + kGrain);
+        for (std::size_t block = blocks.begin(); block != blocks.end(); ++block) {
+          const std::size_t chunk = block * kShadowBlock;
+          const std::size_t chunk_end = std::min(n, chunk + kShadowBlock);
+          // The block's shadow rays, listed from its first slot (kShadowBlock).
+          std::uint32_t shadows = 0;
           if (starts)
             make_stream_starts({at.seed, at.frame, at.sample, PG_RNG_STREAM_PATH}, chunk,
                                chunk_end - chunk, path_starts);
@@ -259,8 +267,6 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
               } else {
                 p.radiance = glm::vec3(g.emission[i]);
               }
-              shadow_rays_[i] = inactive_ray();
-              has_shadow_[i] = 0;
               rays_[i] = inactive_ray();
               alive_[i] = 0;
             }
@@ -299,10 +305,12 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
               };
               // next_event writes the shadow ray in place only where it returns true.
               glm::vec3 c;
+              const std::size_t entry = chunk + shadows;
               if (next_event_on_ && next_event(x0, ng, frame, wo, lobes, origin, u_sel, u1, u2,
-                                               first_bounce_pdf, c, shadow_rays_[i])) {
-                shadow_contribution_[i] = c;
-                has_shadow_[i] = 1;
+                                               first_bounce_pdf, c, shadow_rays_[entry])) {
+                shadow_contribution_[entry] = c;
+                shadow_path_[entry] = static_cast<std::uint32_t>(i);
+                ++shadows;
               }
               // The first bounce draws nothing from this stream: the path goes on from here.
               p.rng = rng.state;
@@ -350,6 +358,7 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
               }
             }
           }
+          if (starts) shadow_counts_[block] = shadows;
         }
       });
 }
@@ -392,6 +401,8 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
     // The world guide's vertices at this depth: sampled from it, and recorded to train it.
     const bool world_here = kExtras && world_guide_ && depth <= world_depths_;
     std::uint64_t guided_here = 0;
+    // The block's shadow rays, listed from its first slot (kShadowBlock).
+    std::uint32_t shadows = 0;
     // The pixel each of the next vertices projects to, found once where its entry is
     // prefetched.
     std::size_t borrow_from[kBorrowRing];
@@ -418,8 +429,6 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         world_vertices_[i * world_stride_ + (depth - 2)].radiance_before = p.radiance;
       const Ray ray = rays_[j];
       const Hit& hit = hits_[j];
-      shadow_rays_[j] = inactive_ray();
-      has_shadow_[j] = 0;
       alive_[j] = 0;
       const glm::vec3 dir = glm::normalize(ray.direction);
       // The density the light found here weighs itself with against a light sample.
@@ -514,10 +523,12 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         return mis_with_bsdf ? bsdf_mis_density(bsdf) : guide_density(guide, w, bsdf);
       };
       glm::vec3 c;
+      const std::size_t entry = range.begin() + shadows;
       if (nee && next_event(sp.position, sp.geometric_normal, frame, wo, lobes, origin, u_sel, u1,
-                            u2, vertex_pdf, c, shadow_rays_[j])) {
-        shadow_contribution_[j] = p.throughput * c;
-        has_shadow_[j] = 1;
+                            u2, vertex_pdf, c, shadow_rays_[entry])) {
+        shadow_contribution_[entry] = p.throughput * c;
+        shadow_path_[entry] = i;
+        ++shadows;
       }
 
       const float u_lobe = shared::pg_rng_next(&rng), v1 = shared::pg_rng_next(&rng),
@@ -608,13 +619,20 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       }
     }
     guided_vertices += guided_here;
+    shadow_counts_[range.begin() / kShadowBlock] = shadows;
   };
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, kGrain), [&](const auto& range) {
-    if (extras_on)
-      shade_range(std::true_type{}, range);
-    else
-      shade_range(std::false_type{}, range);
-  });
+  // Blocks of kShadowBlock slots, each with its list of shadow rays.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (m + kShadowBlock - 1) / kShadowBlock),
+                    [&](const auto& blocks) {
+                      for (std::size_t b = blocks.begin(); b != blocks.end(); ++b) {
+                        const tbb::blocked_range<std::size_t> range(
+                            b * kShadowBlock, std::min(m, (b + 1) * kShadowBlock));
+                        if (extras_on)
+                          shade_range(std::true_type{}, range);
+                        else
+                          shade_range(std::false_type{}, range);
+                      }
+                    });
   rays.guided_vertices += guided_vertices.load();
 }
 
@@ -685,9 +703,9 @@ bool PathTracer::borrow_guide(std::size_t i, const SurfacePoint& sp, PixelGuide&
 
 void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times) {
   const auto start = Clock::now();
-  occluded_.resize(count);
-  // Slots without a shadow ray (inactive_ray()) are skipped, not queried, and not counted.
-  rays.shadow += tracer_.occluded(shadow_rays_.data(), occluded_.data(), count, kShadowRayMode);
+  rays.shadow += tracer_.occluded_lists(shadow_rays_.data(), occluded_.data(), kShadowBlock,
+                                        shadow_counts_.data(),
+                                        (count + kShadowBlock - 1) / kShadowBlock, kShadowRayMode);
   times.trace_ms += ms_since(start);
 }
 
@@ -695,10 +713,11 @@ void PathTracer::apply_shadow_rays_and_compact(std::size_t count,
                                                const std::vector<std::uint32_t>* owners) {
   // A parallel prefix sum of the alive flags gives each survivor its slot, in the serial
   // order (so the frame is the same whatever the thread count); rays move to a second buffer,
-  // as an in-place parallel move could overwrite a ray before it is read. The same pass over
-  // the slots adds each unoccluded shadow ray's contribution to its path (every slot belongs
-  // to a different path: no two iterations touch one PathState), so the slots' owners, flags
-  // and shadow results are read once (docs/host-path-tracer.md, "One pass after each vertex").
+  // as an in-place parallel move could overwrite a ray before it is read. The same pass, block
+  // by block, adds each unoccluded shadow ray of the block's list to its path (a path has one
+  // slot and so at most one entry: no two iterations touch one PathState;
+  // docs/host-path-tracer.md, "One pass after each vertex", "Shadow rays listed where they are
+  // made").
   slot_.resize(count);
   const std::size_t alive = tbb::parallel_scan(
       tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
@@ -712,21 +731,26 @@ void PathTracer::apply_shadow_rays_and_compact(std::size_t count,
       std::plus<std::size_t>());
   next_active_.resize(alive);
   next_rays_.resize(rays_.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
-    for (std::size_t j = range.begin(); j != range.end(); ++j) {
-      const std::uint32_t owner = owners ? (*owners)[j] : static_cast<std::uint32_t>(j);
-      if (has_shadow_[j] && !occluded_[j]) {
-        // At x0 (no owners) a path kept from y (VplPath) adds it to what the pixel found
-        // before y.
-        if (keep_vpls_ && !owners) {
-          vpl_paths_[owner].before_y += shadow_contribution_[j];
+  // At x0 (no owners) a path kept from y (VplPath) adds its light sample to what the pixel
+  // found before y.
+  const bool to_before_y = keep_vpls_ && !owners;
+  const std::size_t blocks = (count + kShadowBlock - 1) / kShadowBlock;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks), [&](const auto& range) {
+    for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      const std::size_t first = b * kShadowBlock, entries_end = first + shadow_counts_[b];
+      for (std::size_t e = first; e != entries_end; ++e) {
+        if (occluded_[e]) continue;
+        if (to_before_y) {
+          vpl_paths_[shadow_path_[e]].before_y += shadow_contribution_[e];
         } else {
-          paths_[owner].radiance += shadow_contribution_[j];
+          paths_[shadow_path_[e]].radiance += shadow_contribution_[e];
         }
       }
-      if (alive_[j]) {
+      const std::size_t end = std::min(count, first + kShadowBlock);
+      for (std::size_t j = first; j != end; ++j) {
+        if (!alive_[j]) continue;
         next_rays_[slot_[j]] = rays_[j];
-        next_active_[slot_[j]] = owner;
+        next_active_[slot_[j]] = owners ? (*owners)[j] : static_cast<std::uint32_t>(j);
       }
     }
   });

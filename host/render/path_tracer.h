@@ -186,6 +186,7 @@ class PathTracer {
                   const shared::pg_frame& frame, const glm::vec3& wo, const shared::pg_lobes& lobes,
                   const glm::vec3& origin, float u_select, float u1, float u2,
                   const CompetingPdf& competing_pdf, glm::vec3& contribution, Ray& shadow) const;
+  // The shadow rays of a pass over `count` slots (the blocks' lists).
   void run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times);
   // Adds each unoccluded shadow ray's contribution to its path (to the pixel's before_y at
   // x0, owners null, where VPLs are kept), and keeps the rays of the paths still alive at the
@@ -254,13 +255,20 @@ class PathTracer {
   std::vector<std::uint32_t> slot_;  // apply_shadow_rays_and_compact(): each survivor's new slot
   std::vector<Ray> next_rays_;       // the same: the survivors' rays, then swapped in
   std::vector<std::uint8_t> alive_;  // per slot: the path goes on after this vertex
-  std::vector<Ray> rays_, shadow_rays_;
+  std::vector<Ray> rays_;
   std::vector<Hit> hits_;
-  std::vector<std::uint8_t> occluded_;
-  std::vector<std::uint8_t> has_shadow_;  // per slot: 1 where shadow_rays_ holds a segment
-  // Per slot with a shadow segment: what it adds to its path's radiance if unoccluded.
+  // The vertices' shadow rays, listed where they are made: the slots of a pass fall into blocks
+  // of kShadowBlock, and block b's shadow rays are entries b * kShadowBlock onwards, in slot
+  // order, shadow_counts_[b] of them (so a slot without one costs nothing after next-event
+  // estimation; docs/host-path-tracer.md, "Shadow rays listed where they are made"). Per entry:
+  // the ray, what it adds to its path's radiance if unoccluded, the path, and Embree's answer.
+  static constexpr std::size_t kShadowBlock = 2048;
+  std::vector<Ray> shadow_rays_;
   std::vector<glm::vec3> shadow_contribution_;
-  std::vector<BorrowablePixel> borrowable_;  // per pixel, with guide_secondary
+  std::vector<std::uint32_t> shadow_path_;
+  std::vector<std::uint8_t> occluded_;
+  std::vector<std::uint32_t> shadow_counts_;  // per block
+  std::vector<BorrowablePixel> borrowable_;   // per pixel, with guide_secondary
 
   // The world guide (set_world_guide) and what a path records for it at each later vertex that
   // sampled a bounce: the bounce's training sample without its weight, the path's throughput

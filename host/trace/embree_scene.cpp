@@ -319,84 +319,104 @@ void EmbreeScene::intersect_image(const Ray* rays, Hit* hits, int width, int hei
       });
 }
 
+namespace {
+
+// EmbreeScene::occluded for the span rays[0..count) on the calling thread: the rays queried.
+// A ray with an empty segment gets 0 without a query: many of the path tracer's shadow slots
+// held no ray (no light sampled, or one behind the surface: half of them on the Cornell box),
+// and asking Embree about them cost a call and a root-node test each (docs/host-path-tracer.md,
+// "Empty shadow rays skipped; per-frame fills").
+std::size_t occluded_span(RTCScene scene, const Ray* rays, std::uint8_t* occluded,
+                          std::size_t count, RayMode mode) {
+  const auto has_segment = [&](std::size_t i) { return rays[i].tmin <= rays[i].tmax; };
+  std::size_t queried = 0;
+  if (mode == RayMode::Stream) {
+    RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    alignas(64) RTCRay chunk[kStreamChunk];
+    std::uint32_t slot[kStreamChunk];
+    std::size_t i = 0;
+    while (i < count) {
+      unsigned int n = 0;
+      // Without a branch: every slot is written at chunk[n], and n moves on only past a
+      // segment (whether a slot has one is a coin toss on most scenes, which a branch
+      // mispredicts; docs/host-path-tracer.md, "Rays written in place").
+      for (; i < count && n < kStreamChunk; ++i) {
+        occluded[i] = 0;
+        to_embree(rays[i], chunk[n]);
+        slot[n] = static_cast<std::uint32_t>(i);
+        n += has_segment(i) ? 1u : 0u;
+      }
+      if (n == 0) continue;
+      rtcOccluded1M(scene, &context, chunk, n, sizeof(RTCRay));
+      for (unsigned int k = 0; k < n; ++k)
+        occluded[slot[k]] = std::isinf(chunk[k].tfar) && chunk[k].tfar < 0.0f ? 1 : 0;
+      queried += n;
+    }
+    return queried;
+  }
+  if (mode == RayMode::Single) {
+    RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    for (std::size_t i = 0; i != count; ++i) {
+      occluded[i] = 0;
+      if (!has_segment(i)) continue;
+      RTCRay ray;
+      to_embree(rays[i], ray);
+      rtcOccluded1(scene, &context, &ray);
+      occluded[i] = std::isinf(ray.tfar) && ray.tfar < 0.0f ? 1 : 0;
+      ++queried;
+    }
+    return queried;
+  }
+  RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
+  for (std::size_t first = 0; first < count; first += 8) {
+    alignas(32) RTCRay8 ray;
+    alignas(32) int valid[8];
+    int lanes = 0;
+    for (int lane = 0; lane < 8; ++lane) {
+      const std::size_t i = first + lane;
+      valid[lane] = i < count && has_segment(i) ? -1 : 0;
+      lanes += valid[lane] != 0;
+      set_ray_n(ray, lane, rays[i < count ? i : count - 1]);
+    }
+    if (lanes > 0) rtcOccluded8(valid, scene, &context, &ray);
+    queried += static_cast<std::size_t>(lanes);
+    for (int lane = 0; lane < 8; ++lane) {
+      const std::size_t i = first + lane;
+      if (i >= count) break;
+      occluded[i] = valid[lane] != 0 && std::isinf(ray.tfar[lane]) && ray.tfar[lane] < 0.0f ? 1 : 0;
+    }
+  }
+  return queried;
+}
+
+}  // namespace
+
 std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
                                   RayMode mode) const {
   RTCScene scene = impl_->scene;
-  // Many of the path tracer's shadow slots hold no ray (no light sampled, or one behind the
-  // surface: half of them on the Cornell box); asking Embree about them costs a call and a
-  // root-node test each (docs/host-path-tracer.md, "Empty shadow rays skipped; per-frame fills").
-  const auto has_segment = [&](std::size_t i) { return rays[i].tmin <= rays[i].tmax; };
-  if (mode == RayMode::Stream) {
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
-        [&](const auto& range, std::size_t queried) {
-          RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
-          alignas(64) RTCRay chunk[kStreamChunk];
-          std::uint32_t slot[kStreamChunk];
-          std::size_t i = range.begin();
-          while (i < range.end()) {
-            unsigned int n = 0;
-            // Without a branch: every slot is written at chunk[n], and n moves on only past a
-            // segment (whether a slot has one is a coin toss on most scenes, which a branch
-            // mispredicts; docs/host-path-tracer.md, "Rays written in place").
-            for (; i < range.end() && n < kStreamChunk; ++i) {
-              occluded[i] = 0;
-              to_embree(rays[i], chunk[n]);
-              slot[n] = static_cast<std::uint32_t>(i);
-              n += has_segment(i) ? 1u : 0u;
-            }
-            if (n == 0) continue;
-            rtcOccluded1M(scene, &context, chunk, n, sizeof(RTCRay));
-            for (unsigned int k = 0; k < n; ++k)
-              occluded[slot[k]] = std::isinf(chunk[k].tfar) && chunk[k].tfar < 0.0f ? 1 : 0;
-            queried += n;
-          }
-          return queried;
-        },
-        std::plus<std::size_t>());
-  }
-  if (mode == RayMode::Single) {
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
-        [&](const auto& range, std::size_t queried) {
-          RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
-          for (std::size_t i = range.begin(); i != range.end(); ++i) {
-            occluded[i] = 0;
-            if (!has_segment(i)) continue;
-            RTCRay ray;
-            to_embree(rays[i], ray);
-            rtcOccluded1(scene, &context, &ray);
-            occluded[i] = std::isinf(ray.tfar) && ray.tfar < 0.0f ? 1 : 0;
-            ++queried;
-          }
-          return queried;
-        },
-        std::plus<std::size_t>());
-  }
-  const std::size_t packets = (count + 7) / 8;
+  // Packets start at multiples of 8 whatever the split.
+  const std::size_t unit = mode == RayMode::Packet8 ? 8 : 1;
+  const std::size_t units = (count + unit - 1) / unit;
   return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), std::size_t{0},
+      tbb::blocked_range<std::size_t>(0, units, kGrain / unit), std::size_t{0},
       [&](const auto& range, std::size_t queried) {
-        RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
-        for (std::size_t p = range.begin(); p != range.end(); ++p) {
-          alignas(32) RTCRay8 ray;
-          alignas(32) int valid[8];
-          int lanes = 0;
-          for (int lane = 0; lane < 8; ++lane) {
-            const std::size_t i = p * 8 + lane;
-            valid[lane] = i < count && has_segment(i) ? -1 : 0;
-            lanes += valid[lane] != 0;
-            set_ray_n(ray, lane, rays[i < count ? i : count - 1]);
-          }
-          if (lanes > 0) rtcOccluded8(valid, scene, &context, &ray);
-          queried += static_cast<std::size_t>(lanes);
-          for (int lane = 0; lane < 8; ++lane) {
-            const std::size_t i = p * 8 + lane;
-            if (i >= count) break;
-            occluded[i] =
-                valid[lane] != 0 && std::isinf(ray.tfar[lane]) && ray.tfar[lane] < 0.0f ? 1 : 0;
-          }
-        }
+        const std::size_t begin = range.begin() * unit;
+        const std::size_t end = std::min(count, range.end() * unit);
+        return queried + occluded_span(scene, rays + begin, occluded + begin, end - begin, mode);
+      },
+      std::plus<std::size_t>());
+}
+
+std::size_t EmbreeScene::occluded_lists(const Ray* rays, std::uint8_t* occluded, std::size_t stride,
+                                        const std::uint32_t* counts, std::size_t lists,
+                                        RayMode mode) const {
+  RTCScene scene = impl_->scene;
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, lists), std::size_t{0},
+      [&](const auto& range, std::size_t queried) {
+        for (std::size_t l = range.begin(); l != range.end(); ++l)
+          queried += occluded_span(scene, rays + l * stride, occluded + l * stride,
+                                   std::min<std::size_t>(counts[l], stride), mode);
         return queried;
       },
       std::plus<std::size_t>());

@@ -33,6 +33,14 @@ class EmbreeScene {
   // a query. Returns the number of rays queried.
   std::size_t occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
                        RayMode mode = RayMode::Single) const;
+  // occluded() for `lists` lists of rays laid out `stride` apart: list l is
+  // rays[l * stride .. l * stride + counts[l]) (at most stride long), answered into the same
+  // places of `occluded`; what lies between the lists is neither read nor written. The path
+  // tracer's shadow rays, each block of its paths' rays written from the block's start
+  // (docs/host-path-tracer.md, "Shadow rays listed where they are made").
+  std::size_t occluded_lists(const Ray* rays, std::uint8_t* occluded, std::size_t stride,
+                             const std::uint32_t* counts, std::size_t lists,
+                             RayMode mode = RayMode::Single) const;
 
   // Closest hits of an image's camera rays, rays[y * width + x] into hits[y * width + x],
   // traced in packets of neighbouring pixels: tiles of 4x4 (16 rays) where this CPU and Embree

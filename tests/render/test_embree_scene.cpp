@@ -1,8 +1,7 @@
 // The batched ray queries of host/trace/embree_scene.h: the same hits and occlusion answers in
-// every ray mode (one by one, packets of 8, streams) and for an image's rays traced in tiles of
-// pixels, and the empty segments the path tracer
-// leaves in its shadow slots (inactive rays, tmin > tmax) answered 0 without a query and left
-// out of the count of rays queried.
+// every ray mode (one by one, packets of 8, streams), for lists of shadow rays laid out a stride
+// apart, and for an image's rays traced in tiles of pixels; empty segments (inactive rays,
+// tmin > tmax) answered 0 without a query and left out of the count of rays queried.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -97,6 +96,38 @@ TEST(EmbreeScene, OccludedOfNoRaysQueriesNothing) {
   std::uint8_t unused = 0;
   for (RayMode mode : {RayMode::Single, RayMode::Packet8, RayMode::Stream})
     EXPECT_EQ(tracer.occluded(nullptr, &unused, 0, mode), 0u) << mode_name(mode);
+}
+
+// The path tracer's shadow rays as lists laid out a stride apart (occluded_lists): each list
+// answered as occluded() answers the same rays, the places between lists left as they were, and
+// the count of rays queried the sum over the lists. Lists of 0 rays, of fewer than a stride, of a
+// whole stride, and one longer than a stride whose places past the stride are not touched (stride
+// 9: a packet of 8 and one more; 4 lists of the shadow_slots() rays, empty segments included).
+TEST(EmbreeScene, OccludedListsAnswerEachListAsOccludedDoes) {
+  const Scene scene = quad_scene();
+  const EmbreeScene tracer(scene);
+  const Case c = shadow_slots();
+  constexpr std::size_t kStride = 9;
+  // The first list is capped at kStride; the empty one after it shows that nothing past the
+  // stride was written.
+  const std::vector<std::uint32_t> counts = {12, 0, 5, 9};
+  std::vector<Ray> lists(kStride * counts.size());
+  std::vector<std::uint8_t> expected(lists.size(), 7);
+  std::size_t next = 0, segments = 0;
+  for (std::size_t l = 0; l < counts.size(); ++l)
+    for (std::size_t k = 0; k < std::min<std::size_t>(counts[l], kStride); ++k, ++next) {
+      lists[l * kStride + k] = c.rays[next % c.rays.size()];
+      expected[l * kStride + k] = c.expected[next % c.rays.size()];
+      segments += c.rays[next % c.rays.size()].tmin <= c.rays[next % c.rays.size()].tmax;
+    }
+  for (RayMode mode : {RayMode::Single, RayMode::Packet8, RayMode::Stream}) {
+    std::vector<std::uint8_t> occluded(lists.size(), 7);
+    const std::size_t queried = tracer.occluded_lists(lists.data(), occluded.data(), kStride,
+                                                      counts.data(), counts.size(), mode);
+    EXPECT_EQ(queried, segments) << mode_name(mode);
+    for (std::size_t i = 0; i < lists.size(); ++i)
+      EXPECT_EQ(occluded[i], expected[i]) << "place " << i << ", " << mode_name(mode);
+  }
 }
 
 // 2000 rays from random points above and below the quad in random directions (a third of them
