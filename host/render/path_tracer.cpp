@@ -89,15 +89,6 @@ float guide_density(const PixelGuide& guide, const glm::vec3& w, float bsdf_pdf)
       bsdf_pdf);
 }
 
-Ray inactive_ray() {
-  Ray r;
-  r.origin = glm::vec3(0.0f);
-  r.direction = glm::vec3(0.0f, 0.0f, 1.0f);
-  r.tmin = 1.0f;  // tmin > tmax: Embree skips the ray
-  r.tmax = 0.0f;
-  return r;
-}
-
 }  // namespace
 
 PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer,
@@ -267,7 +258,8 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
               } else {
                 p.radiance = glm::vec3(g.emission[i]);
               }
-              rays_[i] = inactive_ray();
+              // A slot's ray is written only where its path goes on (alive_): the compaction
+              // moves no other.
               alive_[i] = 0;
             }
             if (!g.has_surface(i)) continue;

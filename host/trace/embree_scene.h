@@ -29,8 +29,8 @@ class EmbreeScene {
   void intersect(const Ray* rays, Hit* hits, std::size_t count,
                  RayMode mode = RayMode::Single) const;
   // occluded[i] = 1 if anything lies on rays[i] within (tmin, tmax), else 0. A ray with an
-  // empty segment (not tmin <= tmax: the path tracer's slot without a shadow ray) gets 0 without
-  // a query. Returns the number of rays queried.
+  // empty segment (not tmin <= tmax, a NaN bound included) gets 0 without a query. Returns the
+  // number of rays queried.
   std::size_t occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
                        RayMode mode = RayMode::Single) const;
   // occluded() for `lists` lists of rays laid out `stride` apart: list l is

@@ -1,7 +1,7 @@
 // The batched ray queries of host/trace/embree_scene.h: the same hits and occlusion answers in
 // every ray mode (one by one, packets of 8, streams), for lists of shadow rays laid out a stride
-// apart, and for an image's rays traced in tiles of pixels; empty segments (inactive rays,
-// tmin > tmax) answered 0 without a query and left out of the count of rays queried.
+// apart, and for an image's rays traced in tiles of pixels; empty segments (tmin > tmax, or a
+// NaN bound) answered 0 without a query and left out of the count of rays queried.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -36,7 +36,7 @@ Ray segment(glm::vec3 origin, glm::vec3 direction, float tmin, float tmax) {
 
 // Rays down through the quad's plane from y = 1 (even slots above the quad, odd ones beside it),
 // alternating between a segment that reaches the plane, one that stops short of it and an empty one
-// (as inactive_ray() in host/render/path_tracer.cpp, and a NaN bound); 21 rays, so the last packet
+// (tmin > tmax, and a NaN bound); 21 rays, so the last packet
 // of 8 is partial and one packet is empty in every lane.
 struct Case {
   std::vector<Ray> rays;
