@@ -115,7 +115,7 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSource& first,
     // bounce's directions (FirstBounceSampler::start_sample), then the first bounce.
     start_paths(g, nullptr, sampler, at, vpls, StartPart::next_event);
     times.shade_ms += ms_since(start);
-    run_shadow_rays(n, rays, times);
+    run_shadow_rays(rays, times);
     const FirstBounceSamples samples = first.await();
     start = Clock::now();
     if (settings_.guide_secondary) collect_borrowable(g, sampler);
@@ -125,25 +125,28 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSource& first,
     if (settings_.guide_secondary) collect_borrowable(g, sampler);
     start_paths(g, first.ready, sampler, at, vpls);
     times.shade_ms += ms_since(start);
-    run_shadow_rays(n, rays, times);
+    run_shadow_rays(rays, times);
   }
   start = Clock::now();
-  apply_shadow_rays_and_compact(n, nullptr);
+  apply_shadow_rays(true);
   times.compact_ms += ms_since(start);
 
-  for (int depth = 1; depth <= settings_.max_bounces && !active_.empty(); ++depth) {
-    const std::size_t m = active_.size();
+  for (int depth = 1; depth <= settings_.max_bounces; ++depth) {
+    std::size_t m = 0;
+    for (const std::uint32_t count : ray_counts_) m += count;
+    if (m == 0) break;
     start = Clock::now();
-    tracer_.intersect(rays_.data(), hits_.data(), m, kBounceRayMode);
+    tracer_.intersect_lists(rays_.data(), hits_.data(), kPathBlock, ray_counts_.data(),
+                            ray_counts_.size(), kBounceRayMode);
     times.trace_ms += ms_since(start);
     rays.secondary += m;
 
     start = Clock::now();
-    shade_bounce(depth, m, vpls, rays);
+    shade_bounce(depth, vpls, rays);
     times.shade_ms += ms_since(start);
-    run_shadow_rays(m, rays, times);
+    run_shadow_rays(rays, times);
     start = Clock::now();
-    apply_shadow_rays_and_compact(m, &active_);
+    apply_shadow_rays(false);
     times.compact_ms += ms_since(start);
   }
   start = Clock::now();
@@ -163,10 +166,11 @@ void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
   shadow_contribution_.resize(n);
   shadow_path_.resize(n);
   occluded_.resize(n);
-  shadow_counts_.resize((n + kShadowBlock - 1) / kShadowBlock);
+  shadow_counts_.resize((n + kPathBlock - 1) / kPathBlock);
   rays_.resize(n);
   hits_.resize(n);
-  alive_.assign(n, 0);
+  active_.resize(n);
+  ray_counts_.resize((n + kPathBlock - 1) / kPathBlock);
   if (world_guide_) {
     // One record per path for each depth the guide covers (at most 254: world_depth_ counts them
     // in a byte beside kNotRecording).
@@ -227,19 +231,20 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
   const bool mis_with_bsdf =
       settings_.first_bounce_mis == FirstBounceMis::bsdf && !sampler.samples_the_bsdf();
   const SampleCoordinates first_at = first_bounce_coordinates(at, settings_.shared_randoms);
-  static_assert(kShadowBlock == kGrain, "a block of pixels is one chunk of stream starts");
+  static_assert(kPathBlock == kGrain, "a block of pixels is one chunk of stream starts");
   const std::size_t n = g.pixel_count();
   tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, (n + kShadowBlock - 1) / kShadowBlock),
+      tbb::blocked_range<std::size_t>(0, (n + kPathBlock - 1) / kPathBlock),
       [&](const auto& blocks) {
         // The pixels' path streams (and first-bounce streams where the BSDF's first bounce is
         // drawn here) started in vector lanes, a block at a time (render/stream_starts.h).
         std::uint32_t path_starts[kGrain], first_starts[kGrain];
         for (std::size_t block = blocks.begin(); block != blocks.end(); ++block) {
-          const std::size_t chunk = block * kShadowBlock;
-          const std::size_t chunk_end = std::min(n, chunk + kShadowBlock);
-          // The block's shadow rays, listed from its first slot (kShadowBlock).
-          std::uint32_t shadows = 0;
+          const std::size_t chunk = block * kPathBlock;
+          const std::size_t chunk_end = std::min(n, chunk + kPathBlock);
+          // The block's shadow rays and the rays of its paths that go on, each listed from its
+          // first slot (kPathBlock).
+          std::uint32_t shadows = 0, survivors = 0;
           if (starts)
             make_stream_starts({at.seed, at.frame, at.sample, PG_RNG_STREAM_PATH}, chunk,
                                chunk_end - chunk, path_starts);
@@ -258,9 +263,6 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
               } else {
                 p.radiance = glm::vec3(g.emission[i]);
               }
-              // A slot's ray is written only where its path goes on (alive_): the compaction
-              // moves no other.
-              alive_[i] = 0;
             }
             if (!g.has_surface(i)) continue;
             const glm::vec3 x0(g.position_depth[i]);
@@ -338,7 +340,9 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                 } else {
                   p.throughput = throughput;
                 }
-                set_ray(rays_[i], origin, fs.direction, 0.0f, 1e30f);
+                const std::size_t slot = chunk + survivors++;
+                set_ray(rays_[slot], origin, fs.direction, 0.0f, 1e30f);
+                active_[slot] = static_cast<std::uint32_t>(i);
                 // The density the hit's MIS weight uses: the same function of the direction
                 // as next-event estimation's above. Under first_bounce_mis_deferred_ the hit
                 // asks the sampler's pdf() instead of this sample's density, which a device
@@ -346,11 +350,11 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                 // density for both weights at the primary hit").
                 p.prev_pdf = mis_with_bsdf ? bsdf_mis_density(bsdf_pdf) : fs.pdf;
                 p.prev_position = x0;
-                alive_[i] = 1;
               }
             }
           }
           if (starts) shadow_counts_[block] = shadows;
+          if (bounces) ray_counts_[block] = survivors;
         }
       });
 }
@@ -376,7 +380,7 @@ float PathTracer::first_bounce_mis_density(std::size_t i, const glm::vec3& direc
   return sampler_->pdf(g, i, lobes, wo, shared::pg_to_local(frame, direction));
 }
 
-void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays) {
+void PathTracer::shade_bounce(int depth, VplBuffer* vpls, RayCounts& rays) {
   const bool nee = next_event_on_;
   // The options that add work at a vertex beyond the first bounce's hit: guiding it (borrowed
   // pixel mixtures or the world guide's cells), recording it for the world guide (at every
@@ -393,8 +397,10 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
     // The world guide's vertices at this depth: sampled from it, and recorded to train it.
     const bool world_here = kExtras && world_guide_ && depth <= world_depths_;
     std::uint64_t guided_here = 0;
-    // The block's shadow rays, listed from its first slot (kShadowBlock).
-    std::uint32_t shadows = 0;
+    // The block's shadow rays and the next rays of its paths that go on, each listed from its
+    // first slot (kPathBlock): the latter in place, at or before the slot being shaded, whose
+    // ray and path were read first.
+    std::uint32_t shadows = 0, survivors = 0;
     // The pixel each of the next vertices projects to, found once where its entry is
     // prefetched.
     std::size_t borrow_from[kBorrowRing];
@@ -421,7 +427,6 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
         world_vertices_[i * world_stride_ + (depth - 2)].radiance_before = p.radiance;
       const Ray ray = rays_[j];
       const Hit& hit = hits_[j];
-      alive_[j] = 0;
       const glm::vec3 dir = glm::normalize(ray.direction);
       // The density the light found here weighs itself with against a light sample.
       const auto arriving_pdf = [&] {
@@ -586,8 +591,9 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       if (is_black(from_camera) || !is_finite(from_camera)) continue;
       p.prev_pdf = mis_with_bsdf ? mis_pdf : bs.pdf;
       p.prev_position = sp.position;
-      set_ray(rays_[j], origin, wi_world, 0.0f, 1e30f);
-      alive_[j] = 1;
+      const std::size_t slot = range.begin() + survivors++;
+      set_ray(rays_[slot], origin, wi_world, 0.0f, 1e30f);
+      active_[slot] = i;
       if (world_here && world_depth_[i] != kNotRecording) {
         WorldVertex& v = world_vertices_[i * world_stride_ + (depth - 1)];
         v.cell = WorldGuide::kNoCell;
@@ -611,14 +617,15 @@ void PathTracer::shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCoun
       }
     }
     guided_vertices += guided_here;
-    shadow_counts_[range.begin() / kShadowBlock] = shadows;
+    shadow_counts_[range.begin() / kPathBlock] = shadows;
+    ray_counts_[range.begin() / kPathBlock] = survivors;
   };
-  // Blocks of kShadowBlock slots, each with its list of shadow rays.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (m + kShadowBlock - 1) / kShadowBlock),
+  // Block by block: each block's live paths, listed from its first slot.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ray_counts_.size()),
                     [&](const auto& blocks) {
                       for (std::size_t b = blocks.begin(); b != blocks.end(); ++b) {
                         const tbb::blocked_range<std::size_t> range(
-                            b * kShadowBlock, std::min(m, (b + 1) * kShadowBlock));
+                            b * kPathBlock, b * kPathBlock + ray_counts_[b]);
                         if (extras_on)
                           shade_range(std::true_type{}, range);
                         else
@@ -693,61 +700,34 @@ bool PathTracer::borrow_guide(std::size_t i, const SurfacePoint& sp, PixelGuide&
   return true;
 }
 
-void PathTracer::run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times) {
+void PathTracer::run_shadow_rays(RayCounts& rays, PassTimes& times) {
   const auto start = Clock::now();
-  rays.shadow += tracer_.occluded_lists(shadow_rays_.data(), occluded_.data(), kShadowBlock,
-                                        shadow_counts_.data(),
-                                        (count + kShadowBlock - 1) / kShadowBlock, kShadowRayMode);
+  rays.shadow +=
+      tracer_.occluded_lists(shadow_rays_.data(), occluded_.data(), kPathBlock,
+                             shadow_counts_.data(), shadow_counts_.size(), kShadowRayMode);
   times.trace_ms += ms_since(start);
 }
 
-void PathTracer::apply_shadow_rays_and_compact(std::size_t count,
-                                               const std::vector<std::uint32_t>* owners) {
-  // A parallel prefix sum of the alive flags gives each survivor its slot, in the serial
-  // order (so the frame is the same whatever the thread count); rays move to a second buffer,
-  // as an in-place parallel move could overwrite a ray before it is read. The same pass, block
-  // by block, adds each unoccluded shadow ray of the block's list to its path (a path has one
-  // slot and so at most one entry: no two iterations touch one PathState;
-  // docs/host-path-tracer.md, "One pass after each vertex", "Shadow rays listed where they are
-  // made").
-  slot_.resize(count);
-  const std::size_t alive = tbb::parallel_scan(
-      tbb::blocked_range<std::size_t>(0, count, kGrain), std::size_t{0},
-      [&](const auto& range, std::size_t sum, bool is_final) {
-        for (std::size_t j = range.begin(); j != range.end(); ++j) {
-          if (is_final) slot_[j] = static_cast<std::uint32_t>(sum);
-          sum += alive_[j];
-        }
-        return sum;
-      },
-      std::plus<std::size_t>());
-  next_active_.resize(alive);
-  next_rays_.resize(rays_.size());
-  // At x0 (no owners) a path kept from y (VplPath) adds its light sample to what the pixel
-  // found before y.
-  const bool to_before_y = keep_vpls_ && !owners;
-  const std::size_t blocks = (count + kShadowBlock - 1) / kShadowBlock;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks), [&](const auto& range) {
-    for (std::size_t b = range.begin(); b != range.end(); ++b) {
-      const std::size_t first = b * kShadowBlock, entries_end = first + shadow_counts_[b];
-      for (std::size_t e = first; e != entries_end; ++e) {
-        if (occluded_[e]) continue;
-        if (to_before_y) {
-          vpl_paths_[shadow_path_[e]].before_y += shadow_contribution_[e];
-        } else {
-          paths_[shadow_path_[e]].radiance += shadow_contribution_[e];
-        }
-      }
-      const std::size_t end = std::min(count, first + kShadowBlock);
-      for (std::size_t j = first; j != end; ++j) {
-        if (!alive_[j]) continue;
-        next_rays_[slot_[j]] = rays_[j];
-        next_active_[slot_[j]] = owners ? (*owners)[j] : static_cast<std::uint32_t>(j);
-      }
-    }
-  });
-  rays_.swap(next_rays_);
-  active_.swap(next_active_);
+void PathTracer::apply_shadow_rays(bool at_x0) {
+  // Each unoccluded shadow ray of a block's list adds its contribution to its path (a path has
+  // one slot and so at most one entry: no two iterations touch one PathState). At x0 a path kept
+  // from y (VplPath) adds it to what the pixel found before y (docs/host-path-tracer.md, "One
+  // pass after each vertex", "Shadow rays listed where they are made").
+  const bool to_before_y = keep_vpls_ && at_x0;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, shadow_counts_.size()),
+                    [&](const auto& range) {
+                      for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                        const std::size_t first = b * kPathBlock, end = first + shadow_counts_[b];
+                        for (std::size_t e = first; e != end; ++e) {
+                          if (occluded_[e]) continue;
+                          if (to_before_y) {
+                            vpl_paths_[shadow_path_[e]].before_y += shadow_contribution_[e];
+                          } else {
+                            paths_[shadow_path_[e]].radiance += shadow_contribution_[e];
+                          }
+                        }
+                      }
+                    });
 }
 
 void PathTracer::collect_world_samples() {

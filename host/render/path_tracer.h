@@ -92,8 +92,9 @@ struct RayCounts {
 
 struct PassTimes {
   double trace_ms = 0.0, shade_ms = 0.0;
-  // Between the passes: shadow rays' results added to their paths, live paths compacted, the
-  // pixel estimates and VPL radiance gathered at the end.
+  // Between the passes: shadow rays' results added to their paths, and the pixel estimates and
+  // VPL radiance gathered at the end (the name stays from when it also compacted the live
+  // paths, which the shading now lists in place).
   double compact_ms = 0.0;
 };
 
@@ -167,9 +168,10 @@ class PathTracer {
   void start_paths(const GBuffer& g, const FirstBounceSamples* first,
                    const FirstBounceSampler& sampler, const SampleCoordinates& at, VplBuffer* vpls,
                    StartPart part = StartPart::whole);
-  // The hits of the m live paths at path vertex `depth`: emission found by the bounce (MIS),
-  // the VPL at depth 1, next-event estimation, BSDF sampling and Russian roulette.
-  void shade_bounce(int depth, std::size_t m, VplBuffer* vpls, RayCounts& rays);
+  // The hits of the live paths at path vertex `depth` (the blocks' lists): emission found by
+  // the bounce (MIS), the VPL at depth 1, next-event estimation, BSDF sampling and Russian
+  // roulette; the paths that go on are listed again, with their next rays.
+  void shade_bounce(int depth, VplBuffer* vpls, RayCounts& rays);
   // The sampler's pdf() at pixel i for world direction `direction` (first_bounce_mis_deferred_).
   float first_bounce_mis_density(std::size_t i, const glm::vec3& direction) const;
   // The random numbers of path i's vertex y (the first bounce's hit) where the frame's samples
@@ -186,13 +188,11 @@ class PathTracer {
                   const shared::pg_frame& frame, const glm::vec3& wo, const shared::pg_lobes& lobes,
                   const glm::vec3& origin, float u_select, float u1, float u2,
                   const CompetingPdf& competing_pdf, glm::vec3& contribution, Ray& shadow) const;
-  // The shadow rays of a pass over `count` slots (the blocks' lists).
-  void run_shadow_rays(std::size_t count, RayCounts& rays, PassTimes& times);
+  // The shadow rays of the pass just made (the blocks' lists).
+  void run_shadow_rays(RayCounts& rays, PassTimes& times);
   // Adds each unoccluded shadow ray's contribution to its path (to the pixel's before_y at
-  // x0, owners null, where VPLs are kept), and keeps the rays of the paths still alive at the
-  // front of rays_; active_ becomes their pixels (owners[j] of slot j, or j itself when owners
-  // is null).
-  void apply_shadow_rays_and_compact(std::size_t count, const std::vector<std::uint32_t>* owners);
+  // x0, where VPLs are kept).
+  void apply_shadow_rays(bool at_x0);
   // Light a bounce found at path vertex `depth` (emission with its MIS weight, times the
   // path's throughput), added to the path's radiance, or to the pixel's own where the VPL
   // leaves it out.
@@ -251,18 +251,20 @@ class PathTracer {
   std::vector<VplPath> vpl_paths_;  // per pixel, where keep_vpls_
   bool keep_vpls_ = false;          // this pass writes VPLs (trace()'s vpls)
   bool next_event_on_ = true;       // next-event estimation this frame (settings and lights)
-  std::vector<std::uint32_t> active_, next_active_;
-  std::vector<std::uint32_t> slot_;  // apply_shadow_rays_and_compact(): each survivor's new slot
-  std::vector<Ray> next_rays_;       // the same: the survivors' rays, then swapped in
-  std::vector<std::uint8_t> alive_;  // per slot: the path goes on after this vertex
+  // The paths are shaded in blocks of kPathBlock slots, fixed whatever the thread count: block
+  // b's slots are b * kPathBlock onwards. At the primary hits slot i is pixel i's; after each
+  // vertex a block lists, from its first slot and in slot order, the paths that go on (their
+  // pixels in active_, their next rays in rays_, ray_counts_[b] of them, written in place), and
+  // the shadow rays its vertices made (shadow_counts_[b] of them). Blocks never merge: a block
+  // of the last bounce holds what is left of its pixels' paths (docs/host-path-tracer.md,
+  // "Shadow rays listed where they are made", "Bounce rays listed in place").
+  static constexpr std::size_t kPathBlock = 2048;
+  std::vector<std::uint32_t> active_;
   std::vector<Ray> rays_;
   std::vector<Hit> hits_;
-  // The vertices' shadow rays, listed where they are made: the slots of a pass fall into blocks
-  // of kShadowBlock, and block b's shadow rays are entries b * kShadowBlock onwards, in slot
-  // order, shadow_counts_[b] of them (so a slot without one costs nothing after next-event
-  // estimation; docs/host-path-tracer.md, "Shadow rays listed where they are made"). Per entry:
-  // the ray, what it adds to its path's radiance if unoccluded, the path, and Embree's answer.
-  static constexpr std::size_t kShadowBlock = 2048;
+  std::vector<std::uint32_t> ray_counts_;  // per block
+  // Per shadow-ray entry: the ray, what it adds to its path's radiance if unoccluded, the path,
+  // and Embree's answer.
   std::vector<Ray> shadow_rays_;
   std::vector<glm::vec3> shadow_contribution_;
   std::vector<std::uint32_t> shadow_path_;

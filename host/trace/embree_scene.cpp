@@ -201,57 +201,73 @@ Hit hit_of(const RTCRayHit& rh) {
   return h;
 }
 
+// EmbreeScene::intersect for the span rays[0..count) on the calling thread.
+void intersect_span(RTCScene scene, const Ray* rays, Hit* hits, std::size_t count, RayMode mode) {
+  if (mode == RayMode::Stream) {
+    RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    alignas(64) RTCRayHit chunk[kStreamChunk];
+    for (std::size_t first = 0; first < count; first += kStreamChunk) {
+      const std::size_t n = std::min(kStreamChunk, count - first);
+      for (std::size_t k = 0; k < n; ++k) start_query(rays[first + k], chunk[k]);
+      rtcIntersect1M(scene, &context, chunk, static_cast<unsigned int>(n), sizeof(RTCRayHit));
+      for (std::size_t k = 0; k < n; ++k) hits[first + k] = hit_of(chunk[k]);
+    }
+    return;
+  }
+  if (mode == RayMode::Single) {
+    RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
+    for (std::size_t i = 0; i != count; ++i) {
+      RTCRayHit rh;
+      start_query(rays[i], rh);
+      rtcIntersect1(scene, &context, &rh);
+      hits[i] = hit_of(rh);
+    }
+    return;
+  }
+  RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
+  for (std::size_t first = 0; first < count; first += 8) {
+    alignas(32) RTCRayHit8 rh;
+    alignas(32) int valid[8];
+    for (int lane = 0; lane < 8; ++lane) {
+      const std::size_t i = first + lane;
+      valid[lane] = i < count ? -1 : 0;
+      set_ray_n(rh.ray, lane, rays[i < count ? i : count - 1]);
+      rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, scene, &context, &rh);
+    for (int lane = 0; lane < 8; ++lane) {
+      const std::size_t i = first + lane;
+      if (i >= count) break;
+      hits[i] = hit_of_lane(rh, lane);
+    }
+  }
+}
+
 }  // namespace
 
 void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMode mode) const {
   RTCScene scene = impl_->scene;
-  if (mode == RayMode::Stream) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
-      RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
-      alignas(64) RTCRayHit chunk[kStreamChunk];
-      for (std::size_t first = range.begin(); first < range.end(); first += kStreamChunk) {
-        const std::size_t n = std::min(kStreamChunk, range.end() - first);
-        for (std::size_t k = 0; k < n; ++k) start_query(rays[first + k], chunk[k]);
-        rtcIntersect1M(scene, &context, chunk, static_cast<unsigned int>(n), sizeof(RTCRayHit));
-        for (std::size_t k = 0; k < n; ++k) hits[first + k] = hit_of(chunk[k]);
-      }
-    });
-    return;
-  }
-  if (mode == RayMode::Single) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
-      RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT);
-      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-        RTCRayHit rh;
-        start_query(rays[i], rh);
-        rtcIntersect1(scene, &context, &rh);
-        hits[i] = hit_of(rh);
-      }
-    });
-    return;
-  }
-  const std::size_t packets = (count + 7) / 8;
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, packets, kGrain / 8), [&](const auto& range) {
-        RTCIntersectContext context = intersect_context(RTC_INTERSECT_CONTEXT_FLAG_COHERENT);
-        for (std::size_t p = range.begin(); p != range.end(); ++p) {
-          alignas(32) RTCRayHit8 rh;
-          alignas(32) int valid[8];
-          for (int lane = 0; lane < 8; ++lane) {
-            const std::size_t i = p * 8 + lane;
-            valid[lane] = i < count ? -1 : 0;
-            set_ray_n(rh.ray, lane, rays[i < count ? i : count - 1]);
-            rh.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
-          }
-          rtcIntersect8(valid, scene, &context, &rh);
-          for (int lane = 0; lane < 8; ++lane) {
-            const std::size_t i = p * 8 + lane;
-            if (i >= count) break;
-            hits[i] = hit_of_lane(rh, lane);
-          }
-        }
-      });
+  // Packets start at multiples of 8 whatever the split.
+  const std::size_t unit = mode == RayMode::Packet8 ? 8 : 1;
+  const std::size_t units = (count + unit - 1) / unit;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, units, kGrain / unit),
+                    [&](const auto& range) {
+                      const std::size_t begin = range.begin() * unit;
+                      const std::size_t end = std::min(count, range.end() * unit);
+                      intersect_span(scene, rays + begin, hits + begin, end - begin, mode);
+                    });
+}
+
+void EmbreeScene::intersect_lists(const Ray* rays, Hit* hits, std::size_t stride,
+                                  const std::uint32_t* counts, std::size_t lists,
+                                  RayMode mode) const {
+  RTCScene scene = impl_->scene;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lists), [&](const auto& range) {
+    for (std::size_t l = range.begin(); l != range.end(); ++l)
+      intersect_span(scene, rays + l * stride, hits + l * stride,
+                     std::min<std::size_t>(counts[l], stride), mode);
+  });
 }
 
 namespace {

@@ -28,6 +28,10 @@ class EmbreeScene {
   // Closest hits of rays[0..count) into hits[0..count).
   void intersect(const Ray* rays, Hit* hits, std::size_t count,
                  RayMode mode = RayMode::Single) const;
+  // intersect() for `lists` lists of rays laid out `stride` apart, as occluded_lists() below
+  // (the path tracer's bounce rays, each block of its paths' rays written from the block's start).
+  void intersect_lists(const Ray* rays, Hit* hits, std::size_t stride, const std::uint32_t* counts,
+                       std::size_t lists, RayMode mode = RayMode::Single) const;
   // occluded[i] = 1 if anything lies on rays[i] within (tmin, tmax), else 0. A ray with an
   // empty segment (not tmin <= tmax, a NaN bound included) gets 0 without a query. Returns the
   // number of rays queried.

@@ -1,7 +1,7 @@
 // The batched ray queries of host/trace/embree_scene.h: the same hits and occlusion answers in
-// every ray mode (one by one, packets of 8, streams), for lists of shadow rays laid out a stride
-// apart, and for an image's rays traced in tiles of pixels; empty segments (tmin > tmax, or a
-// NaN bound) answered 0 without a query and left out of the count of rays queried.
+// every ray mode (one by one, packets of 8, streams), for lists of shadow and bounce rays laid out
+// a stride apart, and for an image's rays traced in tiles of pixels; empty segments (tmin > tmax,
+// or a NaN bound) answered 0 without a query and left out of the count of rays queried.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -127,6 +127,52 @@ TEST(EmbreeScene, OccludedListsAnswerEachListAsOccludedDoes) {
     EXPECT_EQ(queried, segments) << mode_name(mode);
     for (std::size_t i = 0; i < lists.size(); ++i)
       EXPECT_EQ(occluded[i], expected[i]) << "place " << i << ", " << mode_name(mode);
+  }
+}
+
+// The path tracer's bounce rays as lists laid out a stride apart (intersect_lists): each list's
+// hits those of intersect() for the same rays, to the bit, and the places between the lists (and
+// past a list longer than the stride) untouched. 300 random rays in lists of 0, 1, 37 (a partial
+// packet), 64 and 90 (capped at 64) rays, 64 apart, in the three ray modes.
+TEST(EmbreeScene, IntersectListsHitAsIntersectDoes) {
+  const Scene scene = quad_scene();
+  const EmbreeScene tracer(scene);
+  std::mt19937 gen(9);
+  std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+  constexpr std::size_t kStride = 64;
+  const std::vector<std::uint32_t> counts = {90, 0, 1, 37, 64};
+  std::vector<Ray> lists(kStride * counts.size());
+  for (Ray& r : lists) {
+    const glm::vec3 origin(u(gen), u(gen), u(gen));
+    const glm::vec3 to(0.7f * u(gen), 0.0f, 0.7f * u(gen));
+    r = segment(origin, to - origin, 0.0f, 2.0f);
+  }
+  Hit untouched;
+  untouched.mesh = 12345;
+  for (RayMode mode : {RayMode::Single, RayMode::Packet8, RayMode::Stream}) {
+    std::vector<Hit> hits(lists.size(), untouched);
+    tracer.intersect_lists(lists.data(), hits.data(), kStride, counts.data(), counts.size(), mode);
+    std::size_t hit_count = 0;
+    for (std::size_t l = 0; l < counts.size(); ++l) {
+      const std::size_t n = std::min<std::size_t>(counts[l], kStride);
+      std::vector<Hit> expected(n);
+      tracer.intersect(lists.data() + l * kStride, expected.data(), n, RayMode::Single);
+      for (std::size_t k = 0; k < kStride; ++k) {
+        const Hit& got = hits[l * kStride + k];
+        if (k >= n) {
+          EXPECT_EQ(got.mesh, untouched.mesh)
+              << "list " << l << " place " << k << ", " << mode_name(mode);
+          continue;
+        }
+        const Hit& want = expected[k];
+        ASSERT_EQ(got.mesh, want.mesh) << "list " << l << " ray " << k << ", " << mode_name(mode);
+        hit_count += want.valid();
+        if (!want.valid()) continue;
+        EXPECT_EQ(got.triangle, want.triangle) << "list " << l << " ray " << k;
+        EXPECT_EQ(std::memcmp(&got.t, &want.t, sizeof got.t), 0) << "list " << l << " ray " << k;
+      }
+    }
+    EXPECT_GT(hit_count, 0u) << mode_name(mode);
   }
 }
 
