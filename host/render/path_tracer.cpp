@@ -231,14 +231,13 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
   const bool mis_with_bsdf =
       settings_.first_bounce_mis == FirstBounceMis::bsdf && !sampler.samples_the_bsdf();
   const SampleCoordinates first_at = first_bounce_coordinates(at, settings_.shared_randoms);
-  static_assert(kPathBlock == kGrain, "a block of pixels is one chunk of stream starts");
   const std::size_t n = g.pixel_count();
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, (n + kPathBlock - 1) / kPathBlock),
       [&](const auto& blocks) {
         // The pixels' path streams (and first-bounce streams where the BSDF's first bounce is
         // drawn here) started in vector lanes, a block at a time (render/stream_starts.h).
-        std::uint32_t path_starts[kGrain], first_starts[kGrain];
+        std::uint32_t path_starts[kPathBlock], first_starts[kPathBlock];
         for (std::size_t block = blocks.begin(); block != blocks.end(); ++block) {
           const std::size_t chunk = block * kPathBlock;
           const std::size_t chunk_end = std::min(n, chunk + kPathBlock);

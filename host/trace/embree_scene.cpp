@@ -244,29 +244,50 @@ void intersect_span(RTCScene scene, const Ray* rays, Hit* hits, std::size_t coun
   }
 }
 
+// The sum of span(first, n) over the spans of [0, count) handed to TBB's threads: kGrain rays,
+// or whole packets of 8 in Packet8 mode (packets start at multiples of 8 whatever the split).
+template <class Span>
+std::size_t over_spans(std::size_t count, RayMode mode, const Span& span) {
+  const std::size_t unit = mode == RayMode::Packet8 ? 8 : 1;
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, (count + unit - 1) / unit, kGrain / unit), std::size_t{0},
+      [&](const auto& range, std::size_t sum) {
+        const std::size_t first = range.begin() * unit;
+        return sum + span(first, std::min(count, range.end() * unit) - first);
+      },
+      std::plus<std::size_t>());
+}
+
+// The sum of span(first, n) over `lists` lists laid out `stride` apart: list l starts at
+// l * stride and holds counts[l] rays, at most stride.
+template <class Span>
+std::size_t over_lists(std::size_t stride, const std::uint32_t* counts, std::size_t lists,
+                       const Span& span) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, lists), std::size_t{0},
+      [&](const auto& range, std::size_t sum) {
+        for (std::size_t l = range.begin(); l != range.end(); ++l)
+          sum += span(l * stride, std::min<std::size_t>(counts[l], stride));
+        return sum;
+      },
+      std::plus<std::size_t>());
+}
+
 }  // namespace
 
 void EmbreeScene::intersect(const Ray* rays, Hit* hits, std::size_t count, RayMode mode) const {
-  RTCScene scene = impl_->scene;
-  // Packets start at multiples of 8 whatever the split.
-  const std::size_t unit = mode == RayMode::Packet8 ? 8 : 1;
-  const std::size_t units = (count + unit - 1) / unit;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, units, kGrain / unit),
-                    [&](const auto& range) {
-                      const std::size_t begin = range.begin() * unit;
-                      const std::size_t end = std::min(count, range.end() * unit);
-                      intersect_span(scene, rays + begin, hits + begin, end - begin, mode);
-                    });
+  over_spans(count, mode, [&](std::size_t first, std::size_t n) {
+    intersect_span(impl_->scene, rays + first, hits + first, n, mode);
+    return std::size_t{0};
+  });
 }
 
 void EmbreeScene::intersect_lists(const Ray* rays, Hit* hits, std::size_t stride,
                                   const std::uint32_t* counts, std::size_t lists,
                                   RayMode mode) const {
-  RTCScene scene = impl_->scene;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lists), [&](const auto& range) {
-    for (std::size_t l = range.begin(); l != range.end(); ++l)
-      intersect_span(scene, rays + l * stride, hits + l * stride,
-                     std::min<std::size_t>(counts[l], stride), mode);
+  over_lists(stride, counts, lists, [&](std::size_t first, std::size_t n) {
+    intersect_span(impl_->scene, rays + first, hits + first, n, mode);
+    return std::size_t{0};
   });
 }
 
@@ -409,33 +430,17 @@ std::size_t occluded_span(RTCScene scene, const Ray* rays, std::uint8_t* occlude
 
 std::size_t EmbreeScene::occluded(const Ray* rays, std::uint8_t* occluded, std::size_t count,
                                   RayMode mode) const {
-  RTCScene scene = impl_->scene;
-  // Packets start at multiples of 8 whatever the split.
-  const std::size_t unit = mode == RayMode::Packet8 ? 8 : 1;
-  const std::size_t units = (count + unit - 1) / unit;
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, units, kGrain / unit), std::size_t{0},
-      [&](const auto& range, std::size_t queried) {
-        const std::size_t begin = range.begin() * unit;
-        const std::size_t end = std::min(count, range.end() * unit);
-        return queried + occluded_span(scene, rays + begin, occluded + begin, end - begin, mode);
-      },
-      std::plus<std::size_t>());
+  return over_spans(count, mode, [&](std::size_t first, std::size_t n) {
+    return occluded_span(impl_->scene, rays + first, occluded + first, n, mode);
+  });
 }
 
 std::size_t EmbreeScene::occluded_lists(const Ray* rays, std::uint8_t* occluded, std::size_t stride,
                                         const std::uint32_t* counts, std::size_t lists,
                                         RayMode mode) const {
-  RTCScene scene = impl_->scene;
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, lists), std::size_t{0},
-      [&](const auto& range, std::size_t queried) {
-        for (std::size_t l = range.begin(); l != range.end(); ++l)
-          queried += occluded_span(scene, rays + l * stride, occluded + l * stride,
-                                   std::min<std::size_t>(counts[l], stride), mode);
-        return queried;
-      },
-      std::plus<std::size_t>());
+  return over_lists(stride, counts, lists, [&](std::size_t first, std::size_t n) {
+    return occluded_span(impl_->scene, rays + first, occluded + first, n, mode);
+  });
 }
 
 }  // namespace rtpg
