@@ -80,9 +80,9 @@ const std::vector<glm::vec4>& SvgfReference::denoise(const std::vector<glm::vec4
   }
   if (in != &filtered_) filtered_ = *in;
   remodulate(colour, g);
-  prev_position_depth_ = g.position_depth;
-  prev_normal_ = g.shading_normal;
-  prev_material_ = g.material;
+  prev_position_depth_.assign(g.position_depth.begin(), g.position_depth.end());
+  prev_normal_.assign(g.shading_normal.begin(), g.shading_normal.end());
+  prev_material_.assign(g.material.begin(), g.material.end());
   prev_moments_ = moments_;
   has_history_ = true;
   return output_;

@@ -14,17 +14,18 @@
 #include "scene/camera.h"
 #include "shared/bsdf.h"
 #include "shared/compat.h"
+#include "util/huge_pages.h"
 
 namespace rtpg {
 
 struct GBuffer {
   int width = 0, height = 0;
-#define RTPG_HOST_CHANNEL(name, type, bytes) std::vector<shared::type> name;
+#define RTPG_HOST_CHANNEL(name, type, bytes) LargeVector<shared::type> name;
   PG_GBUFFER_CHANNELS(RTPG_HOST_CHANNEL)
 #undef RTPG_HOST_CHANNEL
-  std::vector<glm::vec4> geometric_normal;  // xyz, facing the camera; w the offset distance
+  LargeVector<glm::vec4> geometric_normal;  // xyz, facing the camera; w the offset distance
                                             // (SurfacePoint::offset_distance)
-  std::vector<glm::vec4> emission;          // rgb emitted towards the camera (or sky radiance)
+  LargeVector<glm::vec4> emission;          // rgb emitted towards the camera (or sky radiance)
   CameraFrame camera;                       // the camera the primary rays came from
   // Last frame's camera, which the motion vectors point into, and whether the camera moved
   // (where it did not, every motion vector is zero whatever the jitter).

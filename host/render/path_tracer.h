@@ -19,6 +19,7 @@
 #include "scene/scene.h"
 #include "shared/rng.h"
 #include "trace/embree_scene.h"
+#include "util/huge_pages.h"
 
 namespace rtpg {
 
@@ -247,8 +248,8 @@ class PathTracer {
   bool first_bounce_mis_deferred_ = false;
 
   // Scratch, reused across frames.
-  std::vector<PathState> paths_;
-  std::vector<VplPath> vpl_paths_;  // per pixel, where keep_vpls_
+  LargeVector<PathState> paths_;
+  LargeVector<VplPath> vpl_paths_;  // per pixel, where keep_vpls_
   bool keep_vpls_ = false;          // this pass writes VPLs (trace()'s vpls)
   bool next_event_on_ = true;       // next-event estimation this frame (settings and lights)
   // The paths are shaded in blocks of kPathBlock slots, fixed whatever the thread count: block
@@ -259,18 +260,18 @@ class PathTracer {
   // of the last bounce holds what is left of its pixels' paths (docs/host-path-tracer.md,
   // "Shadow rays listed where they are made", "Bounce rays listed in place").
   static constexpr std::size_t kPathBlock = 2048;
-  std::vector<std::uint32_t> active_;
-  std::vector<Ray> rays_;
-  std::vector<Hit> hits_;
+  LargeVector<std::uint32_t> active_;
+  LargeVector<Ray> rays_;
+  LargeVector<Hit> hits_;
   std::vector<std::uint32_t> ray_counts_;  // per block
   // Per shadow-ray entry: the ray, what it adds to its path's radiance if unoccluded, the path,
   // and Embree's answer.
-  std::vector<Ray> shadow_rays_;
-  std::vector<glm::vec3> shadow_contribution_;
-  std::vector<std::uint32_t> shadow_path_;
-  std::vector<std::uint8_t> occluded_;
+  LargeVector<Ray> shadow_rays_;
+  LargeVector<glm::vec3> shadow_contribution_;
+  LargeVector<std::uint32_t> shadow_path_;
+  LargeVector<std::uint8_t> occluded_;
   std::vector<std::uint32_t> shadow_counts_;  // per block
-  std::vector<BorrowablePixel> borrowable_;   // per pixel, with guide_secondary
+  LargeVector<BorrowablePixel> borrowable_;   // per pixel, with guide_secondary
 
   // The world guide (set_world_guide) and what a path records for it at each later vertex that
   // sampled a bounce: the bounce's training sample without its weight, the path's throughput
@@ -283,10 +284,10 @@ class PathTracer {
     glm::vec3 throughput, radiance_before;
   };
   const WorldGuide* world_guide_ = nullptr;
-  std::vector<WorldVertex> world_vertices_;  // [path * world_stride_ + depth - 1]
+  LargeVector<WorldVertex> world_vertices_;  // [path * world_stride_ + depth - 1]
   int world_depths_ = 0;                     // the depths the guide covers (prepare)
   std::size_t world_stride_ = 1;             // records per path: max(1, world_depths_)
-  std::vector<std::uint8_t> world_depth_;    // per path: vertices recorded (or kNotRecording)
+  LargeVector<std::uint8_t> world_depth_;    // per path: vertices recorded (or kNotRecording)
   static constexpr std::uint8_t kNotRecording = 0xff;
   // Blocks of kWorldBlock paths of each pass, in order; world_blocks_used_ of them hold this
   // frame's samples (the vectors keep their memory).

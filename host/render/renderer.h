@@ -20,6 +20,7 @@
 #include "rtpg/errors.h"
 #include "scene/scene.h"
 #include "trace/embree_scene.h"
+#include "util/huge_pages.h"
 
 namespace rtpg {
 
@@ -104,8 +105,8 @@ class Renderer {
   // the VPLs in place, and its destructor waits for it (GuidedFirstBounce, Overlap).
   std::unique_ptr<FirstBounceSampler> sampler_;
   std::vector<glm::vec3> image_, pass_;
-  std::vector<Ray> camera_rays_;
-  std::vector<Hit> camera_hits_;
+  LargeVector<Ray> camera_rays_;
+  LargeVector<Hit> camera_hits_;
 };
 
 // Largest image the renderer accepts (pixels); beyond it buffers would not fit in memory.

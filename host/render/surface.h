@@ -12,6 +12,7 @@
 #include "scene/scene.h"
 #include "shared/bsdf.h"
 #include "trace/ray.h"
+#include "util/huge_pages.h"
 
 namespace rtpg {
 
@@ -56,7 +57,7 @@ class TriangleTable {
   }
 
  private:
-  std::vector<std::vector<TriangleFacts>> facts_;
+  std::vector<LargeVector<TriangleFacts>> facts_;
 };
 
 // Interpolates and textures the hit of `ray`; `hit` must be valid. The first form computes the

@@ -11,6 +11,8 @@
 
 #include <glm/glm.hpp>
 
+#include "util/huge_pages.h"
+
 namespace rtpg {
 
 // The sRGB transfer function's inverse: an encoded value in [0, 1] to linear.
@@ -24,13 +26,13 @@ struct Texture {
   std::string path;  // where it was read from (for messages and `rtpg info`)
   int width = 0, height = 0;
   // The texels, row 0 = top of the image, in one of two forms:
-  std::vector<glm::vec4> texels;  // linear floats (float images, textures built in code), or
-  std::vector<std::array<std::uint8_t, 4>> texels8;  // 8-bit RGBA as stored, decoded on fetch:
+  LargeVector<glm::vec4> texels;  // linear floats (float images, textures built in code), or
+  LargeVector<std::array<std::uint8_t, 4>> texels8;  // 8-bit RGBA as stored, decoded on fetch:
   bool srgb = false;  // texels8's RGB through the sRGB table (else / 255); alpha always / 255
   // Bump maps only (prepare_bump_slopes): per texel, the difference of channel 0 to the next
   // texel along +u and along +v (the row above), so that a bump's gradient is one bilinear
   // lookup of 4 texels instead of three lookups of 12.
-  std::vector<glm::vec2> slopes;
+  LargeVector<glm::vec2> slopes;
   glm::vec4 fetch(int x, int y) const;
   // uv in texture space with (0,0) = bottom-left (OBJ/glTF convention after loading), repeat.
   glm::vec4 sample(glm::vec2 uv) const;
