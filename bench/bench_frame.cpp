@@ -1,7 +1,8 @@
 // Whole path-traced frames (Renderer::render_frame, 1 spp) per stage, guiding off and pmm,
 // and how far they are from what Embree alone needs for the same rays.
 //
-//   bench_frame                   Cornell 640x360 and 1920x1080, Sponza 640x360
+//   bench_frame                   Cornell 640x360, 960x540 and 1920x1080, Sponza 640x360 and
+//                                 960x540
 //   bench_frame --rtpg_full       also Sponza 1920x1080 (about a minute more)
 //   bench_frame --benchmark_filter='cornell/1920'
 //
@@ -148,8 +149,13 @@ void register_all(bool full) {
     const char* scene;
     int w, h, iterations;
   };
-  std::vector<Config> configs = {
-      {"cornell", 640, 360, 3}, {"cornell", 1920, 1080, 1}, {"sponza", 640, 360, 3}};
+  // 960x540 and 1920x1080: the sizes issue 14's bound is stated at; 640x360 for the figures
+  // measured before 960x540 was here (docs/host-path-tracer.md).
+  std::vector<Config> configs = {{"cornell", 640, 360, 3},
+                                 {"cornell", 960, 540, 3},
+                                 {"cornell", 1920, 1080, 1},
+                                 {"sponza", 640, 360, 3},
+                                 {"sponza", 960, 540, 2}};
   if (full) configs.push_back({"sponza", 1920, 1080, 1});
   for (const Config& c : configs)
     for (bool guided : {false, true}) {
