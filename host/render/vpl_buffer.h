@@ -10,18 +10,19 @@
 
 #include "rtpg/guiding_layout.h"
 #include "shared/compat.h"
+#include "util/huge_pages.h"
 
 namespace rtpg {
 
 struct VplBuffer {
-#define RTPG_HOST_CHANNEL(name, type, bytes) std::vector<shared::type> name;
+#define RTPG_HOST_CHANNEL(name, type, bytes) LargeVector<shared::type> name;
   PG_VPL_CHANNELS(RTPG_HOST_CHANNEL)
-  std::vector<std::uint32_t> info;  // PG_VPL_* bits, the strategy in bits 8..15
+  LargeVector<std::uint32_t> info;  // PG_VPL_* bits, the strategy in bits 8..15
   // Host only, from the first bounce to its hit: the density (solid angle at x0) of the
   // strategy that drew the direction, which becomes position.w in area measure at the hit.
   // Kept apart so that the path tracer writes position, normal and mixture density once, at
   // the hit, instead of some at x0 and the rest at y (docs/guiding.md, "The VPLs written once").
-  std::vector<float> strategy_pdf;
+  LargeVector<float> strategy_pdf;
 
   // The VPLs as they cross the bus (PG_PACKED_VPL_CHANNELS: distance, radiance, normal), which
   // the path tracer writes beside the layout where for_bus is set (the guided first bounce with
