@@ -1,6 +1,7 @@
 #include "util/huge_pages.h"
 
 #include <cstdint>
+#include <limits>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -33,6 +34,8 @@ void deallocate_small(void* p, std::size_t alignment) noexcept {
 void* allocate_large(std::size_t bytes, std::size_t alignment) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   if (!is_large_allocation(bytes)) return allocate_small(bytes, alignment);
+  // The rounding and the extra huge page below must not wrap around.
+  if (bytes > std::numeric_limits<std::size_t>::max() - 2 * kHugePageBytes) throw std::bad_alloc();
   const std::size_t size = round_up(bytes, kHugePageBytes);
   // One huge page more than needed, so that a 2 MiB boundary lies inside; the slack on either
   // side is given back.

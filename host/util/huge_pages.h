@@ -1,8 +1,9 @@
 // Memory for the renderer's large arrays (the path tracer's per-path state and rays, the
-// G-buffer, textures, meshes) in 2 MiB pages where the kernel gives transparent huge pages on
-// request (THP "madvise", Debian's default; "always" gives them anyway): the shading loop and
-// the passes after each vertex read these arrays at scattered places, and with 4 KiB pages most
-// of those reads also miss the TLB (docs/host-path-tracer.md, "Large arrays in huge pages").
+// G-buffer, the VPLs, textures, the triangle table) in 2 MiB pages where the kernel gives
+// transparent huge pages on request (THP "madvise", Debian's default; "always" gives them anyway):
+// the shading loop and the passes after each vertex read these arrays at scattered places, and with
+// 4 KiB pages most of those reads also miss the TLB (docs/host-path-tracer.md, "Large arrays in
+// huge pages").
 //
 // An array of 2 MiB or more is its own mapping, 2 MiB aligned and rounded up to whole 2 MiB,
 // marked MADV_HUGEPAGE before its first touch (after it, only the kernel's background
@@ -19,7 +20,8 @@ namespace rtpg {
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
 // bytes of memory aligned to `alignment` (a power of two up to kHugePageBytes); throws
-// std::bad_alloc. Free with deallocate_large and the same byte count and alignment.
+// std::bad_alloc, also where bytes rounded up to whole huge pages would not fit a size_t. Free
+// with deallocate_large and the same byte count and alignment.
 void* allocate_large(std::size_t bytes, std::size_t alignment);
 void deallocate_large(void* p, std::size_t bytes, std::size_t alignment) noexcept;
 

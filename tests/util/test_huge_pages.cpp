@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -63,6 +64,15 @@ TEST(HugePages, LargeArraysAreAlignedToTwoMiBAndKeepTheirValuesAsTheyGrow) {
   const LargeVector<std::uint32_t> moved = std::move(v);
   EXPECT_EQ(moved.size(), n);
   EXPECT_EQ(moved[n - 1], (n - 1) * 2654435761u);
+}
+
+TEST(HugePages, SizesNearTheLimitAreRefusedNotWrappedAround) {
+  // Rounded up to whole huge pages such sizes would wrap around to a small mapping.
+  const std::size_t max = std::numeric_limits<std::size_t>::max();
+  for (const std::size_t bytes : {max, max - 1, max - kHugePageBytes, max - 2 * kHugePageBytes + 1})
+    EXPECT_THROW(allocate_large(bytes, 16), std::bad_alloc) << bytes;
+  LargeVector<double> v;
+  EXPECT_THROW(v.resize(max / 16), std::bad_alloc);
 }
 
 TEST(HugePages, LargeArraysAreMarkedForHugePagesBeforeTheirFirstTouch) {
