@@ -1,0 +1,97 @@
+#!/usr/bin/env python3
+"""Builds or settings compared on the same frames, in turns: each round runs `rtpg render` once per
+--run, in the order given, and reads its stage times (`--stats-json`); printed are, per stage, each
+round's median over the frames after the first --skip, then the median over the rounds. On a
+shared machine only runs made in turns compare (docs/host-path-tracer.md's before / after tables
+are made so).
+
+A --run is "NAME: [VAR=VALUE ...] BINARY [ARGUMENT ...]": environment assignments, the rtpg binary,
+and arguments added to `render SCENE --res RES --frames FRAMES`.
+
+Usage:
+  ab_frames.py --scene scenes/sponza.json [--res 960x540] [--frames 8] [--skip 2] [--rounds 3]
+               --run "before: /tmp/rtpg-old --guiding off" --run "after: build/rtpg --guiding off"
+"""
+import argparse
+import json
+import os
+import shlex
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+# The frame's stages in the order of a frame (FrameStats "time_ms"); those a run has.
+STAGES = ["total", "primary", "gbuffer", "guiding_begin", "first_bounce", "shade", "trace",
+          "compact", "guiding_end", "reproject", "sample", "train", "svgf_total"]
+
+
+def parse_run(text):
+    name, sep, rest = text.partition(":")
+    words = shlex.split(rest)
+    env = {}
+    while words and "=" in words[0] and not words[0].startswith("-"):
+        var, _, value = words.pop(0).partition("=")
+        env[var] = value
+    if not sep or not name.strip() or not words:
+        sys.exit(f"ab_frames: --run {text!r}: expected 'NAME: [VAR=VALUE ...] BINARY [ARGUMENT ...]'")
+    return name.strip(), env, words[0], words[1:]
+
+
+def stage_medians(stats_path, skip):
+    frames = json.loads(Path(stats_path).read_text())["frames"]
+    kept = frames[skip:] or frames
+    names = [s for s in STAGES if any(s in f["time_ms"] for f in kept)]
+    return {s: statistics.median(f["time_ms"].get(s, 0.0) for f in kept) for s in names}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scene", required=True)
+    parser.add_argument("--res", default="960x540")
+    parser.add_argument("--frames", type=int, default=8)
+    parser.add_argument("--skip", type=int, default=2, help="frames left out at the start")
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--run", action="append", required=True, help="see the usage above")
+    args = parser.parse_args()
+    if args.frames < 1 or args.rounds < 1 or args.skip < 0:
+        sys.exit("ab_frames: --frames and --rounds must be at least 1, --skip at least 0")
+    runs = [parse_run(r) for r in args.run]
+    if len({name for name, _, _, _ in runs}) != len(runs):
+        sys.exit("ab_frames: two runs share a name")
+
+    results = {name: [] for name, _, _, _ in runs}
+    with tempfile.TemporaryDirectory() as tmp:
+        for r in range(args.rounds):
+            for name, env, binary, extra in runs:
+                stats = Path(tmp) / "stats.json"
+                command = [binary, "render", args.scene, "--res", args.res, "--frames",
+                           str(args.frames), "-q", "-o", str(Path(tmp) / "image.exr"),
+                           "--stats-json", str(stats)] + extra
+                done = subprocess.run(command, env={**os.environ, **env},
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                if done.returncode != 0:
+                    sys.exit(f"ab_frames: run {name!r} failed ({done.returncode}): "
+                             f"{shlex.join(command)}\n{done.stderr}")
+                medians = stage_medians(stats, args.skip)
+                results[name].append(medians)
+                print(f"round {r + 1} {name}: " +
+                      ", ".join(f"{s} {v:.2f}" for s, v in medians.items()), flush=True)
+
+    stages = [s for s in STAGES if any(s in m for ms in results.values() for m in ms)]
+    print(f"\n{args.scene} at {args.res}, {args.frames} frames, medians of frames "
+          f"{args.skip}-{args.frames - 1}, ms, rounds in turns:\n")
+    print("| stage | " + " | ".join(results) + " |")
+    print("|---" * (len(results) + 1) + "|")
+    for s in stages:
+        cells = []
+        for ms in results.values():
+            values = [m.get(s, 0.0) for m in ms]
+            cells.append(", ".join(f"{v:.2f}" for v in values) +
+                         (f" (median {statistics.median(values):.2f})" if len(values) > 1 else ""))
+        print(f"| {s} | " + " | ".join(cells) + " |")
+
+
+if __name__ == "__main__":
+    main()
