@@ -29,9 +29,13 @@ struct SurfacePoint {
   bool transmissive = false;
 };
 
-// What a surface point needs of its triangle and not of the hit: the same for every hit on the
-// triangle, so the renderer computes it once per scene (TriangleTable) instead of per hit.
-struct alignas(16) TriangleFacts {
+// What a surface point needs of its triangle and not of the hit, the same for every hit on it,
+// so the renderer computes it once per scene (TriangleTable) instead of per hit, with the
+// triangle's vertex positions copied in: one cache line is all a hit on an untextured,
+// flat-shaded triangle reads, where the mesh's arrays are an index triple and three positions at
+// scattered places (docs/host-path-tracer.md, "Triangles read as one record").
+struct alignas(64) TriangleFacts {
+  glm::vec3 position[3]{};  // the mesh's positions of its vertices, in its winding's order
   glm::vec3 normal{0.0f, 0.0f, 1.0f};  // normalize(cross(p1 - p0, p2 - p0)), facing no ray yet
   // dot(|normal|, gamma(7) * max|p_i|): SurfacePoint::offset_distance of every point on it
   float offset_distance = 0.0f;
@@ -39,25 +43,50 @@ struct alignas(16) TriangleFacts {
   // normalize(normal) for a mesh without vertex normals (normalised once more, as the per-hit
   // code does), and for a triangle whose three vertex normals are the same vector, that vector
   // normalised (then interpolating it would only round it; docs/host-path-tracer.md, "What a
-  // scene does not use, skipped").
+  // scene does not use, skipped"). The zero vector where the shading normal is interpolated per
+  // hit from TriangleVertices::normal.
   glm::vec3 flat_shading_normal{0.0f, 0.0f, 1.0f};
-  // 1 where flat_shading_normal is the shading normal (no interpolation), else 0.
-  std::uint32_t constant_shading_normal = 1;
+  bool constant_shading_normal() const { return flat_shading_normal != glm::vec3(0.0f); }
 };
-// The facts of triangle `triangle` of `mesh`, from its positions and vertex normals.
+// The per-vertex attributes a hit on the triangle interpolates, copied from the mesh: the second
+// cache line of a triangle, read only where the shading normal varies over it or its material
+// has a texture.
+struct alignas(64) TriangleVertices {
+  glm::vec3 normal[3]{};  // the mesh's vertex normals; zero where it has none
+  glm::vec2 uv[3]{};      // the mesh's texture coordinates; zero where it has none
+};
+// The facts and the vertices of triangle `triangle` of `mesh`, from its positions, vertex normals
+// and texture coordinates.
 TriangleFacts triangle_facts(const Mesh& mesh, std::uint32_t triangle);
+TriangleVertices triangle_vertices(const Mesh& mesh, std::uint32_t triangle);
+// Whether a hit on `mesh` can read its triangles' TriangleVertices: its material has a texture,
+// or some triangle's shading normal varies over it.
+bool mesh_reads_triangle_vertices(const Scene& scene, const Mesh& mesh);
 
-// The facts of every triangle of a scene, from its positions as they are when the table is built
-// (the renderer builds it with its BVH; a scene changed afterwards needs both rebuilt).
+// The facts of every triangle of a scene, and the vertices of those whose mesh reads them, from
+// the meshes as they are when the table is built (the renderer builds it with its BVH; a scene
+// changed afterwards needs both rebuilt). Each kind in one array over all meshes, so that the
+// scene's surfaces share huge pages (util/huge_pages.h).
 class TriangleTable {
  public:
   explicit TriangleTable(const Scene& scene);
   const TriangleFacts& at(std::uint32_t mesh, std::uint32_t triangle) const {
-    return facts_[mesh][triangle];
+    return mesh_facts_[mesh][triangle];
+  }
+  // nullptr where mesh_reads_triangle_vertices is false for the mesh.
+  const TriangleVertices* vertices(std::uint32_t mesh, std::uint32_t triangle) const {
+    const TriangleVertices* v = mesh_vertices_[mesh];
+    return v != nullptr ? v + triangle : nullptr;
+  }
+  std::size_t bytes() const {
+    return facts_.size() * sizeof(TriangleFacts) + vertices_.size() * sizeof(TriangleVertices);
   }
 
  private:
-  std::vector<LargeVector<TriangleFacts>> facts_;
+  LargeVector<TriangleFacts> facts_;
+  LargeVector<TriangleVertices> vertices_;
+  std::vector<const TriangleFacts*> mesh_facts_;
+  std::vector<const TriangleVertices*> mesh_vertices_;
 };
 
 // Interpolates and textures the hit of `ray`; `hit` must be valid. The first form computes the
@@ -72,14 +101,14 @@ SurfacePoint make_surface_point(const Scene& scene, const TriangleTable& triangl
 // a path-traced frame (docs/host-path-tracer.md, "Surfaces loaded ahead"). None changes anything.
 // The stages pay only where that data does not stay in a core's cache (on the Cornell box and
 // the sunlit room they cost 4-6% of the shading): scene_surface_bytes says how much there is.
-// 1. the triangle's vertex indices and its facts;
+// 1. the triangle's facts and vertices, and its vertex indices where its mesh has tangents;
 void prefetch_surface_triangle(const Scene& scene, const TriangleTable& triangles, const Hit& hit);
-// 2. its vertices' positions, normals, uvs and tangents (reads the indices);
+// 2. its vertices' tangents, where its mesh has them (reads the indices);
 void prefetch_surface_vertices(const Scene& scene, const Hit& hit);
-// 3. the texels of every texture of its material at the hit's uv (reads the indices and uvs).
-void prefetch_surface_texels(const Scene& scene, const Hit& hit);
-// The bytes make_surface_point can read over a scene: its meshes' vertex and index arrays, the
-// triangle table's facts, and its textures' texels and slopes.
+// 3. the texels of every texture of its material at the hit's uv (reads the triangle's vertices).
+void prefetch_surface_texels(const Scene& scene, const TriangleTable& triangles, const Hit& hit);
+// The bytes make_surface_point can read over a scene: the triangle table's facts and vertices,
+// the meshes' tangents with their index arrays, and the textures' texels and slopes.
 std::size_t scene_surface_bytes(const Scene& scene);
 
 // Whether a pass over hits loads their surfaces ahead (the stages above): automatic where the
@@ -99,7 +128,7 @@ inline void prefetch_surfaces_ahead(const Scene& scene, const TriangleTable& tri
   if (triangle < end && hits[triangle].valid())
     prefetch_surface_triangle(scene, triangles, hits[triangle]);
   if (vertex < end && hits[vertex].valid()) prefetch_surface_vertices(scene, hits[vertex]);
-  if (texel < end && hits[texel].valid()) prefetch_surface_texels(scene, hits[texel]);
+  if (texel < end && hits[texel].valid()) prefetch_surface_texels(scene, triangles, hits[texel]);
 }
 
 // std::nextafter(x, +infinity) and std::nextafter(x, -infinity), to the bit for every float

@@ -123,7 +123,7 @@ TEST(SurfacePoint, ConstantVertexNormalsAreTheInterpolatedOnes) {
     const bool constant = m < 4 && m != 3;  // not the grazing one, nor the last-bit copies
     for (std::uint32_t t = 0; t < 2; ++t) {
       ASSERT_NEAR(table.at(m, t).normal.z, 1.0f, 1e-6f) << m;
-      EXPECT_EQ(table.at(m, t).constant_shading_normal, constant ? 1u : 0u) << m << " " << t;
+      EXPECT_EQ(table.at(m, t).constant_shading_normal(), constant) << m << " " << t;
     }
   }
   std::mt19937 gen(5);
@@ -149,6 +149,53 @@ TEST(SurfacePoint, ConstantVertexNormalsAreTheInterpolatedOnes) {
       }
     }
   }
+}
+
+// The table's records are the meshes' arrays read through the index, triangle by triangle:
+// positions in the facts, vertex normals and texture coordinates in the vertices of every mesh
+// whose hits read them (a sphere with vertex normals; a textured box, flat), and none for a flat
+// untextured box. Each of the three meshes placed after a mesh of another size, so that the
+// records of a mesh start at its own place in the scene's arrays.
+TEST(SurfacePoint, TheTriangleTableHoldsEachTrianglesVertices) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  Material textured;
+  textured.base_color_texture = 0;
+  scene.materials.push_back(textured);
+  Texture texture;
+  texture.width = texture.height = 1;
+  texture.texels.assign(1, glm::vec4(1.0f));
+  scene.textures.push_back(texture);
+  Mesh flat = make_box(glm::vec3(-1.0f), glm::vec3(1.0f));
+  flat.normals.clear();
+  Mesh sphere = make_sphere(glm::vec3(0.5f), 0.25f, 2, false);
+  Mesh textured_box = make_box(glm::vec3(2.0f), glm::vec3(3.0f, 4.0f, 5.0f));
+  textured_box.normals.clear();
+  textured_box.material = 1;
+  scene.meshes = {flat, sphere, textured_box};
+  ASSERT_FALSE(sphere.normals.empty());
+  ASSERT_FALSE(textured_box.uvs.empty());
+  const TriangleTable table(scene);
+  for (std::uint32_t m = 0; m < scene.meshes.size(); ++m) {
+    const Mesh& mesh = scene.meshes[m];
+    EXPECT_EQ(table.vertices(m, 0) != nullptr, m != 0) << m;
+    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      const glm::uvec3 tri = mesh.triangles[t];
+      const TriangleFacts& facts = table.at(m, t);
+      const TriangleVertices* vertices = table.vertices(m, t);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_TRUE(same_bits(facts.position[k], mesh.positions[tri[k]])) << m << " " << t;
+        if (vertices == nullptr) continue;
+        const glm::vec3 normal = mesh.normals.empty() ? glm::vec3(0.0f) : mesh.normals[tri[k]];
+        EXPECT_TRUE(same_bits(vertices->normal[k], normal)) << m << " " << t;
+        const glm::vec2 uv = mesh.uvs.empty() ? glm::vec2(0.0f) : mesh.uvs[tri[k]];
+        EXPECT_EQ(vertices->uv[k], uv) << m << " " << t;
+      }
+    }
+  }
+  EXPECT_EQ(table.bytes(), (flat.triangles.size() + 2 * sphere.triangles.size() +
+                            2 * textured_box.triangles.size()) *
+                               64);
 }
 
 // next_float_up and next_float_down against std::nextafter: zeros, subnormals, the extremes,
@@ -189,9 +236,10 @@ TEST(SurfacePoint, NextFloatIsStdNextafter) {
   EXPECT_EQ(differing, 0);
 }
 
-// The surface data make_surface_point can read, counted array by array: a flat box (positions,
-// uvs, indices), a sphere with normals, the triangle table's 32 bytes a triangle, an 8-bit
-// texture with bump slopes and a float texture.
+// The surface data make_surface_point can read, counted array by array: the triangle table's 64
+// bytes a triangle for a flat untextured box (whose tangents no hit reads), and 64 more of
+// vertices for a bump-mapped sphere, whose tangents (with its index array) shading reads too; an
+// 8-bit texture with bump slopes and a float texture.
 TEST(SurfacePoint, SceneSurfaceBytesCountsEveryArrayShadingReads) {
   Scene scene;
   scene.materials.push_back(Material{});
@@ -200,6 +248,10 @@ TEST(SurfacePoint, SceneSurfaceBytesCountsEveryArrayShadingReads) {
   Mesh sphere = make_sphere(glm::vec3(0.0f), 0.5f, 2, false);
   sphere.uvs.clear();
   sphere.tangents.assign(sphere.positions.size(), glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+  Material bumped;
+  bumped.bump_texture = 0;
+  scene.materials.push_back(bumped);
+  sphere.material = 1;
   scene.meshes = {box, sphere};
   Texture bytes8;
   bytes8.width = 5;
@@ -212,12 +264,16 @@ TEST(SurfacePoint, SceneSurfaceBytesCountsEveryArrayShadingReads) {
   floats.texels.resize(14);
   scene.textures = {bytes8, floats};
   std::size_t expected = 15 * 4 + 15 * 8 + 14 * 16;
-  for (const Mesh& m : scene.meshes)
-    expected += m.positions.size() * 12 + m.normals.size() * 12 + m.uvs.size() * 8 +
-                m.tangents.size() * 16 + m.triangles.size() * (12 + sizeof(TriangleFacts));
-  EXPECT_EQ(sizeof(TriangleFacts), 32u);
+  expected += box.triangles.size() * 64;
+  expected += sphere.triangles.size() * (64 + 64 + 12) + sphere.tangents.size() * 16;
+  EXPECT_EQ(sizeof(TriangleFacts), 64u);
+  EXPECT_EQ(sizeof(TriangleVertices), 64u);
   EXPECT_GT(box.uvs.size(), 0u);
-  EXPECT_GT(sphere.normals.size(), 0u);
+  EXPECT_GT(box.tangents.size(), 0u);
+  EXPECT_FALSE(mesh_reads_triangle_vertices(scene, box));
+  EXPECT_TRUE(mesh_reads_triangle_vertices(scene, sphere));
+  EXPECT_EQ(TriangleTable(scene).bytes(),
+            (box.triangles.size() + 2 * sphere.triangles.size()) * 64);
   EXPECT_EQ(scene_surface_bytes(scene), expected);
 }
 
