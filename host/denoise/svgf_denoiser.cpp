@@ -95,7 +95,16 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
                                               k->getInfo<CL_KERNEL_FUNCTION_NAME>() + ")");
     }
     const cl::Context& c = runtime.context();
-    auto buffer = [&](std::size_t bytes) { return cl::Buffer(c, CL_MEM_READ_WRITE, n * bytes); };
+    // The images only the device reads and writes; where it shares the host's memory, in host
+    // memory it uses in place, whose large arrays are in huge pages (PoCL's own allocations are
+    // in 4 KiB pages; docs/denoising.md, "The denoiser's images in huge pages").
+    host_images_.reserve(20);
+    auto buffer = [&](std::size_t bytes) {
+      if (!zero_copy_) return cl::Buffer(c, CL_MEM_READ_WRITE, n * bytes);
+      LargeVector<HostPage>& storage =
+          host_images_.emplace_back((n * bytes + sizeof(HostPage) - 1) / sizeof(HostPage));
+      return cl::Buffer(c, CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, n * bytes, storage.data());
+    };
     for (Surfaces& s : surfaces_) {
       s.position_depth = buffer(16);
       s.shading_normal = buffer(16);
