@@ -97,8 +97,8 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
     const cl::Context& c = runtime.context();
     // The images only the device reads and writes; where it shares the host's memory, in host
     // memory it uses in place, whose large arrays are in huge pages (PoCL's own allocations are
-    // in 4 KiB pages; docs/denoising.md, "The denoiser's images in huge pages").
-    host_images_.reserve(20);
+    // in 4 KiB pages; docs/denoising.md, "The denoiser's images in huge pages"). host_images_ may
+    // grow: moving a LargeVector keeps its storage where it is.
     auto buffer = [&](std::size_t bytes) {
       if (!zero_copy_) return cl::Buffer(c, CL_MEM_READ_WRITE, n * bytes);
       LargeVector<HostPage>& storage =

@@ -103,8 +103,9 @@ TriangleFacts triangle_facts(const Mesh& mesh, std::uint32_t triangle) {
       if (std::fabs(side) > 1e-3f) f.flat_shading_normal = side < 0.0f ? -shading : shading;
     }
   }
-  // A degenerate triangle's normal is NaN, and so its flat shading normal: not zero, so constant
-  // as before (the loader drops zero-area triangles; docs/robustness.md).
+  // A degenerate triangle's normal is NaN (the loader drops zero-area triangles;
+  // docs/robustness.md): without vertex normals its flat shading normal is NaN too, not zero, so
+  // constant; with them the side test fails and it stays per hit, as before.
   return f;
 }
 
