@@ -101,8 +101,7 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
     // grow: moving a LargeVector keeps its storage where it is.
     auto buffer = [&](std::size_t bytes) {
       if (!zero_copy_) return cl::Buffer(c, CL_MEM_READ_WRITE, n * bytes);
-      LargeVector<HostPage>& storage =
-          host_images_.emplace_back((n * bytes + sizeof(HostPage) - 1) / sizeof(HostPage));
+      LargeVector<glm::vec4>& storage = host_images_.emplace_back((n * bytes + 15) / 16);
       return cl::Buffer(c, CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, n * bytes, storage.data());
     };
     for (Surfaces& s : surfaces_) {

@@ -6,7 +6,6 @@
 #pragma once
 
 #include <array>
-#include <cstddef>
 #include <map>
 #include <memory>
 #include <string>
@@ -105,14 +104,11 @@ class SvgfDenoiser {
   // The a-trous kernel of the iterations up to the history iteration (atrous_ itself where both
   // radii are the same: SvgfSettings::history_atrous_radius).
   cl::Kernel history_atrous_;
-  // Where memory is shared (zero_copy_), the storage of the denoiser's own images below: host
-  // memory in transparent huge pages that the device uses in place (util/huge_pages.h;
-  // docs/denoising.md, "The denoiser's images in huge pages"). Declared before the buffers, so
-  // that it outlives them.
-  struct alignas(4096) HostPage {
-    std::byte bytes[4096];
-  };
-  std::vector<LargeVector<HostPage>> host_images_;
+  // Where memory is shared (zero_copy_), the storage of the denoiser's own images below, in
+  // whole float4s: host memory in transparent huge pages that the device uses in place
+  // (util/huge_pages.h; docs/denoising.md, "The denoiser's images in huge pages"). Declared
+  // before the buffers, so that it outlives them.
+  std::vector<LargeVector<glm::vec4>> host_images_;
   std::array<Surfaces, 2> surfaces_;
   std::array<cl::Buffer, 2> moments_;  // this frame's and last frame's
   int current_ = 0;
