@@ -24,8 +24,11 @@
 //   ratio                 frame_ms / embree_only_ms
 //   guiding_overhead      pmm only: (pmm frame - off frame) / off frame, with an off frame
 //                         rendered in every iteration next to the pmm one
-// The renderers are built and warmed up (kernel compiles, a few frames of training) once per
-// scene and resolution, outside the timed loops.
+// The renderers are built and warmed up (kernel compiles, a few frames of training, and the
+// frames in which BounceRayOrder::automatic times the two orders of the bounce rays) once per
+// scene and resolution, outside the timed loops. The Embree-alone yardstick traces its bounce
+// rays in pixel order, as Embree is handed them without the renderer's grouping
+// (docs/host-path-tracer.md, "Bounce rays traced in groups").
 #include "bench_common.h"
 #include "bench_roofline.h"
 
@@ -35,6 +38,7 @@
 #include "rtpg/cl_runtime.h"
 #include "render/guided_first_bounce.h"
 #include "render/renderer.h"
+#include "trace/ray_order.h"
 
 namespace rtpg::bench {
 namespace {
@@ -46,7 +50,8 @@ struct FrameSetup {
   int next_off = 0, next_pmm = 0;
 };
 
-constexpr int kWarmupOff = 2, kWarmupPmm = 3;
+// Past the frames in which the bounce rays' order is chosen by timing (TimedChoice).
+constexpr int kWarmupOff = 1 + 2 * TimedChoice::kTrials, kWarmupPmm = kWarmupOff;
 
 FrameSetup* setup_for(const std::string& scene_name, int w, int h, std::string* why) {
   static std::map<std::tuple<std::string, int, int>, std::unique_ptr<FrameSetup>> cache;

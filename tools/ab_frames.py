@@ -23,7 +23,7 @@ import tempfile
 from pathlib import Path
 
 # The frame's stages in the order of a frame (FrameStats "time_ms"); those a run has.
-STAGES = ["total", "primary", "gbuffer", "guiding_begin", "first_bounce", "shade", "trace",
+STAGES = ["total", "primary", "gbuffer", "guiding_begin", "first_bounce", "shade", "group_rays", "trace",
           "compact", "guiding_end", "reproject", "sample", "train", "svgf_total"]
 
 

@@ -148,6 +148,27 @@ const char* shared_randoms_name(SharedRandoms s) {
   return "none";
 }
 
+const char* bounce_ray_order_name(BounceRayOrder order) {
+  switch (order) {
+    case BounceRayOrder::grouped:
+      return "grouped";
+    case BounceRayOrder::listed:
+      return "listed";
+    case BounceRayOrder::automatic:
+      break;
+  }
+  return "auto";
+}
+
+// The value of --bounce-ray-order (checked by the command line's parser; a wrong name from
+// elsewhere is an input error naming the flag).
+BounceRayOrder parse_bounce_ray_order(const std::string& name) {
+  if (name == "auto") return BounceRayOrder::automatic;
+  if (name == "grouped") return BounceRayOrder::grouped;
+  if (name == "listed") return BounceRayOrder::listed;
+  throw InputError("--bounce-ray-order", "unknown value '" + name + "' (auto, grouped or listed)");
+}
+
 nlohmann::json path_tracer_settings_json(const PathTracerSettings& s) {
   return {{"max_bounces", s.max_bounces},
           {"roulette_start", s.roulette_start},
@@ -155,7 +176,8 @@ nlohmann::json path_tracer_settings_json(const PathTracerSettings& s) {
           {"guide_secondary", s.guide_secondary},
           {"direct_light_in_vpls", s.direct_light_in_vpls},
           {"first_bounce_mis", s.first_bounce_mis == FirstBounceMis::bsdf ? "bsdf" : "mixture"},
-          {"shared_randoms", shared_randoms_name(s.shared_randoms)}};
+          {"shared_randoms", shared_randoms_name(s.shared_randoms)},
+          {"bounce_ray_order", bounce_ray_order_name(s.bounce_ray_order)}};
 }
 
 // The value of --share-randoms (checked by the command line's parser; a wrong name from
@@ -244,6 +266,7 @@ int run_render(const RenderCommand& command) {
   settings.path_tracer.first_bounce_mis =
       command.first_bounce_mis == "bsdf" ? FirstBounceMis::bsdf : FirstBounceMis::mixture;
   settings.path_tracer.shared_randoms = parse_shared_randoms(command.share_randoms);
+  settings.path_tracer.bounce_ray_order = parse_bounce_ray_order(command.bounce_ray_order);
   settings.path_tracer.guide_position = command.guiding_settings.reproject_position;
   settings.path_tracer.guide_normal = command.guiding_settings.reproject_normal;
   Renderer renderer = with_flag_names([&] { return Renderer(scene, settings); });

@@ -44,6 +44,7 @@ struct RenderCommand {
   float world_guide_min_pi = 0.0f;         // --world-guide-min-pi
   float world_guide_pi_max = -1.0f;        // --world-guide-pi-max (< 0: the pixels' --pg-pi-max)
   std::string share_randoms = "none";      // --share-randoms: SharedRandoms by name
+  std::string bounce_ray_order = "auto";   // --bounce-ray-order: BounceRayOrder by name
                                            // (host/render/path_tracer.h)
   GuidingSettings guiding_settings;
   std::string train_memory = "auto";

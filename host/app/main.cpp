@@ -200,6 +200,14 @@ int main(int argc, char** argv) {
                    "(bench/variance_split.py); none is the renderer")
       ->check(CLI::IsMember({"none", "first-bounce", "primary-vertex", "second-vertex"}))
       ->capture_default_str();
+  render_cmd
+      ->add_option("--bounce-ray-order", render.bounce_ray_order,
+                   "Order of each bounce's rays for Embree: grouped (by direction octant and "
+                   "the origin's cell of a coarse grid), listed (as the path blocks list them) "
+                   "or auto (grouped where the scene's BVH outgrows a core's cache); the images "
+                   "are the same")
+      ->check(CLI::IsMember({"auto", "grouped", "listed"}))
+      ->capture_default_str();
   render_cmd->add_option("-o,--output", render.output,
                          "Last frame: .exr (linear) or .png (tonemapped)");
   render_cmd

@@ -13,6 +13,7 @@
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_scan.h>
 
+#include "render/cpu_code.h"
 #include "render/mis.h"
 #include "render/stream_starts.h"
 #include "render/surface.h"
@@ -94,8 +95,25 @@ float guide_density(const PixelGuide& guide, const glm::vec3& w, float bsdf_pdf)
 PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer,
                        const TriangleTable& triangles, const Lights& lights,
                        PathTracerSettings settings)
-    : scene_(scene), tracer_(tracer), triangles_(triangles), lights_(lights), settings_(settings) {
+    : scene_(scene),
+      tracer_(tracer),
+      triangles_(triangles),
+      lights_(lights),
+      settings_(settings),
+      may_group_(may_group_bounce_rays(settings.bounce_ray_order, scene)),
+      ray_order_(scene.bounds_min(), scene.bounds_max()) {
   prefetch_surfaces_ = rtpg::loads_surfaces_ahead(settings_.surface_prefetch, scene);
+}
+
+bool may_group_bounce_rays(BounceRayOrder setting, const Scene& scene) {
+  if (setting != BounceRayOrder::automatic) return setting == BounceRayOrder::grouped;
+  // Embree 3's BVH takes 70-96 bytes a triangle (measured with its memory monitor at 36 to
+  // 262,000 triangles); grouping costs about 10 ns a ray on two cores, which a BVH held in a
+  // core's cache does not win back (docs/host-path-tracer.md, "Bounce rays traced in groups").
+  constexpr std::size_t kBvhBytesPerTriangle = 80;
+  std::size_t triangles = 0;
+  for (const Mesh& mesh : scene.meshes) triangles += mesh.triangles.size();
+  return triangles * kBvhBytesPerTriangle > core_cache_bytes();
 }
 
 void PathTracer::trace(const GBuffer& g, const FirstBounceSource& first,
@@ -109,6 +127,8 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSource& first,
   first_bounce_mis_deferred_ =
       settings_.first_bounce_mis == FirstBounceMis::mixture && !sampler.samples_the_bsdf();
   prepare(n, vpls);
+  const bool timing_choice = may_group_ && settings_.bounce_ray_order == BounceRayOrder::automatic;
+  group_this_pass_ = may_group_ && (!timing_choice || order_choice_.next_takes_second());
   auto start = Clock::now();
   if (first.await) {
     // The primary hit's light samples and their shadow rays while the device makes the first
@@ -131,10 +151,18 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSource& first,
   apply_shadow_rays(true);
   times.compact_ms += ms_since(start);
 
+  // The bounce loop's time and rays, for order_choice_.
+  const auto loop_start = Clock::now();
+  const std::uint64_t loop_rays = rays.secondary + rays.shadow;
   for (int depth = 1; depth <= settings_.max_bounces; ++depth) {
     std::size_t m = 0;
     for (const std::uint32_t count : ray_counts_) m += count;
     if (m == 0) break;
+    if (group_this_pass_) {
+      start = Clock::now();
+      group_rays();
+      times.group_ms += ms_since(start);
+    }
     start = Clock::now();
     tracer_.intersect_lists(rays_.data(), hits_.data(), kPathBlock, ray_counts_.data(),
                             ray_counts_.size(), kBounceRayMode);
@@ -149,6 +177,9 @@ void PathTracer::trace(const GBuffer& g, const FirstBounceSource& first,
     apply_shadow_rays(false);
     times.compact_ms += ms_since(start);
   }
+  if (timing_choice)
+    order_choice_.record(group_this_pass_, ms_since(loop_start),
+                         static_cast<double>(rays.secondary + rays.shadow - loop_rays));
   start = Clock::now();
   if (world_guide_) collect_world_samples();
   gather(radiance, vpls, nonfinite);
@@ -170,6 +201,11 @@ void PathTracer::prepare(std::size_t n, VplBuffer* vpls) {
   rays_.resize(n);
   hits_.resize(n);
   active_.resize(n);
+  if (may_group_) {
+    ray_groups_.resize(n);
+    grouped_rays_.resize(n);
+    grouped_active_.resize(n);
+  }
   ray_counts_.resize((n + kPathBlock - 1) / kPathBlock);
   if (world_guide_) {
     // One record per path for each depth the guide covers (at most 254: world_depth_ counts them
@@ -342,6 +378,7 @@ void PathTracer::start_paths(const GBuffer& g, const FirstBounceSamples* first,
                 const std::size_t slot = chunk + survivors++;
                 set_ray(rays_[slot], origin, fs.direction, 0.0f, 1e30f);
                 active_[slot] = static_cast<std::uint32_t>(i);
+                if (group_this_pass_) ray_groups_[slot] = ray_order_.group(origin, fs.direction);
                 // The density the hit's MIS weight uses: the same function of the direction
                 // as next-event estimation's above. Under first_bounce_mis_deferred_ the hit
                 // asks the sampler's pdf() instead of this sample's density, which a device
@@ -411,7 +448,12 @@ void PathTracer::shade_bounce(int depth, VplBuffer* vpls, RayCounts& rays) {
     for (std::size_t j = range.begin(); j != range.end(); ++j) {
       if (guide_secondary && j + kPrefetchAhead < range.end())
         borrow_from[(j + kPrefetchAhead) % kBorrowRing] = prefetch_borrowable(j + kPrefetchAhead);
-      if (j + kPathPrefetchAhead < range.end()) prefetch_path(active_[j + kPathPrefetchAhead]);
+      if (j + kPathPrefetchAhead < range.end()) {
+        const std::uint32_t ahead = active_[j + kPathPrefetchAhead];
+        prefetch_path(ahead);
+        // In groups the first bounce's hits write their pixels' VPLs all over the buffer.
+        if (depth == 1 && vpls && group_this_pass_) prefetch_vpl(*vpls, ahead);
+      }
       if (world_here && j + kPrefetchAhead < range.end() && hits_[j + kPrefetchAhead].valid()) {
         const Ray& ahead = rays_[j + kPrefetchAhead];
         world_guide_->prefetch(ahead.origin + ahead.direction * hits_[j + kPrefetchAhead].t);
@@ -593,6 +635,7 @@ void PathTracer::shade_bounce(int depth, VplBuffer* vpls, RayCounts& rays) {
       const std::size_t slot = range.begin() + survivors++;
       set_ray(rays_[slot], origin, wi_world, 0.0f, 1e30f);
       active_[slot] = i;
+      if (group_this_pass_) ray_groups_[slot] = ray_order_.group(origin, wi_world);
       if (world_here && world_depth_[i] != kNotRecording) {
         WorldVertex& v = world_vertices_[i * world_stride_ + (depth - 1)];
         v.cell = WorldGuide::kNoCell;
@@ -664,6 +707,35 @@ std::size_t PathTracer::borrowable_index(const glm::vec3& position) const {
     return kNotOnScreen;
   return static_cast<std::size_t>(fy) * static_cast<std::size_t>(g.width) +
          static_cast<std::size_t>(fx);
+}
+
+void PathTracer::group_rays() {
+  const std::vector<std::uint32_t>& order =
+      ray_order_.order(ray_groups_.data(), kPathBlock, ray_counts_.data(), ray_counts_.size());
+  const std::size_t count = order.size();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
+    for (std::size_t k = range.begin(); k != range.end(); ++k) {
+      // The rays are gathered from all over the lists: load them a few ahead.
+      constexpr std::size_t kAhead = 16;
+      if (k + kAhead < range.end()) __builtin_prefetch(&rays_[order[k + kAhead]]);
+      grouped_rays_[k] = rays_[order[k]];
+      grouped_active_[k] = active_[order[k]];
+    }
+  });
+  rays_.swap(grouped_rays_);
+  active_.swap(grouped_active_);
+  for (std::size_t b = 0; b != ray_counts_.size(); ++b) {
+    const std::size_t first = b * kPathBlock;
+    ray_counts_[b] =
+        static_cast<std::uint32_t>(first < count ? std::min(kPathBlock, count - first) : 0);
+  }
+}
+
+void PathTracer::prefetch_vpl(const VplBuffer& vpls, std::uint32_t i) {
+  __builtin_prefetch(&vpls.position[i], 1);
+  __builtin_prefetch(&vpls.normal_radiance[i], 1);
+  __builtin_prefetch(&vpls.info[i], 1);
+  __builtin_prefetch(&vpls.strategy_pdf[i]);
 }
 
 void PathTracer::prefetch_path(std::uint32_t i) const {

@@ -19,6 +19,7 @@
 #include "scene/scene.h"
 #include "shared/rng.h"
 #include "trace/embree_scene.h"
+#include "trace/ray_order.h"
 #include "util/huge_pages.h"
 
 namespace rtpg {
@@ -47,6 +48,17 @@ enum class FirstBounceMis {
   bsdf,     // the BSDF's density (D where that is 0): no mixture evaluated for the light sample
 };
 
+// grouped: before each bounce's trace the paths that go on are put in RayOrder's groups (by the
+// direction's octant and the origin's cell: trace/ray_order.h), so that Embree's streams walk
+// the BVH coherently; listed: as the blocks list them; automatic: listed where the scene's BVH
+// fits in a core's cache, else whichever of the two the first passes time faster
+// (TimedChoice), as the gain depends on how much of the BVH the paths walk
+// (docs/host-path-tracer.md, "Bounce rays traced in groups").
+enum class BounceRayOrder { automatic, grouped, listed };
+// Whether `setting` may group the scene's bounce rays (automatic: its BVH outgrows a core's
+// cache).
+bool may_group_bounce_rays(BounceRayOrder setting, const Scene& scene);
+
 struct PathTracerSettings {
   int max_bounces = 8;     // path vertices after the primary hit
   int roulette_start = 3;  // first bounce at which Russian roulette may end a path
@@ -68,6 +80,9 @@ struct PathTracerSettings {
   // Whether the shading loop and the G-buffer load each hit's triangle, vertices and texels a
   // few hits ahead (render/surface.h, loads_surfaces_ahead). Images are the same either way.
   SurfacePrefetch surface_prefetch = SurfacePrefetch::automatic;
+  // The order each bounce's rays go to Embree in (BounceRayOrder). Images are the same
+  // either way.
+  BounceRayOrder bounce_ray_order = BounceRayOrder::automatic;
 };
 
 // The coordinates a sample's first bounce draws with: sample 0's where the first bounce is
@@ -93,6 +108,7 @@ struct RayCounts {
 
 struct PassTimes {
   double trace_ms = 0.0, shade_ms = 0.0;
+  double group_ms = 0.0;  // the bounce rays put in groups (BounceRayOrder)
   // Between the passes: shadow rays' results added to their paths, and the pixel estimates and
   // VPL radiance gathered at the end (the name stays from when it also compacted the live
   // paths, which the shading now lists in place).
@@ -125,6 +141,8 @@ class PathTracer {
   // settings().surface_prefetch resolved for the scene (render/surface.h, loads_surfaces_ahead):
   // the G-buffer pass follows the same decision.
   bool loads_surfaces_ahead() const { return prefetch_surfaces_; }
+  // Whether the last trace() grouped its bounce rays (settings().bounce_ray_order).
+  bool grouped_rays() const { return group_this_pass_; }
   // Later vertices sample the world-space guide's cells and record their bounces for it
   // (render/world_guide.h); null: neither. The caller trains the guide between frames.
   void set_world_guide(const WorldGuide* guide) { world_guide_ = guide; }
@@ -221,12 +239,17 @@ class PathTracer {
   // Starts loading path i's PathState (and VplPath where VPLs are kept) a few vertices before
   // the shading loop reads it.
   void prefetch_path(std::uint32_t i) const;
+  // Starts loading the VPL records of pixel i that the first bounce's hit writes.
+  static void prefetch_vpl(const VplBuffer& vpls, std::uint32_t i);
   // The guide of pixel i (from prefetch_borrowable) if it shows surface point sp
   // (guide_secondary).
   bool borrow_guide(std::size_t i, const SurfacePoint& sp, PixelGuide& guide) const;
   // The world guide's training samples of this pass: each recorded vertex's bounce with the
   // radiance its path gathered after it (WorldVertex), into the next blocks of world_blocks_.
   void collect_world_samples();
+  // Puts the listed bounce rays and their paths in RayOrder's groups: rays_ and active_ then
+  // hold them from slot 0 on, every block full but the last (group_this_pass_).
+  void group_rays();
   // Pixel estimates (non-finite ones dropped and counted) and the VPLs' radiance.
   void gather(std::vector<glm::vec3>& radiance, VplBuffer* vpls, std::uint64_t& nonfinite) const;
 
@@ -263,6 +286,15 @@ class PathTracer {
   LargeVector<std::uint32_t> active_;
   LargeVector<Ray> rays_;
   LargeVector<Hit> hits_;
+  // Where group_this_pass_: each listed ray's group (written with the ray), and the rays and
+  // their paths in group order (group_rays), swapped with rays_ and active_ before each trace.
+  bool may_group_ = false;        // may_group_bounce_rays
+  bool group_this_pass_ = false;  // this trace() groups
+  TimedChoice order_choice_;      // listed or grouped, under BounceRayOrder::automatic
+  RayOrder ray_order_;
+  LargeVector<std::uint16_t> ray_groups_;
+  LargeVector<Ray> grouped_rays_;
+  LargeVector<std::uint32_t> grouped_active_;
   std::vector<std::uint32_t> ray_counts_;  // per block
   // Per shadow-ray entry: the ray, what it adds to its path's radiance if unoccluded, the path,
   // and Embree's answer.

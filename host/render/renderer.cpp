@@ -248,6 +248,8 @@ FrameStats Renderer::render_frame(int index) {
     stats.extra["world_at_pi_min"] = world_guide_->fraction_at_pi_min();
   }
   stats.time_ms["trace"] = times.trace_ms;
+  if (path_tracer_->grouped_rays()) stats.time_ms["group_rays"] = times.group_ms;
+  stats.extra["bounce_rays_grouped"] = path_tracer_->grouped_rays() ? 1.0 : 0.0;
   stats.time_ms["shade"] = times.shade_ms;
   stats.time_ms["compact"] = times.compact_ms;
   stats.secondary_rays = rays.secondary;

@@ -1,0 +1,99 @@
+#include "trace/ray_order.h"
+
+#include <algorithm>
+#include <array>
+#include <utility>
+
+#include <tbb/parallel_for.h>
+
+namespace rtpg {
+namespace {
+
+constexpr std::uint32_t kCells = 1u << RayOrder::kCellBits;
+
+// kMorton[v]: the bits of v < kCells spread to every third bit.
+constexpr std::array<std::uint32_t, kCells> morton_table() {
+  std::array<std::uint32_t, kCells> table{};
+  for (std::uint32_t v = 0; v < kCells; ++v)
+    for (int b = 0; b < RayOrder::kCellBits; ++b) table[v] |= ((v >> b) & 1u) << (3 * b);
+  return table;
+}
+constexpr std::array<std::uint32_t, kCells> kMorton = morton_table();
+
+std::uint32_t cell_of(float x, float min, float cells_per_unit) {
+  const float c = (x - min) * cells_per_unit;
+  if (!(c >= 0.0f)) return 0u;  // below the grid, or NaN
+  return c < static_cast<float>(kCells) ? static_cast<std::uint32_t>(c) : kCells - 1u;
+}
+
+// The lists are split into this many chunks at most, each counted and written by one task: a
+// fixed number, so that the order does not depend on the thread count.
+constexpr std::size_t kChunks = 4;
+
+}  // namespace
+
+RayOrder::RayOrder(const glm::vec3& bounds_min, const glm::vec3& bounds_max) : min_(bounds_min) {
+  const glm::vec3 extent = bounds_max - bounds_min;
+  for (int a = 0; a < 3; ++a)
+    cells_per_unit_[a] = extent[a] > 0.0f ? static_cast<float>(kCells) / extent[a] : 0.0f;
+}
+
+std::uint16_t RayOrder::group(const glm::vec3& origin, const glm::vec3& direction) const {
+  const std::uint32_t octant = (direction.x < 0.0f ? 1u : 0u) | (direction.y < 0.0f ? 2u : 0u) |
+                               (direction.z < 0.0f ? 4u : 0u);
+  const std::uint32_t cell = kMorton[cell_of(origin.x, min_.x, cells_per_unit_.x)] |
+                             kMorton[cell_of(origin.y, min_.y, cells_per_unit_.y)] << 1 |
+                             kMorton[cell_of(origin.z, min_.z, cells_per_unit_.z)] << 2;
+  return static_cast<std::uint16_t>(octant << (3 * kCellBits) | cell);
+}
+
+const std::vector<std::uint32_t>& RayOrder::order(const std::uint16_t* groups, std::size_t stride,
+                                                  const std::uint32_t* counts, std::size_t lists) {
+  const std::size_t chunks = std::min(kChunks, lists);
+  const auto each_slot = [&](std::size_t chunk, const auto& visit) {
+    for (std::size_t l = lists * chunk / chunks, end = lists * (chunk + 1) / chunks; l != end; ++l)
+      for (std::size_t s = l * stride, last = s + std::min<std::size_t>(counts[l], stride);
+           s != last; ++s)
+        visit(s);
+  };
+  // A counting sort: each chunk's count of each group ...
+  starts_.assign(chunks * kGroups, 0u);
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+    std::uint32_t* count = starts_.data() + c * kGroups;
+    each_slot(c, [&](std::size_t s) { ++count[groups[s]]; });
+  });
+  // ... made into where its slots of that group start (group by group, chunk by chunk inside a
+  // group, so that a group keeps slot order) ...
+  std::uint32_t total = 0;
+  for (std::uint32_t g = 0; g != kGroups; ++g)
+    for (std::size_t c = 0; c != chunks; ++c) {
+      std::uint32_t& entry = starts_[c * kGroups + g];
+      total += std::exchange(entry, total);
+    }
+  // ... and its slots written there.
+  order_.resize(total);
+  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+    std::uint32_t* next = starts_.data() + c * kGroups;
+    each_slot(c, [&](std::size_t s) { order_[next[groups[s]]++] = static_cast<std::uint32_t>(s); });
+  });
+  return order_;
+}
+
+bool TimedChoice::next_takes_second() const {
+  if (decided_) return second_;
+  return passes_ > 0 && passes_ % 2 == 0;  // passes 2, 4, ...: the second way
+}
+
+void TimedChoice::record(bool second, double time, double units) {
+  if (decided_) return;
+  if (passes_++ > 0 && units > 0.0) (second ? second_times_ : first_times_).push_back(time / units);
+  if (first_times_.size() < kTrials || second_times_.size() < kTrials) return;
+  const auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  second_ = median(second_times_) < (1.0 - kMargin) * median(first_times_);
+  decided_ = true;
+}
+
+}  // namespace rtpg
