@@ -481,6 +481,7 @@ int run_reference(const ReferenceCommand& command) {
   settings.height = command.height;
   settings.seed = command.seed;
   settings.path_tracer.max_bounces = bounces_for(scene, command.max_bounces);
+  settings.path_tracer.bounce_ray_order = parse_bounce_ray_order(command.bounce_ray_order);
   settings.camera_path = command.camera_path;
   if (command.frame < 0) throw InputError("--frame", "must not be negative");
   settings.camera_frame = command.frame;

@@ -64,7 +64,8 @@ struct ReferenceCommand {
   std::string camera_path;  // "" = static camera
   int frame = 0;            // the camera path's frame to render
   std::string output;
-  std::string stats_json;  // "" = none; else spp, time and samples per second
+  std::string stats_json;                 // "" = none; else spp, time and samples per second
+  std::string bounce_ray_order = "auto";  // --bounce-ray-order: BounceRayOrder by name
 };
 
 // Where --save-frames writes frame `frame` of a render whose --output is `output`:

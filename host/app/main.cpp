@@ -164,6 +164,17 @@ bool parse_resolution(const std::string& text, int& w, int& h) {
   return true;
 }
 
+// --bounce-ray-order of render and reference (PathTracerSettings::bounce_ray_order).
+void add_bounce_ray_order(CLI::App* cmd, std::string& order) {
+  cmd->add_option("--bounce-ray-order", order,
+                  "Order of each bounce's rays for Embree: grouped (by direction octant and the "
+                  "origin's cell of a coarse grid), listed (as the path blocks list them) or auto "
+                  "(listed where the scene's BVH fits a core's cache, else whichever of the two "
+                  "the first passes time faster); the images are the same")
+      ->check(CLI::IsMember({"auto", "grouped", "listed"}))
+      ->capture_default_str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -200,14 +211,7 @@ int main(int argc, char** argv) {
                    "(bench/variance_split.py); none is the renderer")
       ->check(CLI::IsMember({"none", "first-bounce", "primary-vertex", "second-vertex"}))
       ->capture_default_str();
-  render_cmd
-      ->add_option("--bounce-ray-order", render.bounce_ray_order,
-                   "Order of each bounce's rays for Embree: grouped (by direction octant and "
-                   "the origin's cell of a coarse grid), listed (as the path blocks list them) "
-                   "or auto (grouped where the scene's BVH outgrows a core's cache); the images "
-                   "are the same")
-      ->check(CLI::IsMember({"auto", "grouped", "listed"}))
-      ->capture_default_str();
+  add_bounce_ray_order(render_cmd, render.bounce_ray_order);
   render_cmd->add_option("-o,--output", render.output,
                          "Last frame: .exr (linear) or .png (tonemapped)");
   render_cmd
@@ -238,6 +242,7 @@ int main(int argc, char** argv) {
   reference_cmd
       ->add_option("--frame", reference.frame, "Frame of the camera path (its time is frame / fps)")
       ->capture_default_str();
+  add_bounce_ray_order(reference_cmd, reference.bounce_ray_order);
   reference_cmd->add_option("--max-bounces", reference.max_bounces,
                             "Path vertices after the primary hit (default: the scene's, else 8)");
 
