@@ -38,7 +38,7 @@
 #include "rtpg/cl_runtime.h"
 #include "render/guided_first_bounce.h"
 #include "render/renderer.h"
-#include "trace/ray_order.h"
+#include "util/timed_choice.h"
 
 namespace rtpg::bench {
 namespace {

@@ -20,6 +20,7 @@
 #include "shared/rng.h"
 #include "trace/embree_scene.h"
 #include "trace/ray_order.h"
+#include "util/timed_choice.h"
 #include "util/huge_pages.h"
 
 namespace rtpg {
@@ -259,6 +260,10 @@ class PathTracer {
   const Lights& lights_;
   PathTracerSettings settings_;
   bool prefetch_surfaces_ = false;  // settings_.surface_prefetch, resolved for the scene
+  bool may_group_ = false;          // may_group_bounce_rays(settings_.bounce_ray_order)
+  bool group_this_pass_ = false;    // this trace() groups its bounce rays
+  TimedChoice order_choice_;        // listed or grouped, under BounceRayOrder::automatic
+  RayOrder ray_order_;              // the groups: the scene's bounds in cells
 
   // This frame's G-buffer and first-bounce sampler (set by trace()).
   const GBuffer* gbuffer_ = nullptr;
@@ -279,19 +284,17 @@ class PathTracer {
   // b's slots are b * kPathBlock onwards. At the primary hits slot i is pixel i's; after each
   // vertex a block lists, from its first slot and in slot order, the paths that go on (their
   // pixels in active_, their next rays in rays_, ray_counts_[b] of them, written in place), and
-  // the shadow rays its vertices made (shadow_counts_[b] of them). Blocks never merge: a block
+  // the shadow rays its vertices made (shadow_counts_[b] of them). Blocks merge only where a
+  // pass groups its bounce rays (group_rays: every block full but the last); otherwise a block
   // of the last bounce holds what is left of its pixels' paths (docs/host-path-tracer.md,
-  // "Shadow rays listed where they are made", "Bounce rays listed in place").
+  // "Shadow rays listed where they are made", "Bounce rays listed in place", "Bounce rays traced
+  // in groups").
   static constexpr std::size_t kPathBlock = 2048;
   LargeVector<std::uint32_t> active_;
   LargeVector<Ray> rays_;
   LargeVector<Hit> hits_;
   // Where group_this_pass_: each listed ray's group (written with the ray), and the rays and
   // their paths in group order (group_rays), swapped with rays_ and active_ before each trace.
-  bool may_group_ = false;        // may_group_bounce_rays
-  bool group_this_pass_ = false;  // this trace() groups
-  TimedChoice order_choice_;      // listed or grouped, under BounceRayOrder::automatic
-  RayOrder ray_order_;
   LargeVector<std::uint16_t> ray_groups_;
   LargeVector<Ray> grouped_rays_;
   LargeVector<std::uint32_t> grouped_active_;

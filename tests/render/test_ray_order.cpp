@@ -1,14 +1,12 @@
 // The order the bounce rays go to Embree in (trace/ray_order.h, PathTracerSettings::
-// bounce_ray_order): RayOrder's groups and counting sort, the timed choice between the two
-// orders, and that grouping changes no pixel and no VPL.
+// bounce_ray_order): RayOrder's groups and counting sort, and that grouping changes no pixel and
+// no VPL.
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
 #include <limits>
 #include <memory>
-#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -80,38 +78,6 @@ TEST(RayOrder, GroupsByOctantThenTheOriginsCell) {
   EXPECT_LT(order.group(glm::vec3(nan), glm::vec3(nan)), RayOrder::kGroups);
   const RayOrder flat(glm::vec3(0.0f), glm::vec3(4.0f, 0.0f, 4.0f));
   EXPECT_EQ(flat.group(glm::vec3(4.0f, 3.0f, 0.0f), plus) & 2u, 0u);
-}
-
-// Pass 0 takes the first way and is not counted; passes 1-6 alternate first, second; after
-// them the second way is kept only where its median time per unit is below the first's by the
-// margin, and the choice stays.
-TEST(TimedChoice, KeepsTheSecondWayOnlyWhereItIsFasterByItsMargin) {
-  const auto run = [](double first_time, double second_time, int* passes_to_decide) {
-    TimedChoice choice;
-    std::vector<bool> taken;
-    for (int pass = 0; !choice.decided() && pass < 20; ++pass) {
-      const bool second = choice.next_takes_second();
-      taken.push_back(second);
-      // Pass 0 far slower (a cold cache), and one outlier each way that the median ignores.
-      double t = second ? second_time : first_time;
-      if (pass == 0) t *= 10.0;
-      if (pass == 1 || pass == 2) t *= 3.0;
-      choice.record(second, t * 1000.0, 1000.0);
-    }
-    *passes_to_decide = static_cast<int>(taken.size());
-    const std::vector<bool> schedule = {false, false, true, false, true, false, true};
-    EXPECT_EQ(taken, schedule);
-    return choice.next_takes_second();
-  };
-  int passes = 0;
-  EXPECT_TRUE(run(1.0, 0.90, &passes));
-  EXPECT_EQ(passes, 1 + 2 * TimedChoice::kTrials);
-  EXPECT_FALSE(run(1.0, 0.99, &passes));  // within the margin: the first way
-  EXPECT_FALSE(run(1.0, 1.20, &passes));
-  // A pass without work counts for neither way.
-  TimedChoice idle;
-  for (int pass = 0; pass < 20; ++pass) idle.record(idle.next_takes_second(), 1.0, 0.0);
-  EXPECT_FALSE(idle.decided());
 }
 
 bool same_bits(const void* a, const void* b, std::size_t bytes) {
