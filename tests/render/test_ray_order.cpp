@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "forwarding_sampler.h"
 #include "render/first_bounce.h"
 #include "render/renderer.h"
 #include "render/vpl_buffer.h"
@@ -84,27 +85,19 @@ bool same_bits(const void* a, const void* b, std::size_t bytes) {
   return std::memcmp(a, b, bytes) == 0;
 }
 
-// A first-bounce sampler that samples the BSDF and keeps each frame's VPLs (as a guide
-// would train on them).
-class VplKeepingSampler final : public FirstBounceSampler {
+// BSDF sampling that asks for each frame's VPLs (as a guide would, to train on them) and keeps
+// them.
+class VplKeepingSampler final : public ForwardingSampler {
  public:
-  explicit VplKeepingSampler(std::vector<VplBuffer>& frames) : frames_(frames) {}
-  void begin_frame(const GBuffer&, const SampleCoordinates&) override {}
+  explicit VplKeepingSampler(std::vector<VplBuffer>& frames)
+      : ForwardingSampler(std::make_unique<BsdfFirstBounce>()), frames_(frames) {}
+  bool wants_vpls() const override { return true; }
   void end_frame(const GBuffer&, const VplBuffer& vpls, const SampleCoordinates&) override {
     frames_.push_back(vpls);
-  }
-  bool wants_vpls() const override { return true; }
-  FirstBounceSamples sample(const GBuffer& g, const SampleCoordinates& at) override {
-    return bsdf_.sample(g, at);
-  }
-  float pdf(const GBuffer& g, std::size_t i, const shared::pg_lobes& lobes, const glm::vec3& wo,
-            const glm::vec3& wi) const override {
-    return bsdf_.pdf(g, i, lobes, wo, wi);
   }
 
  private:
   std::vector<VplBuffer>& frames_;
-  BsdfFirstBounce bsdf_;
 };
 
 // Grouping reorders the paths between bounces (rays_ and active_ in group order), so every
