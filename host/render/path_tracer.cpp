@@ -710,18 +710,14 @@ std::size_t PathTracer::borrowable_index(const glm::vec3& position) const {
 }
 
 void PathTracer::group_rays() {
-  const std::vector<std::uint32_t>& order =
-      ray_order_.order(ray_groups_.data(), kPathBlock, ray_counts_.data(), ray_counts_.size());
-  const std::size_t count = order.size();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const auto& range) {
-    for (std::size_t k = range.begin(); k != range.end(); ++k) {
-      // The rays are gathered from all over the lists: load them a few ahead.
-      constexpr std::size_t kAhead = 16;
-      if (k + kAhead < range.end()) __builtin_prefetch(&rays_[order[k + kAhead]]);
-      grouped_rays_[k] = rays_[order[k]];
-      grouped_active_[k] = active_[order[k]];
-    }
-  });
+  // Each ray and its pixel moved where the order puts it (RayOrder::arrange): the lists are read
+  // in slot order, and each group's places are written in turn.
+  const std::size_t count =
+      ray_order_.arrange(ray_groups_.data(), kPathBlock, ray_counts_.data(), ray_counts_.size(),
+                         [&](std::size_t slot, std::size_t place) {
+                           grouped_rays_[place] = rays_[slot];
+                           grouped_active_[place] = active_[slot];
+                         });
   rays_.swap(grouped_rays_);
   active_.swap(grouped_active_);
   for (std::size_t b = 0; b != ray_counts_.size(); ++b) {

@@ -26,10 +26,6 @@ std::uint32_t cell_of(float x, float min, float cells_per_unit) {
   return c < static_cast<float>(kCells) ? static_cast<std::uint32_t>(c) : kCells - 1u;
 }
 
-// The lists are split into this many chunks at most, each counted and written by one task: a
-// fixed number, so that the order does not depend on the thread count.
-constexpr std::size_t kChunks = 4;
-
 }  // namespace
 
 RayOrder::RayOrder(const glm::vec3& bounds_min, const glm::vec3& bounds_max) : min_(bounds_min) {
@@ -47,35 +43,34 @@ std::uint16_t RayOrder::group(const glm::vec3& origin, const glm::vec3& directio
   return static_cast<std::uint16_t>(octant << (3 * kCellBits) | cell);
 }
 
-const std::vector<std::uint32_t>& RayOrder::order(const std::uint16_t* groups, std::size_t stride,
-                                                  const std::uint32_t* counts, std::size_t lists) {
-  const std::size_t chunks = std::min(kChunks, lists);
-  const auto each_slot = [&](std::size_t chunk, const auto& visit) {
-    for (std::size_t l = lists * chunk / chunks, end = lists * (chunk + 1) / chunks; l != end; ++l)
-      for (std::size_t s = l * stride, last = s + std::min<std::size_t>(counts[l], stride);
-           s != last; ++s)
-        visit(s);
-  };
+std::size_t RayOrder::count_starts(const std::uint16_t* groups, std::size_t stride,
+                                   const std::uint32_t* counts, std::size_t lists) {
+  const std::size_t chunks = chunks_of(lists);
   // A counting sort: each chunk's count of each group ...
   starts_.assign(chunks * kGroups, 0u);
   tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
     std::uint32_t* count = starts_.data() + c * kGroups;
-    each_slot(c, [&](std::size_t s) { ++count[groups[s]]; });
+    each_listed_slot(c, stride, counts, lists, [&](std::size_t s) { ++count[groups[s]]; });
   });
   // ... made into where its slots of that group start (group by group, chunk by chunk inside a
-  // group, so that a group keeps slot order) ...
+  // group, so that a group keeps slot order); arrange() then writes each slot there.
   std::uint32_t total = 0;
   for (std::uint32_t g = 0; g != kGroups; ++g)
     for (std::size_t c = 0; c != chunks; ++c) {
       std::uint32_t& entry = starts_[c * kGroups + g];
       total += std::exchange(entry, total);
     }
-  // ... and its slots written there.
+  return total;
+}
+
+const std::vector<std::uint32_t>& RayOrder::order(const std::uint16_t* groups, std::size_t stride,
+                                                  const std::uint32_t* counts, std::size_t lists) {
+  order_.resize(stride * lists);
+  const std::size_t total =
+      arrange(groups, stride, counts, lists, [&](std::size_t slot, std::size_t place) {
+        order_[place] = static_cast<std::uint32_t>(slot);
+      });
   order_.resize(total);
-  tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
-    std::uint32_t* next = starts_.data() + c * kGroups;
-    each_slot(c, [&](std::size_t s) { order_[next[groups[s]]++] = static_cast<std::uint32_t>(s); });
-  });
   return order_;
 }
 

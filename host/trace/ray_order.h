@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <tbb/parallel_for.h>
 
 namespace rtpg {
 
@@ -34,11 +35,48 @@ class RayOrder {
   // next call.
   const std::vector<std::uint32_t>& order(const std::uint16_t* groups, std::size_t stride,
                                           const std::uint32_t* counts, std::size_t lists);
+  // The same order handed out instead of stored: move(slot, place) for every listed slot, place
+  // its position in order()'s vector, each slot once, from several threads; returns how many
+  // slots are listed. A caller that moves its slots' data into that order saves the order's
+  // own pass (the path tracer's rays and pixels: PathTracer::group_rays).
+  template <class Move>
+  std::size_t arrange(const std::uint16_t* groups, std::size_t stride, const std::uint32_t* counts,
+                      std::size_t lists, const Move& move);
 
  private:
+  // Lists are split into at most this many chunks, each counted and written by one task: a fixed
+  // number, so that the order does not depend on the thread count.
+  static constexpr std::size_t kChunks = 4;
+  static std::size_t chunks_of(std::size_t lists) { return lists < kChunks ? lists : kChunks; }
+  // visit(slot) for the listed slots of chunk c, in slot order.
+  template <class Visit>
+  static void each_listed_slot(std::size_t c, std::size_t stride, const std::uint32_t* counts,
+                               std::size_t lists, const Visit& visit) {
+    const std::size_t chunks = chunks_of(lists);
+    for (std::size_t l = lists * c / chunks, end = lists * (c + 1) / chunks; l != end; ++l)
+      for (std::size_t s = l * stride, last = s + (counts[l] < stride ? counts[l] : stride);
+           s != last; ++s)
+        visit(s);
+  }
+  // starts_ made into where each chunk's slots of each group go; returns the listed slots.
+  std::size_t count_starts(const std::uint16_t* groups, std::size_t stride,
+                           const std::uint32_t* counts, std::size_t lists);
+
   glm::vec3 min_, cells_per_unit_;
   std::vector<std::uint32_t> starts_;  // [chunk * kGroups + group]: counts, then where they go
   std::vector<std::uint32_t> order_;
 };
+
+template <class Move>
+std::size_t RayOrder::arrange(const std::uint16_t* groups, std::size_t stride,
+                              const std::uint32_t* counts, std::size_t lists, const Move& move) {
+  const std::size_t total = count_starts(groups, stride, counts, lists);
+  tbb::parallel_for(std::size_t{0}, chunks_of(lists), [&](std::size_t c) {
+    std::uint32_t* next = starts_.data() + c * kGroups;
+    each_listed_slot(c, stride, counts, lists,
+                     [&](std::size_t s) { move(s, static_cast<std::size_t>(next[groups[s]]++)); });
+  });
+  return total;
+}
 
 }  // namespace rtpg
