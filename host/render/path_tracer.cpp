@@ -108,7 +108,7 @@ PathTracer::PathTracer(const Scene& scene, const EmbreeScene& tracer,
 bool may_group_bounce_rays(BounceRayOrder setting, const Scene& scene) {
   if (setting != BounceRayOrder::automatic) return setting == BounceRayOrder::grouped;
   // Embree 3's BVH takes 70-96 bytes a triangle (measured with its memory monitor at 36 to
-  // 262,000 triangles); grouping costs about 10 ns a ray on two cores, which a BVH held in a
+  // 262,000 triangles); grouping costs about 7 ns a ray on two cores, which a BVH held in a
   // core's cache does not win back (docs/host-path-tracer.md, "Bounce rays traced in groups").
   constexpr std::size_t kBvhBytesPerTriangle = 80;
   std::size_t triangles = 0;
