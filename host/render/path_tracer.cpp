@@ -111,9 +111,7 @@ bool may_group_bounce_rays(BounceRayOrder setting, const Scene& scene) {
   // 262,000 triangles); grouping costs about 7 ns a ray on two cores, which a BVH held in a
   // core's cache does not win back (docs/host-path-tracer.md, "Bounce rays traced in groups").
   constexpr std::size_t kBvhBytesPerTriangle = 80;
-  std::size_t triangles = 0;
-  for (const Mesh& mesh : scene.meshes) triangles += mesh.triangles.size();
-  return triangles * kBvhBytesPerTriangle > core_cache_bytes();
+  return scene.triangle_count() * kBvhBytesPerTriangle > core_cache_bytes();
 }
 
 void PathTracer::trace(const GBuffer& g, const FirstBounceSource& first,

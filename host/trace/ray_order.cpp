@@ -1,6 +1,5 @@
 #include "trace/ray_order.h"
 
-#include <algorithm>
 #include <array>
 #include <utility>
 
