@@ -53,7 +53,7 @@ constexpr int kFrames = 4;  // noisy frames cycled through (different seeds, sam
 
 struct Frames {
   GBuffer gbuffer;
-  std::vector<std::vector<glm::vec4>> colour;
+  std::vector<std::vector<glm::vec3>> colour;
   double pt_frame_ms = 0.0;
 };
 
@@ -73,9 +73,7 @@ Frames* frames_for(const std::string& scene_name, int w, int h, std::string* why
   std::vector<double> times;
   for (int k = 0; k < kFrames; ++k) {
     times.push_back(renderer.render_frame(k).time_ms.at("total"));
-    std::vector<glm::vec4> c(renderer.image().size());
-    for (std::size_t i = 0; i < c.size(); ++i) c[i] = glm::vec4(renderer.image()[i], 1.0f);
-    f->colour.push_back(std::move(c));
+    f->colour.push_back(renderer.image());
   }
   f->gbuffer = renderer.gbuffer();
   std::sort(times.begin(), times.end());
@@ -129,13 +127,13 @@ Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const Svgf
         c.variance_flops += 1;
         c.atrous_bytes += s.iterations * 48.0;
         c.atrous_flops += s.iterations * 1.0;
-        c.remodulate_bytes += 4 + 16 + 16;
+        c.remodulate_bytes += 4 + 12 + 12;  // the colour in and out, three floats each
         continue;
       }
       c.surface_pixels += 1;
       // temporal, static camera: one bilinear tap of weight 1 (the others have weight 0),
       // tested and accepted.
-      c.temporal_bytes += 96 + 68 + 88;
+      c.temporal_bytes += 92 + 68 + 88;
       c.temporal_flops += 41 + 4 * 8 + 19 + 15 + 30;
       const bool spatial = moments[i].z < static_cast<float>(s.min_history);
       c.variance_bytes += 16 + 16 + 16 + 16 + (spatial ? 4 : 0);
@@ -145,7 +143,7 @@ Counts count(const GBuffer& g, const std::vector<glm::vec4>& moments, const Svgf
         c.atrous_flops += 11 + 3 * taps_inside(x, y, 1, 1) + atrous_inverse_phi_z +
                           atrous_tap * taps_inside(x, y, 2, 1 << k) + 5;
       c.atrous_bytes += s.iterations * 52.0;
-      c.remodulate_bytes += 4 + 16 + 16 + 16 + 16;
+      c.remodulate_bytes += 4 + 16 + 16 + 16 + 12;
       c.remodulate_flops += 9;
     }
   return c;

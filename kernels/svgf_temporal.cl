@@ -10,8 +10,9 @@
  * Per pixel (hand count; the rules: docs/guiding.md, "The roofline"; bench/bench_svgf.cpp counts
  * with it): 41 flops without history; with it 8 per bilinear tap, 34 per tap tested for the same
  * surface and summed, 30 for the blend; where no bilinear tap holds, 4 per neighbourhood tap and
- * 34 per tap tested. Bytes: 96 read and 88 written, 68 more read where a tap of last frame is
- * tested; a pixel without a surface reads 40 and writes 88. */
+ * 34 per tap tested. Bytes: 92 read and 88 written, 68 more read where a tap of last frame is
+ * tested; a pixel without a surface reads 40 and writes 88. The colour is the renderer's image as
+ * it is, three floats a pixel (no copy into four). */
 /* Each operation rounded on its own, as in the host reference. */
 #pragma OPENCL FP_CONTRACT OFF
 
@@ -19,7 +20,7 @@
 #include "shared/svgf.h"
 
 /* clang-format off */
-__kernel void svgf_temporal(__global const float4* colour, __global const float4* emission,
+__kernel void svgf_temporal(__global const float* colour, __global const float4* emission,
                             __global const float4* position_depth,
                             __global const float4* shading_normal,
                             __global const float4* base_color_roughness,
@@ -62,7 +63,7 @@ __kernel void svgf_temporal(__global const float4* colour, __global const float4
   depth_slope[i] = pg_svgf_depth_slope(pd.w, z_left, z_right, z_down, z_up);
 
   float3 albedo = pg_svgf_albedo(base_color_roughness[i], settings.albedo_floor);
-  float3 illumination = pg_svgf_demodulate(colour[i].xyz, emission[i].xyz, albedo);
+  float3 illumination = pg_svgf_demodulate(vload3(i, colour), emission[i].xyz, albedo);
   float luminance = pg_luminance(illumination);
 
   float3 sum_history = (float3)(0.0f);

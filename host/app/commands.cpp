@@ -297,8 +297,8 @@ int run_render(const RenderCommand& command) {
   std::vector<glm::vec3> previous, previous_noisy;
   ReprojectedFlicker reprojected_flicker, reprojected_flicker_noisy;
   std::vector<glm::vec4> frame_rgba;
-  // This frame's output: the renderer's image, or with --denoise the denoised one.
-  std::vector<glm::vec3> denoised_rgb;
+  // This frame's output: the renderer's image, or with --denoise the denoised one (the
+  // denoiser's, valid until its next frame).
   const std::vector<glm::vec3>* shown = &renderer.image();
   ImageRgb accumulated{settings.width, settings.height, {}};
   const std::map<std::string, std::string> metadata = {
@@ -349,16 +349,11 @@ int run_render(const RenderCommand& command) {
     double svgf_bytes = 0.0;
     shown = &image;
     if (denoiser) {
-      frame_rgba.resize(image.size());
-      for (std::size_t i = 0; i < image.size(); ++i) frame_rgba[i] = glm::vec4(image[i], 1.0f);
-      // Where the guided sampler copied this frame's G-buffer to the device, the denoiser reads
-      // it there (docs/denoising.md, "On a GPU").
-      const std::vector<glm::vec4>& denoised =
-          denoiser->denoise(frame_rgba, renderer.gbuffer(),
-                            guided ? guided->device_gbuffer_of(renderer.gbuffer()) : nullptr);
-      denoised_rgb.resize(image.size());
-      for (std::size_t i = 0; i < image.size(); ++i) denoised_rgb[i] = glm::vec3(denoised[i]);
-      shown = &denoised_rgb;
+      // The renderer's image in, the denoised image out, both as they are (three floats a
+      // pixel, in place where memory is shared). Where the guided sampler copied this frame's
+      // G-buffer to the device, the denoiser reads it there (docs/denoising.md, "On a GPU").
+      shown = &denoiser->denoise(image, renderer.gbuffer(),
+                                 guided ? guided->device_gbuffer_of(renderer.gbuffer()) : nullptr);
       for (const auto& [name, ms] : denoiser->times_ms()) stats.time_ms[name] = ms;
       stats.time_ms["total"] += denoiser->times_ms().at("svgf_total");
       svgf_bytes = denoiser->host_device_bytes_per_pixel();

@@ -15,14 +15,16 @@ namespace {
 
 static_assert(sizeof(shared::pg_svgf_settings) == 11 * 4, "pg_svgf_settings: 4-byte fields only");
 static_assert(sizeof(glm::vec4) == sizeof(cl_float4), "glm::vec4 must match cl_float4");
+static_assert(sizeof(glm::vec3) == 3 * sizeof(cl_float), "glm::vec3 must be three packed floats");
 
-// Bytes per pixel the upload of one frame copies: colour, emission, position_depth,
-// shading_normal, base_color_roughness (16 each), flags, material (4 each), motion (8); only the
-// first two where the G-buffer is on the device already.
-constexpr double kUploadBytesPerPixel = 5 * 16 + 4 + 4 + 8;
-constexpr double kColourUploadBytesPerPixel = 2 * 16;
+// Bytes per pixel the upload of one frame copies: colour (12: the renderer's image, three floats
+// a pixel), emission, position_depth, shading_normal, base_color_roughness (16 each), flags,
+// material (4 each), motion (8); only the first two where the G-buffer is on the device already.
+constexpr std::size_t kColourBytesPerPixel = 12;
+constexpr double kUploadBytesPerPixel = kColourBytesPerPixel + 4 * 16 + 4 + 4 + 8;
+constexpr double kColourUploadBytesPerPixel = kColourBytesPerPixel + 16;
 constexpr std::size_t kUploadChannels = 8;
-constexpr double kDownloadBytesPerPixel = 16;
+constexpr double kDownloadBytesPerPixel = kColourBytesPerPixel;
 
 using BufferList = std::initializer_list<const cl::Buffer*>;
 
@@ -112,7 +114,7 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
     for (cl::Buffer& b : moments_) b = buffer(16);
     for (cl::Buffer& b : illumination_) b = buffer(16);
     if (!zero_copy_) {  // else denoise() reads these in place
-      colour_ = buffer(16);
+      colour_ = buffer(kColourBytesPerPixel);
       emission_ = buffer(16);
       position_depth_ = buffer(16);
       shading_normal_ = buffer(16);
@@ -128,9 +130,9 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
     // Where memory is shared, remodulate writes the host's output image in place (mapped after
     // the kernel: OpenCL 1.2 gives the mapped pointer from host_ptr); elsewhere it is read back.
     output_host_.resize(n);
-    output_ = zero_copy_ ? cl::Buffer(c, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, n * 16,
-                                      output_host_.data())
-                         : buffer(16);
+    output_ = zero_copy_ ? cl::Buffer(c, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR,
+                                      n * kColourBytesPerPixel, output_host_.data())
+                         : buffer(kColourBytesPerPixel);
   });
   if (!zero_copy_)
     staging_ = std::make_unique<PinnedStaging>(
@@ -162,7 +164,7 @@ void SvgfDenoiser::unmap_output() {
   translate_cl_errors([&] { runtime_.queue().enqueueUnmapMemObject(output_, mapped); });
 }
 
-const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>& colour,
+const std::vector<glm::vec3>& SvgfDenoiser::denoise(const std::vector<glm::vec3>& colour,
                                                     const GBuffer& g,
                                                     const GuiderGBuffer* on_device) {
   check_svgf_input(width_, height_, colour, g);
@@ -297,7 +299,7 @@ const std::vector<glm::vec4>& SvgfDenoiser::denoise(const std::vector<glm::vec4>
     times_["svgf_remodulate"] = run(remodulate_, 1, pixel_groups_);
 
     const auto download = Clock::now();
-    const std::size_t bytes = output_host_.size() * 16;
+    const std::size_t bytes = output_host_.size() * kColourBytesPerPixel;
     if (zero_copy_) {
       // Mapped for reading until the next denoise(), so that the host reads output_host_ only
       // between map and unmap, as OpenCL 1.2 asks of a CL_MEM_USE_HOST_PTR buffer. Nothing is
@@ -351,12 +353,15 @@ std::vector<glm::vec4> SvgfDenoiser::read(SvgfStage stage) {
       break;
   }
   const std::size_t n = static_cast<std::size_t>(width_) * height_;
-  std::vector<float> floats(4 * n);
-  translate_cl_errors(
-      [&] { runtime_.queue().enqueueReadBuffer(*b, CL_TRUE, 0, n * 16, floats.data()); });
+  const std::size_t channels = stage == SvgfStage::Output ? 3 : 4;
+  std::vector<float> floats(channels * n);
+  translate_cl_errors([&] {
+    runtime_.queue().enqueueReadBuffer(*b, CL_TRUE, 0, n * channels * sizeof(float), floats.data());
+  });
   std::vector<glm::vec4> out(n);
-  if (stage == SvgfStage::Output) {  // one float4 per pixel
-    std::memcpy(out.data(), floats.data(), n * 16);
+  if (stage == SvgfStage::Output) {  // three floats per pixel, returned with w = 1
+    for (std::size_t i = 0; i < n; ++i)
+      out[i] = glm::vec4(floats[3 * i], floats[3 * i + 1], floats[3 * i + 2], 1.0f);
     return out;
   }
   // The denoiser's own images are planar (kernels/shared/svgf.h).

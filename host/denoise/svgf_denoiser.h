@@ -41,14 +41,16 @@ class SvgfDenoiser {
   SvgfDenoiser(const SvgfDenoiser&) = delete;
   SvgfDenoiser& operator=(const SvgfDenoiser&) = delete;
 
-  // Filters one frame of noisy colour (rgb; w ignored) seen through the G-buffer g, blocking;
-  // returns the denoised colour (w = 1 on surfaces; pixels without a surface keep their input),
-  // valid until the next denoise().
+  // Filters one frame of noisy colour seen through the G-buffer g, blocking; returns the
+  // denoised colour (pixels without a surface keep their input), valid until the next
+  // denoise(). Both are the renderer's image layout, three floats a pixel, read and written in
+  // place where memory is shared (converting them to four floats and back on the host cost 2.7
+  // ms a frame at 960x540; docs/denoising.md, "The colour in the renderer's layout").
   // on_device: g's channels already on the device (the guided sampler's copy of this frame's
   // G-buffer, GuidedFirstBounce::device_gbuffer_of): where denoise() would copy its inputs, it
-  // reads the G-buffer's there and uploads only the colour and the emission (32 bytes a pixel
-  // instead of 96). Throws InputError when the sizes do not match.
-  const std::vector<glm::vec4>& denoise(const std::vector<glm::vec4>& colour, const GBuffer& g,
+  // reads the G-buffer's there and uploads only the colour and the emission (28 bytes a pixel
+  // instead of 92). Throws InputError when the sizes do not match.
+  const std::vector<glm::vec3>& denoise(const std::vector<glm::vec3>& colour, const GBuffer& g,
                                         const GuiderGBuffer* on_device = nullptr);
   // Forgets the history: the next frame starts anew (a camera cut).
   void reset() { has_history_ = false; }
@@ -120,7 +122,7 @@ class SvgfDenoiser {
   // The a-trous ping-pong ([0], [1]) and the variance pass's output ([2]).
   std::array<cl::Buffer, 3> illumination_;
   const cl::Buffer* filtered_ = nullptr;  // the last iteration's output
-  std::vector<glm::vec4> output_host_;
+  std::vector<glm::vec3> output_host_;
   void* mapped_output_ = nullptr;  // output_ mapped for reading, from denoise() to the next
   std::map<std::string, double> times_;
 };

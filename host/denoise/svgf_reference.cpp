@@ -16,7 +16,7 @@ glm::vec3 xyz(const glm::vec4& v) {
 
 }  // namespace
 
-void check_svgf_input(int width, int height, const std::vector<glm::vec4>& colour,
+void check_svgf_input(int width, int height, const std::vector<glm::vec3>& colour,
                       const GBuffer& g) {
   const std::string size = std::to_string(width) + "x" + std::to_string(height);
   if (g.width != width || g.height != height)
@@ -63,7 +63,7 @@ const std::vector<glm::vec4>& SvgfReference::stage(SvgfStage stage) const {
   return output_;
 }
 
-const std::vector<glm::vec4>& SvgfReference::denoise(const std::vector<glm::vec4>& colour,
+const std::vector<glm::vec3>& SvgfReference::denoise(const std::vector<glm::vec3>& colour,
                                                      const GBuffer& g) {
   check_svgf_input(width_, height_, colour, g);
   temporal(colour, g);
@@ -85,10 +85,12 @@ const std::vector<glm::vec4>& SvgfReference::denoise(const std::vector<glm::vec4
   prev_material_.assign(g.material.begin(), g.material.end());
   prev_moments_ = moments_;
   has_history_ = true;
-  return output_;
+  denoised_.resize(output_.size());
+  for (std::size_t i = 0; i < output_.size(); ++i) denoised_[i] = glm::vec3(output_[i]);
+  return denoised_;
 }
 
-void SvgfReference::temporal(const std::vector<glm::vec4>& colour, const GBuffer& g) {
+void SvgfReference::temporal(const std::vector<glm::vec3>& colour, const GBuffer& g) {
   const sh::pg_svgf_settings& s = kernel_settings_;
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
@@ -110,8 +112,7 @@ void SvgfReference::temporal(const std::vector<glm::vec4>& colour, const GBuffer
       depth_slope_[i] = sh::pg_svgf_depth_slope(pd.w, z_left, z_right, z_down, z_up);
 
       const glm::vec3 albedo = sh::pg_svgf_albedo(g.base_color_roughness[i], s.albedo_floor);
-      const glm::vec3 illumination =
-          sh::pg_svgf_demodulate(xyz(colour[i]), xyz(g.emission[i]), albedo);
+      const glm::vec3 illumination = sh::pg_svgf_demodulate(colour[i], xyz(g.emission[i]), albedo);
       const float luminance = sh::pg_luminance(illumination);
 
       glm::vec3 sum_history(0.0f);
@@ -260,10 +261,10 @@ void SvgfReference::atrous(const std::vector<glm::vec4>& in, std::vector<glm::ve
     }
 }
 
-void SvgfReference::remodulate(const std::vector<glm::vec4>& colour, const GBuffer& g) {
+void SvgfReference::remodulate(const std::vector<glm::vec3>& colour, const GBuffer& g) {
   for (std::size_t i = 0; i < output_.size(); ++i) {
     if (!sh::pg_svgf_has_surface(g.flags[i])) {
-      output_[i] = colour[i];
+      output_[i] = glm::vec4(colour[i], 1.0f);
       continue;
     }
     const glm::vec3 albedo =

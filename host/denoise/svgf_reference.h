@@ -18,9 +18,10 @@ class SvgfReference {
   // Throws InputError for settings out of range or a size below 1x1.
   SvgfReference(int width, int height, const SvgfSettings& settings = {});
 
-  // Filters one frame of noisy colour (rgb; w ignored) seen through the G-buffer g; returns the
-  // denoised colour. Throws InputError when the sizes do not match.
-  const std::vector<glm::vec4>& denoise(const std::vector<glm::vec4>& colour, const GBuffer& g);
+  // Filters one frame of noisy colour seen through the G-buffer g; returns the denoised colour
+  // (stage(SvgfStage::Output) holds it with w = 1). Throws InputError when the sizes do not
+  // match.
+  const std::vector<glm::vec3>& denoise(const std::vector<glm::vec3>& colour, const GBuffer& g);
   // Forgets the history: the next frame starts anew.
   void reset() { has_history_ = false; }
 
@@ -28,11 +29,11 @@ class SvgfReference {
   const std::vector<float>& depth_slope() const { return depth_slope_; }
 
  private:
-  void temporal(const std::vector<glm::vec4>& colour, const GBuffer& g);
+  void temporal(const std::vector<glm::vec3>& colour, const GBuffer& g);
   void variance();
   void atrous(const std::vector<glm::vec4>& in, std::vector<glm::vec4>& out, int step,
               int radius) const;
-  void remodulate(const std::vector<glm::vec4>& colour, const GBuffer& g);
+  void remodulate(const std::vector<glm::vec3>& colour, const GBuffer& g);
 
   int width_, height_;
   SvgfSettings settings_;
@@ -40,6 +41,7 @@ class SvgfReference {
   bool has_history_ = false;
   std::vector<glm::vec4> surface_, integrated_, moments_, illumination_, filtered_, history_,
       output_, scratch_;
+  std::vector<glm::vec3> denoised_;  // output_'s rgb
   std::vector<float> depth_slope_;
   // Last frame's G-buffer channels that the history test reads.
   std::vector<glm::vec4> prev_position_depth_, prev_normal_;
@@ -48,7 +50,7 @@ class SvgfReference {
 };
 
 // InputError unless colour and g hold width x height pixels.
-void check_svgf_input(int width, int height, const std::vector<glm::vec4>& colour,
+void check_svgf_input(int width, int height, const std::vector<glm::vec3>& colour,
                       const GBuffer& g);
 
 }  // namespace rtpg

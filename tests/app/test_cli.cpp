@@ -716,10 +716,11 @@ TEST_F(Cli, DenoiseWritesTheFilteredAndTheNoisyFrameWithTheirStatistics) {
   EXPECT_TRUE(last.contains("flicker_mse_noisy"));
   // Nothing crosses where the guided frame reads in place (zero_copy, PoCL's CPU device);
   // elsewhere (RTPG_HOST_TRANSFER=packed, the tests' second run) SVGF reads the guider's copy of
-  // the G-buffer and moves the colour and emission up and the denoised colour down: 48 bytes.
+  // the G-buffer and moves the colour (12 bytes) and emission (16) up and the denoised colour
+  // (12) down: 40 bytes.
   ASSERT_TRUE(last.contains("zero_copy"));
   EXPECT_EQ(last.value("svgf_host_device_bytes_per_pixel", -1.0),
-            last.value("zero_copy", 0.0) == 1.0 ? 0.0 : 48.0);
+            last.value("zero_copy", 0.0) == 1.0 ? 0.0 : 40.0);
 }
 
 TEST_F(Cli, RejectsBadDenoiserSettings) {

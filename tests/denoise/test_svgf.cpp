@@ -81,21 +81,27 @@ GBuffer scene_gbuffer(int w, int h, float shift_x, std::mt19937& rng) {
 }
 
 // Noisy colour on g: albedo * (smooth illumination * heavy-tailed noise) + emission.
-std::vector<glm::vec4> noisy_colour(const GBuffer& g, std::mt19937& rng) {
+std::vector<glm::vec3> noisy_colour(const GBuffer& g, std::mt19937& rng) {
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  std::vector<glm::vec4> c(g.pixel_count());
+  std::vector<glm::vec3> c(g.pixel_count());
   for (std::size_t i = 0; i < c.size(); ++i) {
     if (!g.has_surface(i)) {
-      c[i] = g.emission[i];
+      c[i] = glm::vec3(g.emission[i]);
       continue;
     }
     const float u = unit(rng);
     const float noise = u < 0.05f ? 12.0f * unit(rng) : 0.5f * unit(rng);  // mean 0.8375
     const float light = 1.0f + 0.5f * static_cast<float>(g.material[i]);
-    c[i] = glm::vec4(glm::vec3(g.base_color_roughness[i]) * light * noise, 1.0f) +
-           glm::vec4(glm::vec3(g.emission[i]), 0.0f);
+    c[i] = glm::vec3(g.base_color_roughness[i]) * light * noise + glm::vec3(g.emission[i]);
   }
   return c;
+}
+
+// The denoised colour as the stage images hold it: w = 1.
+std::vector<glm::vec4> with_unit_w(const std::vector<glm::vec3>& rgb) {
+  std::vector<glm::vec4> out(rgb.size());
+  for (std::size_t i = 0; i < rgb.size(); ++i) out[i] = glm::vec4(rgb[i], 1.0f);
+  return out;
 }
 
 // |a - b| within a relative tolerance of the larger magnitude (plus a floor for values near 0).
@@ -149,9 +155,9 @@ void expect_equal_to_the_host_reference(ClRuntime& rt, const std::vector<Case>& 
     std::mt19937 rng(7);
     for (int f = 0; f < 3; ++f) {
       const GBuffer g = scene_gbuffer(c.width, c.height, 1.7f * static_cast<float>(f), rng);
-      const std::vector<glm::vec4> colour = noisy_colour(g, rng);
-      const std::vector<glm::vec4> out = device.denoise(colour, g);
-      host.denoise(colour, g);
+      const std::vector<glm::vec3> colour = noisy_colour(g, rng);
+      const std::vector<glm::vec3> out = device.denoise(colour, g);
+      const std::vector<glm::vec3> host_out = host.denoise(colour, g);
       // The exp and log of the device may be 3 ulp off the host's; sums of 25-49 terms.
       const float tol = 2e-4f;
       expect_close(device.read(SvgfStage::Surface), host.stage(SvgfStage::Surface), "surface", 0);
@@ -167,7 +173,8 @@ void expect_equal_to_the_host_reference(ClRuntime& rt, const std::vector<Case>& 
       expect_close(device.read(SvgfStage::History), host.stage(SvgfStage::History), "history", tol);
       expect_close(device.read(SvgfStage::Filtered), host.stage(SvgfStage::Filtered), "filtered",
                    tol);
-      expect_close(out, host.stage(SvgfStage::Output), "output", tol);
+      expect_close(with_unit_w(out), host.stage(SvgfStage::Output), "output", tol);
+      expect_close(device.read(SvgfStage::Output), with_unit_w(host_out), "output read back", tol);
     }
   }
 }
@@ -240,14 +247,12 @@ TEST(SvgfKernels, FlatIlluminationPassesThroughUnchanged) {
     std::mt19937 rng(3);
     for (int f = 0; f < 3; ++f) {
       const GBuffer g = scene_gbuffer(w, h, 0.0f, rng);
-      std::vector<glm::vec4> colour(g.pixel_count());
+      std::vector<glm::vec3> colour(g.pixel_count());
       for (std::size_t i = 0; i < colour.size(); ++i)
-        colour[i] =
-            g.has_surface(i)
-                ? glm::vec4(glm::vec3(g.base_color_roughness[i]) * 0.7f + glm::vec3(g.emission[i]),
-                            1.0f)
-                : g.emission[i];
-      const std::vector<glm::vec4> out = device.denoise(colour, g);
+        colour[i] = g.has_surface(i)
+                        ? glm::vec3(g.base_color_roughness[i]) * 0.7f + glm::vec3(g.emission[i])
+                        : glm::vec3(g.emission[i]);
+      const std::vector<glm::vec3> out = device.denoise(colour, g);
       for (std::size_t i = 0; i < out.size(); ++i)
         for (int c = 0; c < 3; ++c)
           ASSERT_NEAR(out[i][c], colour[i][c], 1e-5f * std::max(1.0f, colour[i][c]))
@@ -267,7 +272,7 @@ TEST(SvgfKernels, EdgesOfDepthAndNormalAreNotBlurred) {
                    std::to_string(radius));
       GBuffer g;
       g.resize(w, h);
-      std::vector<glm::vec4> colour(g.pixel_count());
+      std::vector<glm::vec3> colour(g.pixel_count());
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
           const std::size_t i = static_cast<std::size_t>(y) * w + x;
@@ -278,13 +283,13 @@ TEST(SvgfKernels, EdgesOfDepthAndNormalAreNotBlurred) {
           g.shading_normal[i] =
               right && normal_edge ? glm::vec4(1, 0, 0, 0) : glm::vec4(0, 0, 1, 0);
           g.base_color_roughness[i] = glm::vec4(0.5f, 0.5f, 0.5f, 0.5f);
-          colour[i] = right ? glm::vec4(2.0f, 1.0f, 0.5f, 1.0f) : glm::vec4(0.1f, 0.2f, 0.3f, 1.0f);
+          colour[i] = right ? glm::vec3(2.0f, 1.0f, 0.5f) : glm::vec3(0.1f, 0.2f, 0.3f);
         }
       SvgfSettings s;
       s.atrous_radius = radius;
       s.history_atrous_radius = radius;
       SvgfDenoiser device(rt, w, h, s);
-      const std::vector<glm::vec4> out = device.denoise(colour, g);
+      const std::vector<glm::vec3> out = device.denoise(colour, g);
       for (std::size_t i = 0; i < out.size(); ++i)
         for (int c = 0; c < 3; ++c)
           ASSERT_NEAR(out[i][c], colour[i][c], 1e-5f) << "pixel " << i % w << "," << i / w;
@@ -347,10 +352,10 @@ TEST(SvgfKernels, TemporalAccumulationConvergesToTheMean) {
       std::uniform_real_distribution<float> unit(0.0f, 1.0f);  // mean 1/2
       std::vector<double> sum(g.pixel_count(), 0.0);
       for (int f = 0; f < frames; ++f) {
-        std::vector<glm::vec4> colour(g.pixel_count());
+        std::vector<glm::vec3> colour(g.pixel_count());
         for (std::size_t i = 0; i < colour.size(); ++i) {
-          colour[i] = glm::vec4(glm::vec3(unit(rng)), 1.0f);
-          sum[i] += shared::pg_luminance(glm::vec3(colour[i]));
+          colour[i] = glm::vec3(unit(rng));
+          sum[i] += shared::pg_luminance(colour[i]);
         }
         device.denoise(colour, g);
       }
@@ -387,13 +392,15 @@ TEST(SvgfKernels, GBufferOnTheDeviceEqualsUploadingIt) {
   std::mt19937 rng(13);
   for (int f = 0; f < 6; ++f) {
     const GBuffer g = scene_gbuffer(w, h, 2.3f * static_cast<float>(f), rng);
-    const std::vector<glm::vec4> colour = noisy_colour(g, rng);
+    const std::vector<glm::vec3> colour = noisy_colour(g, rng);
     enqueue_upload(rt.queue(), g, on_device);
     rt.queue().finish();
-    const std::vector<glm::vec4> a = uploading.denoise(colour, g);
-    const std::vector<glm::vec4> b = sharing.denoise(colour, g, &on_device);
-    EXPECT_EQ(uploading.host_device_bytes_per_pixel(), 112.0);
-    EXPECT_EQ(sharing.host_device_bytes_per_pixel(), 48.0);
+    const std::vector<glm::vec3> a = uploading.denoise(colour, g);
+    const std::vector<glm::vec3> b = sharing.denoise(colour, g, &on_device);
+    // Up: the colour (12 bytes), emission, position, normal, base colour (16 each), flags and
+    // material (4 each), motion (8), or the first two alone; down: the colour (12).
+    EXPECT_EQ(uploading.host_device_bytes_per_pixel(), 104.0);
+    EXPECT_EQ(sharing.host_device_bytes_per_pixel(), 40.0);
     ASSERT_EQ(a.size(), b.size());
     std::size_t differ = 0;
     for (std::size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
@@ -420,18 +427,18 @@ TEST(SvgfKernels, ZeroCopyEqualsCopying) {
   const bool copies_forced = env && (std::string(env) == "pinned" || std::string(env) == "packed" ||
                                      std::string(env) == "pageable");
   EXPECT_EQ(in_place.zero_copy(), rt.info().host_unified_memory && !copies_forced);
-  EXPECT_EQ(copying.host_device_bytes_per_pixel(), 112.0);
-  EXPECT_EQ(in_place.host_device_bytes_per_pixel(), in_place.zero_copy() ? 0.0 : 112.0);
+  EXPECT_EQ(copying.host_device_bytes_per_pixel(), 104.0);
+  EXPECT_EQ(in_place.host_device_bytes_per_pixel(), in_place.zero_copy() ? 0.0 : 104.0);
   std::mt19937 rng(11);
   GBuffer g = scene_gbuffer(w, h, 0.0f, rng);
-  std::vector<glm::vec4> colour = noisy_colour(g, rng);
+  std::vector<glm::vec3> colour = noisy_colour(g, rng);
   for (int f = 0; f < 6; ++f) {
     const GBuffer next = scene_gbuffer(w, h, 2.3f * static_cast<float>(f), rng);
-    const std::vector<glm::vec4> next_colour = noisy_colour(next, rng);
+    const std::vector<glm::vec3> next_colour = noisy_colour(next, rng);
     g = next;  // copy assignment: the same host memory, rewritten
     colour = next_colour;
-    const std::vector<glm::vec4> a = copying.denoise(colour, g);
-    const std::vector<glm::vec4> b = in_place.denoise(colour, g);
+    const std::vector<glm::vec3> a = copying.denoise(colour, g);
+    const std::vector<glm::vec3> b = in_place.denoise(colour, g);
     ASSERT_EQ(a.size(), b.size());
     std::size_t differ = 0;
     for (std::size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
@@ -458,7 +465,7 @@ TEST(SvgfKernels, ReprojectionKeepsHistoryOnlyOnTheSameSurface) {
     SvgfDenoiser device(rt, w, h, settings);
     SvgfReference host(w, h, settings);
     for (const GBuffer* g : {&g0, &g1}) {
-      const std::vector<glm::vec4> colour = noisy_colour(*g, rng);
+      const std::vector<glm::vec3> colour = noisy_colour(*g, rng);
       device.denoise(colour, *g);
       host.denoise(colour, *g);
     }
@@ -531,14 +538,14 @@ TEST(SvgfKernels, BadInputIsAClearError) {
   GBuffer g;
   g.resize(8, 8);
   try {
-    d.denoise(std::vector<glm::vec4>(63), g);
+    d.denoise(std::vector<glm::vec3>(63), g);
     ADD_FAILURE() << "63 pixels accepted for 8x8";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("63 colour pixels"), std::string::npos) << e.what();
   }
   GBuffer small;
   small.resize(8, 7);
-  EXPECT_THROW(d.denoise(std::vector<glm::vec4>(64), small), InputError);
+  EXPECT_THROW(d.denoise(std::vector<glm::vec3>(64), small), InputError);
 }
 
 // Non-finite and huge colours (a broken or a firefly sample) give finite output everywhere.
@@ -549,12 +556,12 @@ TEST(SvgfKernels, ExtremeInputStaysFinite) {
   SvgfDenoiser device(rt, w, h);
   for (int f = 0; f < 3; ++f) {
     const GBuffer g = scene_gbuffer(w, h, static_cast<float>(f), rng);
-    std::vector<glm::vec4> colour = noisy_colour(g, rng);
+    std::vector<glm::vec3> colour = noisy_colour(g, rng);
     for (std::size_t i = 0; i < colour.size(); i += 7)
-      colour[i] = i % 3 == 0   ? glm::vec4(std::nanf(""))
-                  : i % 3 == 1 ? glm::vec4(3e38f, 1e30f, 0.0f, 1.0f)
-                               : glm::vec4(INFINITY, 0.0f, -INFINITY, 1.0f);
-    const std::vector<glm::vec4> out = device.denoise(colour, g);
+      colour[i] = i % 3 == 0   ? glm::vec3(std::nanf(""))
+                  : i % 3 == 1 ? glm::vec3(3e38f, 1e30f, 0.0f)
+                               : glm::vec3(INFINITY, 0.0f, -INFINITY);
+    const std::vector<glm::vec3> out = device.denoise(colour, g);
     for (std::size_t i = 0; i < out.size(); ++i) {
       if (!g.has_surface(i)) continue;  // the sky is passed through as it came
       for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(out[i][c])) << "pixel " << i;
