@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Builds or settings compared on the same frames, in turns: each round runs `rtpg render` once per
 --run, in the order given, and reads its stage times (`--stats-json`); printed are, per stage, each
-round's median over the frames after the first --skip, then the median over the rounds. On a
+round's median over the frames after the first --skip, then the median over the rounds; `wall` is
+the frame's wall time (the stats' `wall_ms`: what the run does per frame beyond the timed stages
+too, such as the statistics that --stats-json itself computes). On a
 shared machine only runs made in turns compare (docs/host-path-tracer.md's before / after tables
 are made so).
 
@@ -23,7 +25,7 @@ import tempfile
 from pathlib import Path
 
 # The frame's stages in the order of a frame (FrameStats "time_ms"); those a run has.
-STAGES = ["total", "primary", "gbuffer", "guiding_begin", "first_bounce", "shade", "group_rays", "trace",
+STAGES = ["wall", "total", "primary", "gbuffer", "guiding_begin", "first_bounce", "shade", "group_rays", "trace",
           "compact", "guiding_end", "reproject", "sample", "train", "svgf_total"]
 
 
@@ -43,7 +45,10 @@ def stage_medians(stats_path, skip):
     frames = json.loads(Path(stats_path).read_text())["frames"]
     kept = frames[skip:] or frames
     names = [s for s in STAGES if any(s in f["time_ms"] for f in kept)]
-    return {s: statistics.median(f["time_ms"].get(s, 0.0) for f in kept) for s in names}
+    medians = {s: statistics.median(f["time_ms"].get(s, 0.0) for f in kept) for s in names}
+    if all("wall_ms" in f for f in kept):
+        medians["wall"] = statistics.median(f["wall_ms"] for f in kept)
+    return medians
 
 
 def main():
