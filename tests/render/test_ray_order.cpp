@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstring>
 #include <limits>
 #include <memory>
 #include <random>
@@ -12,6 +11,7 @@
 #include <vector>
 
 #include "forwarding_sampler.h"
+#include "same_image.h"
 #include "render/first_bounce.h"
 #include "render/renderer.h"
 #include "render/vpl_buffer.h"
@@ -81,10 +81,6 @@ TEST(RayOrder, GroupsByOctantThenTheOriginsCell) {
   EXPECT_EQ(flat.group(glm::vec3(4.0f, 3.0f, 0.0f), plus) & 2u, 0u);
 }
 
-bool same_bits(const void* a, const void* b, std::size_t bytes) {
-  return std::memcmp(a, b, bytes) == 0;
-}
-
 // BSDF sampling that asks for each frame's VPLs (as a guide would, to train on them) and keeps
 // them.
 class VplKeepingSampler final : public ForwardingSampler {
@@ -126,14 +122,8 @@ TEST(RayOrder, GroupingLeavesImagesAndVplsAsTheyAre) {
       EXPECT_EQ(sa.extra.at("bounce_rays_grouped"), 1.0);
       EXPECT_EQ(sb.extra.at("bounce_rays_grouped"), 0.0);
       EXPECT_EQ(sa.secondary_rays, sb.secondary_rays);
-      ASSERT_EQ(a.image().size(), b.image().size());
-      std::size_t differ = 0, lit = 0;
-      for (std::size_t i = 0; i < a.image().size(); ++i) {
-        differ += !same_bits(&a.image()[i], &b.image()[i], sizeof(glm::vec3));
-        lit += a.image()[i] != glm::vec3(0.0f);
-      }
-      EXPECT_EQ(differ, 0u) << "frame " << frame << (with_vpls ? ", with VPLs" : "");
-      EXPECT_GT(lit, a.image().size() / 2) << "frame " << frame;
+      expect_same_lit_image(a.image(), b.image(),
+                            "frame " + std::to_string(frame) + (with_vpls ? ", with VPLs" : ""));
     }
     if (!with_vpls) continue;
     ASSERT_EQ(vpls_a.size(), vpls_b.size());
@@ -146,10 +136,8 @@ TEST(RayOrder, GroupingLeavesImagesAndVplsAsTheyAre) {
         EXPECT_EQ(va.info[i], vb.info[i]) << "pass " << f << ", pixel " << i;
         if ((va.info[i] & PG_VPL_VALID) == 0u) continue;
         ++valid;
-        EXPECT_TRUE(same_bits(&va.position[i], &vb.position[i], sizeof(va.position[i])))
-            << "pass " << f << ", pixel " << i;
-        EXPECT_TRUE(same_bits(&va.normal_radiance[i], &vb.normal_radiance[i],
-                              sizeof(va.normal_radiance[i])))
+        EXPECT_TRUE(same_bits(va.position[i], vb.position[i])) << "pass " << f << ", pixel " << i;
+        EXPECT_TRUE(same_bits(va.normal_radiance[i], vb.normal_radiance[i]))
             << "pass " << f << ", pixel " << i;
       }
       EXPECT_GT(valid, va.info.size() / 4) << "pass " << f;
