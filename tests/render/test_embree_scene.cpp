@@ -1,7 +1,8 @@
 // The batched ray queries of host/trace/embree_scene.h: the same hits and occlusion answers in
 // every ray mode (one by one, packets of 8, streams), for lists of shadow and bounce rays laid out
 // a stride apart, and for an image's rays traced in tiles of pixels; empty segments (tmin > tmax,
-// or a NaN bound) answered 0 without a query and left out of the count of rays queried.
+// or a NaN bound) answered 0 without a query and left out of the count of rays queried; alpha
+// masks' transparent texels let rays through.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -214,6 +215,64 @@ TEST(EmbreeScene, EveryRayModeGivesTheSameAnswers) {
       EXPECT_EQ(std::memcmp(&a.t, &b.t, sizeof a.t), 0) << "ray " << i << ", " << mode_name(mode);
       EXPECT_EQ(std::memcmp(&a.u, &b.u, sizeof a.u), 0) << "ray " << i << ", " << mode_name(mode);
       EXPECT_EQ(std::memcmp(&a.v, &b.v, sizeof a.v), 0) << "ray " << i << ", " << mode_name(mode);
+    }
+  }
+}
+
+// A quad whose left half is transparent in its alpha mask (u < 1/2: texels of alpha 0 up to a
+// quarter texel from the middle, and from the wrap's edge), over a floor: rays straight down
+// through the transparent half hit the floor and are not occluded on their way to it, through
+// the opaque half they hit the quad, in every ray mode, for 8-bit and float masks.
+TEST(EmbreeScene, AlphaMaskLetsRaysThroughItsTransparentTexels) {
+  for (const bool eight_bit : {true, false}) {
+    Scene scene;
+    Texture mask;
+    mask.width = 8;
+    mask.height = 1;
+    for (int x = 0; x < mask.width; ++x) {
+      const std::uint8_t alpha = x < 4 ? 0 : 255;
+      if (eight_bit) {
+        mask.texels8.push_back({255, 255, 255, alpha});
+      } else {
+        mask.texels.push_back(glm::vec4(1.0f, 1.0f, 1.0f, alpha / 255.0f));
+      }
+    }
+    scene.textures.push_back(mask);
+    Material masked;
+    masked.alpha_texture = 0;
+    masked.alpha_cutoff = 0.5f;
+    scene.materials = {masked, Material{}};
+    // u = (x + 1) / 2 on the quad (make_quad's corners take uv (0, 0), (1, 0), (1, 1), (0, 1)).
+    scene.meshes.push_back(make_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2}));
+    Mesh floor = make_quad({-2, -1, -2}, {4, 0, 0}, {0, 0, 4});
+    floor.material = 1;
+    scene.meshes.push_back(floor);
+    const EmbreeScene tracer(scene);
+
+    std::mt19937 gen(17);
+    std::uniform_real_distribution<float> band(0.15f, 0.35f), z(-0.9f, 0.9f);
+    std::vector<Ray> down, to_middle;
+    std::vector<bool> transparent;
+    for (int i = 0; i < 200; ++i) {
+      const bool left = i % 2 == 0;
+      const float u = left ? band(gen) : band(gen) + 0.5f;
+      const glm::vec3 origin(2.0f * u - 1.0f, 1.0f, z(gen));
+      down.push_back(segment(origin, {0, -1, 0}, 0.0f, 1e30f));
+      to_middle.push_back(segment(origin, {0, -1, 0}, 0.0f, 1.5f));  // ends above the floor
+      transparent.push_back(left);
+    }
+    for (RayMode mode : {RayMode::Single, RayMode::Packet8, RayMode::Stream}) {
+      std::vector<Hit> hits(down.size());
+      std::vector<std::uint8_t> occluded(down.size(), 7);
+      tracer.intersect(down.data(), hits.data(), down.size(), mode);
+      tracer.occluded(to_middle.data(), occluded.data(), to_middle.size(), mode);
+      for (std::size_t i = 0; i < down.size(); ++i) {
+        ASSERT_TRUE(hits[i].valid()) << "ray " << i << ", " << mode_name(mode);
+        EXPECT_EQ(hits[i].mesh, transparent[i] ? 1u : 0u)
+            << "ray " << i << ", " << mode_name(mode) << (eight_bit ? ", 8-bit" : ", float");
+        EXPECT_EQ(occluded[i], transparent[i] ? 0 : 1)
+            << "ray " << i << ", " << mode_name(mode) << (eight_bit ? ", 8-bit" : ", float");
+      }
     }
   }
 }
