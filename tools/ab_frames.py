@@ -1,18 +1,23 @@
 #!/usr/bin/env python3
 """Builds or settings compared on the same frames, in turns: each round runs `rtpg render` once per
---run, in the order given, and reads its stage times (`--stats-json`); printed are, per stage, each
-round's median over the frames after the first --skip, then the median over the rounds; `wall` is
-the frame's wall time (the stats' `wall_ms`: what the run does per frame beyond the timed stages
-too, such as the statistics that --stats-json itself computes). On a
+--run and reads its stage times (`--stats-json`); printed are, per stage, each round's median over
+the frames after the first --skip, then the median over the rounds; `wall` is the frame's wall
+time (the stats' `wall_ms`: what the run does per frame beyond the timed stages too, such as the
+statistics that --stats-json itself computes). A second table gives each later run's time over
+the first run's, round by round (the two made minutes apart at most), and their median. On a
 shared machine only runs made in turns compare (docs/host-path-tracer.md's before / after tables
-are made so).
+are made so), and the order within a round matters too: the same binary run twice in a row on
+Sponza took 1-4% less the second time in three rounds of four, and 1% more on the Cornell box
+(docs/host-path-tracer.md, "The order within a round"). So the rounds alternate the order
+(`--order alternate`, the default: the runs as given, then reversed, and so on), which cancels a
+drift within a round over every two rounds; `--order fixed` keeps the order given.
 
 A --run is "NAME: [VAR=VALUE ...] BINARY [ARGUMENT ...]": environment assignments, the rtpg binary,
 and arguments added to `render SCENE --res RES --frames FRAMES`.
 
 Usage:
   ab_frames.py --scene scenes/sponza.json [--res 960x540] [--frames 8] [--skip 2] [--rounds 3]
-               --run "before: /tmp/rtpg-old --guiding off" --run "after: build/rtpg --guiding off"
+               [--order alternate|fixed] --run "before: /tmp/rtpg-old --guiding off" --run "after: build/rtpg --guiding off"
 """
 import argparse
 import json
@@ -58,6 +63,9 @@ def main():
     parser.add_argument("--frames", type=int, default=8)
     parser.add_argument("--skip", type=int, default=2, help="frames left out at the start")
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--order", choices=["alternate", "fixed"], default="alternate",
+                        help="the runs' order within a round: as given, then reversed, and so on "
+                             "(alternate), or always as given (fixed)")
     parser.add_argument("--run", action="append", required=True, help="see the usage above")
     args = parser.parse_args()
     if args.frames < 1 or args.rounds < 1 or args.skip < 0:
@@ -69,7 +77,8 @@ def main():
     results = {name: [] for name, _, _, _ in runs}
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(args.rounds):
-            for name, env, binary, extra in runs:
+            order = runs if args.order == "fixed" or r % 2 == 0 else runs[::-1]
+            for position, (name, env, binary, extra) in enumerate(order):
                 stats = Path(tmp) / "stats.json"
                 command = [binary, "render", args.scene, "--res", args.res, "--frames",
                            str(args.frames), "-q", "-o", str(Path(tmp) / "image.exr"),
@@ -81,12 +90,14 @@ def main():
                              f"{shlex.join(command)}\n{done.stderr}")
                 medians = stage_medians(stats, args.skip)
                 results[name].append(medians)
-                print(f"round {r + 1} {name}: " +
+                print(f"round {r + 1} ({position + 1}. in turn) {name}: " +
                       ", ".join(f"{s} {v:.2f}" for s, v in medians.items()), flush=True)
 
     stages = [s for s in STAGES if any(s in m for ms in results.values() for m in ms)]
+    order = "each round's order the reverse of the one before" if args.order == "alternate" \
+        else "the same order every round"
     print(f"\n{args.scene} at {args.res}, {args.frames} frames, medians of frames "
-          f"{args.skip}-{args.frames - 1}, ms, rounds in turns:\n")
+          f"{args.skip}-{args.frames - 1}, ms, rounds in turns ({order}):\n")
     print("| stage | " + " | ".join(results) + " |")
     print("|---" * (len(results) + 1) + "|")
     for s in stages:
@@ -95,6 +106,23 @@ def main():
             values = [m.get(s, 0.0) for m in ms]
             cells.append(", ".join(f"{v:.2f}" for v in values) +
                          (f" (median {statistics.median(values):.2f})" if len(values) > 1 else ""))
+        print(f"| {s} | " + " | ".join(cells) + " |")
+
+    names = list(results)
+    if len(names) < 2:
+        return
+    first = names[0]
+    print(f"\nEach run's time over {first}'s in the same round, and their median:\n")
+    print("| stage | " + " | ".join(f"{n} / {first}" for n in names[1:]) + " |")
+    print("|---" * len(names) + "|")
+    for s in stages:
+        cells = []
+        for n in names[1:]:
+            ratios = [m.get(s, 0.0) / f[s] for m, f in zip(results[n], results[first])
+                      if f.get(s, 0.0) > 0.0]
+            cells.append(", ".join(f"{v:.3f}" for v in ratios) +
+                         (f" (median {statistics.median(ratios):.3f})" if len(ratios) > 1 else "")
+                         if ratios else "-")
         print(f"| {s} | " + " | ".join(cells) + " |")
 
 
