@@ -49,9 +49,11 @@ MODES = {
                  scenes=["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza"],
                  tradeoff_scenes=["cornell-indirect", "sponza"]),
 }
-# The equal-time runs' order (equal_time: PT and PG run by run), recorded in the results' settings
-# so that the report says it; results from before 2026-11-27 (evening) lack it (all PT runs first).
-EQUAL_TIME_ORDER = "alternating"
+# The equal-time runs' order, recorded in the results' settings so that the report says it:
+# "alternating-balanced" (since 2026-12-07: PT and PG run by run, each pair in the reverse order of
+# the one before, suite/equal_time.py's method_order); "alternating" (2026-11-27, evening, to
+# 2026-12-07: PT and PG run by run, PT first in every pair); absent before (all PT runs first).
+EQUAL_TIME_ORDER = "alternating-balanced"
 LAST = 8  # equal-frame and trade-off errors: mean over the last 8 frames of a run
 
 

@@ -121,17 +121,26 @@ def figures(pt_runs, pg_runs):
             "time_ratio_pg_pt": NOT_REACHED if pg_time == NOT_REACHED else pg_time / budget}
 
 
+def method_order(repeat):
+    """The methods' order in repeat `repeat` (from 0): PT then PG, then PG then PT, and so on. A
+    run's place in the pair moves its frame times by 1-4% on the 2-core machine
+    (docs/host-path-tracer.md, "The order within a round"); taking both places in turn keeps
+    that out of the ratio of the two methods' times (exactly so for an even number of repeats)."""
+    return runner.METHODS if repeat % 2 == 0 else runner.METHODS[::-1]
+
+
 def runs(scene, res, frames, repeats, out, reference, extra=(), pg_extra=()):
     """The curves of `repeats` runs of each method (`rtpg render --accumulate --reference`, seeds
-    100, 101, ...), PT and PG alternating run by run, so that a machine whose speed drifts slows
-    both alike rather than one method's block of runs: {method: {"runs": [{"time_ms": cumulative
+    100, 101, ...), PT and PG alternating run by run (method_order: each repeat's pair in the
+    reverse order of the one before), so that a machine whose speed drifts slows both alike
+    rather than one method's block of runs: {method: {"runs": [{"time_ms": cumulative
     frame totals, "relmse": accumulated relMSE per frame}]}}. Frame 0 also builds the OpenCL
     programs (from the disk cache) and compiles work-group functions, a one-time start-up cost, so
     its time is replaced by the median frame's. `extra`: more rtpg arguments for both methods;
     `pg_extra`: for the guided runs only (a variant of guiding against the same path tracing)."""
     curves = {method: {"runs": []} for method in runner.METHODS}
     for r in range(repeats):
-        for method in runner.METHODS:
+        for method in method_order(r):
             stats, _ = runner.render(scene, res, frames, method, out, f"{method}-r{r}", reference=reference,
                                      extra=["--accumulate", "--seed", 100 + r, *extra,
                                             *(pg_extra if method == "pmm" else ())])

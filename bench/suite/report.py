@@ -102,9 +102,12 @@ def _equal_time(ex, report_dir, settings):
     else:  # results.json from before bench/suite/equal_time.py: its figures came from per-frame medians
         method = ("The figures are read off per-frame medians of the runs' times and errors (the method before "
                   "bench/suite/equal_time.py).")
-    # Runs before 2026-11-27 (evening) rendered all of PT's repeats, then all of PG's.
-    order = ("PT and PG alternating run by run" if settings.get("equal_time_order") == "alternating"
-             else "all PT runs first, then all PG runs")
+    # Runs before 2026-11-27 (evening) rendered all of PT's repeats, then all of PG's; until
+    # 2026-12-07 PT came first in every pair (bench/experiments.py, EQUAL_TIME_ORDER).
+    order = {"alternating-balanced": "PT and PG alternating run by run, each pair in the reverse order of the one "
+                                     "before",
+             "alternating": "PT and PG alternating run by run, PT first in each pair"}.get(
+        settings.get("equal_time_order"), "all PT runs first, then all PG runs")
     lines = ["## Equal time: error of the accumulated image against wall time", "",
              f"{settings['time_frames']} accumulated frames per method, {settings['repeats']} runs each (seeds 100, "
              f"101, ...) in the same process tree, {order}; frame 0's one-time program build is replaced by the "

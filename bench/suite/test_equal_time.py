@@ -19,6 +19,13 @@ def frames(s, k, n=4):
 
 
 class EqualTimeTests(unittest.TestCase):
+    def test_methods_take_both_places_in_turn(self):
+        self.assertEqual(equal_time.method_order(0), ("off", "pmm"))
+        self.assertEqual(equal_time.method_order(1), ("pmm", "off"))
+        self.assertEqual(equal_time.method_order(2), ("off", "pmm"))
+        for r in range(5):
+            self.assertEqual(sorted(equal_time.method_order(r)), ["off", "pmm"])
+
     def test_power_law_is_interpolated_exactly(self):
         # error = 3 t^-0.7 at uneven times: a straight line in log-log, so the answer is exact.
         t = [1.0, 1.7, 4.2, 9.0, 16.0]
