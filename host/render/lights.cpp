@@ -121,9 +121,14 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
     sun_frame_t_ = f.t;
     sun_frame_b_ = f.b;
     if (scene.sun.angular_radius > 0.0f) {
-      sun_cos_max_ = std::cos(scene.sun.angular_radius);
-      sun_solid_angle_ = 2.0f * kPi * (1.0f - sun_cos_max_);
-      sun_radiance_ = scene.sun.irradiance / sun_solid_angle_;
+      // A cone of radius r holds the solid angle 2 pi (1 - cos r) = 4 pi sin^2(r / 2), and a
+      // surface facing it receives L pi sin^2 r from radiance L over it: the radiance that
+      // gives the scene's irradiance on such a surface (scenes/README.md, "sun").
+      const float r = scene.sun.angular_radius, half_sine = std::sin(0.5f * r);
+      sun_one_minus_cos_max_ = 2.0f * half_sine * half_sine;
+      sun_sin2_max_ = std::sin(r) * std::sin(r);
+      sun_solid_angle_ = 2.0f * kPi * sun_one_minus_cos_max_;
+      sun_radiance_ = scene.sun.irradiance / (kPi * sun_sin2_max_);
     }
   }
   const Environment& env = scene.environment;
@@ -157,6 +162,13 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
   has_sky_ = env_map_ != nullptr ||
              (env.kind == Environment::Kind::Constant && env.color != glm::vec3(0.0f)) ||
              sun_solid_angle_ > 0.0f;
+}
+
+bool Lights::in_sun_cone(const glm::vec3& d) const {
+  // |d x axis| = sin of the angle, with the relative precision of its small components: the
+  // cosine, a dot product near 1, resolves the sun's 0.27-degree rim only to about 1%.
+  const glm::vec3 c = glm::cross(d, sun_axis_);
+  return glm::dot(d, sun_axis_) > 0.0f && glm::dot(c, c) <= sun_sin2_max_;
 }
 
 glm::vec2 Lights::direction_to_equirect(const glm::vec3& d) const {
@@ -247,8 +259,11 @@ bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2,
       out.delta = true;
       return true;
     }
-    const float cos_t = 1.0f - u1 * (1.0f - sun_cos_max_);
-    const float sin_t = std::sqrt(std::max(0.0f, 1.0f - cos_t * cos_t));
+    // Uniform in solid angle: 1 - cos t uniform in [0, 1 - cos r]; sin t from it without
+    // cancellation.
+    const float one_minus_cos = u1 * sun_one_minus_cos_max_;
+    const float cos_t = 1.0f - one_minus_cos;
+    const float sin_t = std::sqrt(std::max(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
     const float phi = 2.0f * kPi * u2;
     out.direction = glm::normalize(sun_frame_t_ * (sin_t * std::cos(phi)) +
                                    sun_frame_b_ * (sin_t * std::sin(phi)) + axis * cos_t);
@@ -292,14 +307,14 @@ float Lights::pdf_triangle(std::uint32_t mesh, std::uint32_t triangle, const glm
 glm::vec3 Lights::escaped_radiance(const glm::vec3& d) const {
   if (!has_sky_) return glm::vec3(0.0f);
   glm::vec3 l = environment_radiance(d);
-  if (sun_solid_angle_ > 0.0f && glm::dot(d, sun_axis_) >= sun_cos_max_) l += sun_radiance_;
+  if (sun_solid_angle_ > 0.0f && in_sun_cone(d)) l += sun_radiance_;
   return l;
 }
 
 float Lights::pdf_escaped(const glm::vec3& d) const {
   if (!has_sky_) return 0.0f;
   float pdf = selection_.probability(kEnvironment) * environment_pdf(d);
-  if (sun_solid_angle_ > 0.0f && glm::dot(d, sun_axis_) >= sun_cos_max_)
+  if (sun_solid_angle_ > 0.0f && in_sun_cone(d))
     pdf += selection_.probability(kSun) / sun_solid_angle_;
   return pdf;
 }

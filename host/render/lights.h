@@ -91,8 +91,14 @@ class Lights {
   bool has_sky_ = true;
   glm::vec3 sun_axis_{0, 1, 0};  // normalize(scene.sun.direction), once: every escaped ray asks
   glm::vec3 sun_frame_t_{1, 0, 0}, sun_frame_b_{0, 1, 0};
-  float sun_cos_max_ = 1.0f;
+  // The sun's cone of angular radius r: 1 - cos r and sin^2 r from sines, not from cos r, whose
+  // difference from 1 keeps only two or three digits in float at the sun's 0.27 degrees
+  // (docs/robustness.md, "The sun's cone").
+  float sun_one_minus_cos_max_ = 0.0f;
+  float sun_sin2_max_ = 0.0f;
   float sun_solid_angle_ = 0.0f;
+  // Whether direction d (unit) lies in the sun's cone: by the sine of its angle to the axis.
+  bool in_sun_cone(const glm::vec3& d) const;
   glm::vec3 sun_radiance_{0.0f};
   const Texture* env_map_ = nullptr;
   Distribution2D env_distribution_;

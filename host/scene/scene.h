@@ -34,8 +34,10 @@ struct Material {
   float bump_scale = 1.0f;
   int alpha_texture = -1;  // alpha mask, alpha-tested at alpha_cutoff
   float alpha_cutoff = 0.5f;
-  glm::vec3 emission{0.0f};   // emitted radiance (one-sided, along the geometric normal)
-  bool transmissive = false;  // guiding and NEE skip it; rendered as the BSDF allows
+  glm::vec3 emission{0.0f};  // emitted radiance (one-sided, along the geometric normal)
+  // Guiding skips it (no guided first bounce there: PG_GBUF_TRANSMISSIVE); it is shaded, lit by
+  // next-event estimation and sampled as its BSDF allows, which has no transmission.
+  bool transmissive = false;
   bool is_emissive() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
   // Whether shading a hit reads a texture (the alpha mask is the ray queries' own).
   bool has_textures() const {

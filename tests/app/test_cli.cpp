@@ -644,6 +644,56 @@ TEST_F(Cli, ReferenceReportsSamplesPerSecond) {
               0.5 + 1e-6 * rate);
 }
 
+// `rtpg reference` and `rtpg render --accumulate` both average frames of the same random streams:
+// a reference of 8 spp (two passes of 4) equals two accumulated 4-spp frames of the same seed, to
+// float rounding, and the accumulated image's relMSE against it is that rounding while each
+// frame's own relMSE is not. A reference that averaged its passes wrongly (a sum, the last pass
+// alone, divided by the sample count), or ignored --max-bounces or the seed, and an accumulation
+// that wrote or measured the last frame instead of the running mean, all fail here
+// (bench/suite/equal_time.py reads relmse_accumulated; the references are every error's yardstick).
+TEST_F(Cli, ReferenceEqualsTheAccumulatedFramesOfTheSameSeed) {
+  const std::string scene = shell_quote(source_dir() + "/scenes/cornell-box.json");
+  for (const std::string& args :
+       {"reference " + scene + " --res 20x12 --spp 8 --seed 3 --max-bounces 2 -q -o ref.exr",
+        "reference " + scene + " --res 20x12 --spp 8 --seed 3 --max-bounces 3 -q -o deeper.exr",
+        "reference " + scene + " --res 20x12 --spp 8 --seed 4 --max-bounces 2 -q -o seed4.exr",
+        "render " + scene + " --res 20x12 --spp 4 --frames 2 --seed 3 --max-bounces 2 --guiding " +
+            "off --accumulate -q -o accumulated.exr --reference ref.exr --stats-json stats.json"}) {
+    const RunResult r = run_rtpg(dir(), args);
+    ASSERT_TRUE(r.exited) << describe(r);
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+  }
+  const ExrImage reference = read_exr(dir() / "ref.exr"),
+                 accumulated = read_exr(dir() / "accumulated.exr");
+  ASSERT_EQ(reference.pixels.size(), 20u * 12u * 3u);
+  ASSERT_EQ(accumulated.pixels.size(), reference.pixels.size());
+  double sum = 0.0;
+  for (std::size_t i = 0; i < reference.pixels.size(); ++i) {
+    const float want = reference.pixels[i], got = accumulated.pixels[i];
+    EXPECT_NEAR(got, want, 1e-5f * std::max(1.0f, std::fabs(want))) << "value " << i;
+    sum += want;
+  }
+  EXPECT_GT(sum, 0.0);
+  // The deeper reference and the other seed's differ from it (so the comparison above can fail).
+  for (const char* other : {"deeper.exr", "seed4.exr"}) {
+    const ExrImage o = read_exr(dir() / other);
+    ASSERT_EQ(o.pixels.size(), reference.pixels.size()) << other;
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < o.pixels.size(); ++i)
+      differing += std::fabs(o.pixels[i] - reference.pixels[i]) >
+                   1e-4f * std::max(1.0f, std::fabs(reference.pixels[i]));
+    EXPECT_GT(differing, o.pixels.size() / 20) << other;
+  }
+  const nlohmann::json stats = nlohmann::json::parse(read_file(dir() / "stats.json"));
+  EXPECT_EQ(stats.at("max_bounces"), 2);
+  const nlohmann::json& frames = stats.at("frames");
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_GT(frames[0].at("relmse").get<double>(), 1e-4);
+  EXPECT_GT(frames[1].at("relmse").get<double>(), 1e-4);
+  EXPECT_LT(frames[1].at("relmse_accumulated").get<double>(), 1e-9);
+  EXPECT_GT(frames[0].at("relmse_accumulated").get<double>(), 1e-4);
+}
+
 // No OpenCL platform at all (the ICD loader finds no vendor file): exit code 3, the OpenCL
 // failure's one line, and nothing written, for every command that needs a device.
 TEST_F(Cli, NoOpenClPlatformIsExitThree) {

@@ -456,6 +456,74 @@ TEST(Lights, NoSkyWithoutAnEnvironmentOrASunsDisc) {
   EXPECT_EQ(sun_lights.escaped_radiance(side), glm::vec3(0.0f));
 }
 
+// What the sky looks like, not only how it is sampled (the chi-square tests above compare samples
+// with densities derived from the same lookups, so an upside-down map, a map turned the wrong way
+// or a wrong scale passes them): the radiance of the direction through each texel centre of an
+// environment map is that texel times the scene's colour, with the map's top row at the zenith
+// (+y), u = 0 towards +x and u growing towards +z, turned by `rotation` about +y
+// (scenes/README.md, "environment"); and a sun of finite size gives a surface facing it its
+// irradiance (the radiance over its cone, weighed by the cosine, integrated by quadrature).
+TEST(Lights, SkyRadianceHasTheMapsOrientationAndTheSunsIrradiance) {
+  for (const float rotation : {0.0f, 0.7f}) {
+    Scene scene = floor_scene();
+    Texture map;
+    map.width = 8;
+    map.height = 4;
+    for (int y = 0; y < map.height; ++y)
+      for (int x = 0; x < map.width; ++x)  // every texel its own value: x + 8 y + 1
+        map.texels.push_back(glm::vec4(glm::vec3(static_cast<float>(x + map.width * y + 1)), 1.0f));
+    scene.textures.push_back(map);
+    scene.environment.kind = Environment::Kind::Map;
+    scene.environment.map_texture = 0;
+    scene.environment.color = glm::vec3(2.0f, 3.0f, 0.5f);
+    scene.environment.rotation = rotation;
+    const Lights lights(scene);
+    for (int y = 0; y < map.height; ++y)
+      for (int x = 0; x < map.width; ++x) {
+        const double theta = kPi * (y + 0.5) / map.height;                // from the zenith
+        const double phi = 2.0 * kPi * (x + 0.5) / map.width + rotation;  // from +x towards +z
+        const glm::vec3 d(static_cast<float>(std::sin(theta) * std::cos(phi)),
+                          static_cast<float>(std::cos(theta)),
+                          static_cast<float>(std::sin(theta) * std::sin(phi)));
+        const glm::vec3 want =
+            glm::vec3(static_cast<float>(x + map.width * y + 1)) * scene.environment.color;
+        const glm::vec3 got = lights.escaped_radiance(d);
+        for (int c = 0; c < 3; ++c)
+          EXPECT_NEAR(got[c], want[c], 1e-3f * want[c])
+              << "texel " << x << "," << y << ", rotation " << rotation << ", channel " << c;
+      }
+  }
+
+  for (const float radius : {0.01f, 0.05f, 0.3f}) {
+    Scene scene = floor_scene();
+    scene.sun.enabled = true;
+    scene.sun.direction = glm::normalize(glm::vec3(-0.5f, 0.6f, 0.3f));
+    scene.sun.irradiance = glm::vec3(3.0f, 2.0f, 1.0f);
+    scene.sun.angular_radius = radius;
+    const Lights lights(scene);
+    const glm::vec3 axis = scene.sun.direction;
+    const shared::pg_frame frame = shared::pg_frame_from_normal(axis);
+    // Midpoint rule in (angle from the axis, azimuth), out to just past the cone's edge.
+    const int rings = 400, sectors = 64;
+    const double outer = 1.02 * radius;
+    glm::dvec3 irradiance(0.0);
+    for (int i = 0; i < rings; ++i) {
+      const double a = outer * (i + 0.5) / rings;
+      for (int j = 0; j < sectors; ++j) {
+        const double b = 2.0 * kPi * (j + 0.5) / sectors;
+        const glm::vec3 d = glm::normalize(static_cast<float>(std::cos(a)) * axis +
+                                           static_cast<float>(std::sin(a) * std::cos(b)) * frame.t +
+                                           static_cast<float>(std::sin(a) * std::sin(b)) * frame.b);
+        const double weight = std::cos(a) * std::sin(a) * (outer / rings) * (2.0 * kPi / sectors);
+        irradiance += glm::dvec3(lights.escaped_radiance(d)) * weight;
+      }
+    }
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(irradiance[c], scene.sun.irradiance[c], 0.01 * scene.sun.irradiance[c])
+          << "angular radius " << radius << ", channel " << c;
+  }
+}
+
 // Distribution2D: samples fall in cells in proportion to their weights, and the density it
 // reports integrates to one and equals weight / mean weight.
 TEST(Distribution2D, SamplesInProportionToTheWeights) {

@@ -11,6 +11,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "render/renderer.h"
+#include "same_image.h"
 #include "scene/scene_loader.h"
 
 namespace rtpg {
@@ -100,6 +101,41 @@ TEST(MotionVectors, ZeroForAStaticCamera) {
       renderer.render_frame(f);
       for (const glm::vec2& m : renderer.gbuffer().motion) ASSERT_EQ(m, glm::vec2(0.0f));
     }
+  }
+}
+
+// A camera path held at one frame (RenderSettings::camera_frame, `rtpg reference --camera-path P
+// --frame N`: the references of moving-camera frames) renders that frame's view in every frame:
+// without jitter, the G-buffer's surfaces and view directions of any frame equal, to the bit,
+// those of frame N rendered along the path, and differ from frame 0's (the pan moves more than
+// a pixel a frame, so a pose that followed the frame index or stayed at the path's start fails).
+TEST(MotionVectors, AHeldCameraFrameIsThatFramesView) {
+  const Scene scene = cornell_box();
+  RenderSettings settings;
+  settings.width = 29;
+  settings.height = 17;
+  settings.jitter = false;
+  settings.path_tracer.max_bounces = 1;
+  settings.camera_path = "pan";
+  Renderer moving(scene, settings);
+  moving.render_frame(0);
+  const GBuffer first = moving.gbuffer();
+  moving.render_frame(3);
+  const GBuffer third = moving.gbuffer();
+  settings.camera_frame = 3;
+  Renderer held(scene, settings);
+  for (int f : {0, 1, 5}) {
+    held.render_frame(f);
+    const GBuffer& g = held.gbuffer();
+    ASSERT_EQ(g.pixel_count(), third.pixel_count());
+    std::size_t differing_from_third = 0, differing_from_first = 0;
+    for (std::size_t i = 0; i < g.pixel_count(); ++i) {
+      differing_from_third += !same_bits(g.position_depth[i], third.position_depth[i]) ||
+                              !same_bits(g.view_dir[i], third.view_dir[i]);
+      differing_from_first += !same_bits(g.position_depth[i], first.position_depth[i]);
+    }
+    EXPECT_EQ(differing_from_third, 0u) << "frame " << f;
+    EXPECT_GT(differing_from_first, g.pixel_count() / 4) << "frame " << f;
   }
 }
 

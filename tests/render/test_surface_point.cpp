@@ -197,6 +197,115 @@ TEST(SurfacePoint, TheTriangleTableHoldsEachTrianglesVertices) {
 
 // next_float_up and next_float_down against std::nextafter: zeros, subnormals, the extremes,
 // infinities, NaN (compared as NaN) and a million random bit patterns.
+// What a surface's textures do to its surface point, against the directions worked out by hand
+// (the other tests here compare two ways of computing the same point, which share this code): a
+// tangent-space normal map tilts the shading normal towards the tangent (dP/du) or the bitangent
+// (dP/dv) as its texel says, the bitangent follows the mesh tangents' handedness and, without
+// tangents, the uv parameterisation; a height map rising along u tilts it back, by bump_scale;
+// roughness and metallic textures scale the material by their chosen channels. A quad in y = 0
+// facing +y, u along +z and v along +x, hit straight down at uv (0.5, 0.5).
+TEST(SurfacePoint, TexturesTiltTheShadingNormalAndScaleTheMaterial) {
+  const float s30 = 0.5f, c30 = std::sqrt(3.0f) / 2.0f;
+  const auto texture_of = [](int width, int height, const std::vector<glm::vec4>& texels) {
+    Texture t;
+    t.width = width;
+    t.height = height;
+    t.texels.assign(texels.begin(), texels.end());
+    return t;
+  };
+  const auto normal_texel = [](glm::vec3 tn) { return glm::vec4(0.5f * (tn + 1.0f), 1.0f); };
+  struct Case {
+    const char* what;
+    Material material;
+    Texture texture;
+    float tangent_sign;  // 0: no tangents (the uv parameterisation's basis)
+    glm::vec3 expected_normal;
+  };
+  std::vector<glm::vec4> ramp;  // height x / 8 along u (columns), the same in every row
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) ramp.push_back(glm::vec4(glm::vec3(x / 8.0f), 1.0f));
+  std::vector<Case> cases;
+  Material normal_mapped;
+  normal_mapped.normal_texture = 0;
+  cases.push_back({"normal map towards u",
+                   normal_mapped,
+                   texture_of(1, 1, {normal_texel({s30, 0.0f, c30})}),
+                   1.0f,
+                   {0.0f, c30, s30}});
+  cases.push_back({"normal map towards v",
+                   normal_mapped,
+                   texture_of(1, 1, {normal_texel({0.0f, s30, c30})}),
+                   1.0f,
+                   {s30, c30, 0.0f}});
+  cases.push_back({"normal map towards v, left-handed tangents",
+                   normal_mapped,
+                   texture_of(1, 1, {normal_texel({0.0f, s30, c30})}),
+                   -1.0f,
+                   {-s30, c30, 0.0f}});
+  cases.push_back({"normal map towards v, no tangents",
+                   normal_mapped,
+                   texture_of(1, 1, {normal_texel({0.0f, s30, c30})}),
+                   0.0f,
+                   {s30, c30, 0.0f}});
+  for (const float scale : {10.0f, 20.0f}) {
+    Material bumped;
+    bumped.bump_texture = 0;
+    bumped.bump_scale = scale;
+    // perturbed = n - bump_scale / 100 * (dh/du t + dh/dv b), dh/du = 1 per unit u.
+    cases.push_back({scale == 10.0f ? "bump ramp, scale 10" : "bump ramp, scale 20", bumped,
+                     texture_of(8, 8, ramp), 1.0f,
+                     glm::normalize(glm::vec3(0.0f, 1.0f, -scale / 100.0f))});
+  }
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    Scene scene;
+    scene.textures.push_back(c.texture);
+    scene.materials.push_back(c.material);
+    Mesh quad = make_quad({-1, 0, -1}, {0, 0, 2}, {2, 0, 0});
+    for (glm::vec4& t : quad.tangents) t.w = c.tangent_sign;
+    if (c.tangent_sign == 0.0f) quad.tangents.clear();
+    scene.meshes.push_back(quad);
+    const EmbreeScene tracer(scene);
+    Ray ray;
+    ray.origin = glm::vec3(0.0f, 1.0f, 0.0f);
+    ray.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+    Hit hit;
+    tracer.intersect(&ray, &hit, 1);
+    ASSERT_TRUE(hit.valid());
+    const SurfacePoint sp = make_surface_point(scene, ray, hit);
+    ASSERT_NEAR(sp.geometric_normal.y, 1.0f, 1e-6f);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(sp.shading_normal[k], c.expected_normal[k], 1e-5f) << "component " << k;
+  }
+
+  // Roughness from the texel's green channel, metallic from its blue one (glTF's layout), each
+  // multiplying the material's value; the base colour untouched without a colour texture.
+  Scene scene;
+  scene.textures.push_back(texture_of(1, 1, {glm::vec4(0.1f, 0.5f, 0.9f, 1.0f)}));
+  Material m;
+  m.base_color = glm::vec3(0.3f, 0.4f, 0.5f);
+  m.roughness = 0.8f;
+  m.metallic = 1.0f;
+  m.roughness_texture = 0;
+  m.metallic_texture = 0;
+  m.roughness_channel = 1;
+  m.metallic_channel = 2;
+  scene.materials.push_back(m);
+  scene.meshes.push_back(make_quad({-1, 0, -1}, {0, 0, 2}, {2, 0, 0}));
+  const EmbreeScene tracer(scene);
+  Ray ray;
+  ray.origin = glm::vec3(0.1f, 1.0f, 0.2f);
+  ray.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+  Hit hit;
+  tracer.intersect(&ray, &hit, 1);
+  ASSERT_TRUE(hit.valid());
+  const SurfacePoint sp = make_surface_point(scene, ray, hit);
+  EXPECT_NEAR(sp.material.roughness, 0.4f, 1e-6f);
+  EXPECT_NEAR(sp.material.metallic, 0.9f, 1e-6f);
+  EXPECT_EQ(sp.material.base_color.x, 0.3f);
+  EXPECT_EQ(sp.shading_normal, glm::vec3(0.0f, 1.0f, 0.0f));
+}
+
 TEST(SurfacePoint, NextFloatIsStdNextafter) {
   const float inf = std::numeric_limits<float>::infinity();
   std::vector<float> values = {0.0f,

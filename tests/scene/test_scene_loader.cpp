@@ -728,6 +728,78 @@ TEST(SceneLoaderErrors, MissingRequiredKeyAndBadValues) {
                      {"times.json", "camera_paths.p.keys[1].time", "increasing"});
 }
 
+// Every range check of the scene file's values, each failing with the file and the key path
+// named (docs/robustness.md, "Input validation"): a zero sun direction (NaN everywhere after
+// normalising), a sun cone of 90 degrees, negative light, a bounce count outside [1, 64], a
+// colour above 1 (energy from nowhere), a roughness above 1, degenerate shapes, a zero scale and
+// a singular matrix. And the one integrator value a scene sets is kept.
+TEST(SceneLoaderErrors, ValuesOutOfRangeNameTheirKey) {
+  TempDir dir;
+  const auto scene_text = [](const std::string& light, const std::string& white,
+                             const std::string& shape, const std::string& extra) {
+    return std::string("{") + kCamera + ", " + light + R"(, "materials": {"white": )" + white +
+           R"(}, "shapes": [)" + shape + "]" + extra + "}";
+  };
+  const std::string sun = kLightSource, white = R"({"base_color": [0.5, 0.5, 0.5]})",
+                    quad = R"({"type": "quad", "corner": [0,0,0], "edge1": [1,0,0],
+                               "edge2": [0,1,0], "material": "white"})";
+  struct Case {
+    std::string text;
+    std::vector<std::string> expected;  // what the message must hold besides the file name
+  };
+  const std::vector<Case> cases = {
+      {scene_text(R"("sun": {"direction": [0, 0, 0], "irradiance": [1, 1, 1]})", white, quad, ""),
+       {"sun.direction", "zero"}},
+      {scene_text(R"("sun": {"direction": [0, 1, 0], "irradiance": [1, 1, 1],
+                             "angular_radius_deg": 90})",
+                  white, quad, ""),
+       {"sun.angular_radius_deg"}},
+      {scene_text(R"("sun": {"direction": [0, 1, 0], "irradiance": [1, -1, 1]})", white, quad, ""),
+       {"sun.irradiance", "negative"}},
+      {scene_text(R"("environment": {"color": [0.5, -0.5, 0.5]})", white, quad, ""),
+       {"environment.color", "negative"}},
+      {scene_text(sun, white, quad, R"(, "integrator": {"max_bounces": 0})"),
+       {"integrator.max_bounces", "[1, 64]"}},
+      {scene_text(sun, white, quad, R"(, "integrator": {"max_bounces": 65})"),
+       {"integrator.max_bounces", "[1, 64]"}},
+      {scene_text(sun, R"({"base_color": [1.5, 0.5, 0.5]})", quad, ""),
+       {"materials.white.base_color", "[0, 1]"}},
+      {scene_text(sun, R"({"roughness": 2})", quad, ""), {"materials.white.roughness", "[0, 1]"}},
+      {scene_text(sun, white,
+                  R"({"type": "quad", "corner": [0,0,0], "edge1": [1,0,0], "edge2": [2,0,0],
+                      "material": "white"})",
+                  ""),
+       {"shapes[0]", "parallelogram"}},
+      {scene_text(sun, white,
+                  R"({"type": "box", "min": [0,0,0], "max": [1,0,1], "material": "white"})", ""),
+       {"shapes[0].max", "exceed"}},
+      {scene_text(sun, white,
+                  R"({"type": "sphere", "center": [0,0,0], "radius": 0, "material": "white"})", ""),
+       {"shapes[0].radius", "positive"}},
+      {scene_text(sun, white,
+                  R"({"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "white",
+                      "transform": {"scale": [1, 0, 1]}})",
+                  ""),
+       {"shapes[0].transform.scale", "zero"}},
+      {scene_text(sun, white,
+                  R"({"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "white",
+                      "transform": {"matrix": [1,0,0,0, 0,1,0,0, 2,0,0,0, 0,0,0,1]}})",
+                  ""),
+       {"shapes[0].transform", "singular"}},
+  };
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    SCOPED_TRACE(cases[k].text);
+    const std::string name = "bad" + std::to_string(k) + ".json";
+    write_file(dir / name, cases[k].text);
+    std::vector<std::string> expected = cases[k].expected;
+    expected.push_back(name);
+    expect_input_error([&] { load_scene(dir / name); }, expected);
+  }
+  write_file(dir / "three.json",
+             scene_text(sun, white, quad, R"(, "integrator": {"max_bounces": 3})"));
+  EXPECT_EQ(load_scene(dir / "three.json").max_bounces, 3);
+}
+
 // The display exposure (PNG output, the benchmarks' LDR-FLIP): 1 by default, a positive finite
 // number when given.
 TEST(SceneLoader, ExposureDefaultsToOneAndMustBePositive) {

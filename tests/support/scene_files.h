@@ -10,6 +10,7 @@
 #include <functional>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -51,7 +52,7 @@ inline void write_file(const std::string& path, const std::string& content) {
 
 // Runs `f`, expects an InputError whose message contains every one of `parts`.
 inline void expect_input_error(const std::function<void()>& f,
-                               std::initializer_list<std::string> parts) {
+                               const std::vector<std::string>& parts) {
   try {
     f();
     ADD_FAILURE() << "no InputError thrown";
@@ -61,6 +62,11 @@ inline void expect_input_error(const std::function<void()>& f,
       EXPECT_NE(message.find(part), std::string::npos)
           << "message \"" << message << "\" lacks \"" << part << "\"";
   }
+}
+
+inline void expect_input_error(const std::function<void()>& f,
+                               std::initializer_list<std::string> parts) {
+  expect_input_error(f, std::vector<std::string>(parts));
 }
 
 }  // namespace rtpg::test
