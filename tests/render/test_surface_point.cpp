@@ -197,6 +197,19 @@ TEST(SurfacePoint, TheTriangleTableHoldsEachTrianglesVertices) {
 
 // next_float_up and next_float_down against std::nextafter: zeros, subnormals, the extremes,
 // infinities, NaN (compared as NaN) and a million random bit patterns.
+// The surface point that a ray straight down from `origin` hits, into `out`; false for a miss.
+bool surface_below(const Scene& scene, const glm::vec3& origin, SurfacePoint& out) {
+  const EmbreeScene tracer(scene);
+  Ray ray;
+  ray.origin = origin;
+  ray.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+  Hit hit;
+  tracer.intersect(&ray, &hit, 1);
+  if (!hit.valid()) return false;
+  out = make_surface_point(scene, ray, hit);
+  return true;
+}
+
 // What a surface's textures do to its surface point, against the directions worked out by hand
 // (the other tests here compare two ways of computing the same point, which share this code): a
 // tangent-space normal map tilts the shading normal towards the tangent (dP/du) or the bitangent
@@ -265,14 +278,8 @@ TEST(SurfacePoint, TexturesTiltTheShadingNormalAndScaleTheMaterial) {
     for (glm::vec4& t : quad.tangents) t.w = c.tangent_sign;
     if (c.tangent_sign == 0.0f) quad.tangents.clear();
     scene.meshes.push_back(quad);
-    const EmbreeScene tracer(scene);
-    Ray ray;
-    ray.origin = glm::vec3(0.0f, 1.0f, 0.0f);
-    ray.direction = glm::vec3(0.0f, -1.0f, 0.0f);
-    Hit hit;
-    tracer.intersect(&ray, &hit, 1);
-    ASSERT_TRUE(hit.valid());
-    const SurfacePoint sp = make_surface_point(scene, ray, hit);
+    SurfacePoint sp;
+    ASSERT_TRUE(surface_below(scene, glm::vec3(0.0f, 1.0f, 0.0f), sp));
     ASSERT_NEAR(sp.geometric_normal.y, 1.0f, 1e-6f);
     for (int k = 0; k < 3; ++k)
       EXPECT_NEAR(sp.shading_normal[k], c.expected_normal[k], 1e-5f) << "component " << k;
@@ -292,14 +299,8 @@ TEST(SurfacePoint, TexturesTiltTheShadingNormalAndScaleTheMaterial) {
   m.metallic_channel = 2;
   scene.materials.push_back(m);
   scene.meshes.push_back(make_quad({-1, 0, -1}, {0, 0, 2}, {2, 0, 0}));
-  const EmbreeScene tracer(scene);
-  Ray ray;
-  ray.origin = glm::vec3(0.1f, 1.0f, 0.2f);
-  ray.direction = glm::vec3(0.0f, -1.0f, 0.0f);
-  Hit hit;
-  tracer.intersect(&ray, &hit, 1);
-  ASSERT_TRUE(hit.valid());
-  const SurfacePoint sp = make_surface_point(scene, ray, hit);
+  SurfacePoint sp;
+  ASSERT_TRUE(surface_below(scene, glm::vec3(0.1f, 1.0f, 0.2f), sp));
   EXPECT_NEAR(sp.material.roughness, 0.4f, 1e-6f);
   EXPECT_NEAR(sp.material.metallic, 0.9f, 1e-6f);
   EXPECT_EQ(sp.material.base_color.x, 0.3f);
