@@ -73,6 +73,8 @@ class Lights {
   [[gnu::always_inline]] inline bool sample_triangle(const glm::vec3& p, float u_triangle,
                                                      float p_kind, float u1, float u2,
                                                      LightSample& out) const;
+  // Whether direction d (unit) lies in the sun's cone: by the sine of its angle to the axis.
+  bool in_sun_cone(const glm::vec3& d) const;
   glm::vec3 environment_radiance(const glm::vec3& direction) const;
   float environment_pdf(const glm::vec3& direction) const;
   glm::vec2 direction_to_equirect(const glm::vec3& d) const;
@@ -97,8 +99,6 @@ class Lights {
   float sun_one_minus_cos_max_ = 0.0f;
   float sun_sin2_max_ = 0.0f;
   float sun_solid_angle_ = 0.0f;
-  // Whether direction d (unit) lies in the sun's cone: by the sine of its angle to the axis.
-  bool in_sun_cone(const glm::vec3& d) const;
   glm::vec3 sun_radiance_{0.0f};
   const Texture* env_map_ = nullptr;
   Distribution2D env_distribution_;

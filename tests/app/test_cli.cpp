@@ -756,6 +756,16 @@ TEST_F(Cli, DenoiseWritesTheFilteredAndTheNoisyFrameWithTheirStatistics) {
     differ += std::fabs(out.pixels[i] - noisy.pixels[i]);
   }
   EXPECT_GT(differ, 0.0);
+  // The noisy images, the last frame's and the saved one's, are the frames the same render
+  // writes without the denoiser, to the bit.
+  const RunResult plain =
+      run_rtpg(dir(), "render --res 40x24 --frames 3 -o plain.exr --save-frames 1");
+  ASSERT_TRUE(plain.exited && plain.exit_code == 0) << describe(plain);
+  EXPECT_EQ(read_exr(dir() / "plain.exr").pixels, noisy.pixels);
+  const ExrImage saved = read_exr(dir() / "noisy-f0001.exr");
+  ASSERT_EQ(saved.pixels.size(), noisy.pixels.size());
+  EXPECT_EQ(read_exr(dir() / "plain-f0001.exr").pixels, saved.pixels);
+  EXPECT_NE(saved.pixels, noisy.pixels);
   const nlohmann::json stats = nlohmann::json::parse(read_file(dir() / "stats.json"));
   EXPECT_EQ(stats.value("denoise", std::string()), "svgf");
   EXPECT_EQ(stats["svgf_settings"].value("iterations", 0), 5);

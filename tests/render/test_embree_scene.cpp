@@ -277,6 +277,38 @@ TEST(EmbreeScene, AlphaMaskLetsRaysThroughItsTransparentTexels) {
   }
 }
 
+// A mask of alpha 0.4 everywhere is opaque for a cutoff of 0.3 and transparent for one of 0.5
+// (hits with alpha >= cutoff stay), for closest hits and occlusion alike.
+TEST(EmbreeScene, AlphaCutoffDecidesAtPartialAlpha) {
+  for (const float cutoff : {0.3f, 0.5f}) {
+    Scene scene;
+    Texture mask;
+    mask.width = 1;
+    mask.height = 1;
+    mask.texels8.push_back({255, 255, 255, 102});  // 102 / 255 = 0.4
+    scene.textures.push_back(mask);
+    Material masked;
+    masked.alpha_texture = 0;
+    masked.alpha_cutoff = cutoff;
+    scene.materials = {masked, Material{}};
+    scene.meshes.push_back(make_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2}));
+    Mesh floor = make_quad({-2, -1, -2}, {4, 0, 0}, {0, 0, 4});
+    floor.material = 1;
+    scene.meshes.push_back(floor);
+    const EmbreeScene tracer(scene);
+    const Ray down = segment({0.1f, 1.0f, 0.2f}, {0, -1, 0}, 0.0f, 1e30f);
+    const Ray to_middle = segment({0.1f, 1.0f, 0.2f}, {0, -1, 0}, 0.0f, 1.5f);
+    Hit hit;
+    std::uint8_t occluded = 7;
+    tracer.intersect(&down, &hit, 1);
+    tracer.occluded(&to_middle, &occluded, 1);
+    const bool opaque = cutoff < 0.4f;
+    ASSERT_TRUE(hit.valid()) << "cutoff " << cutoff;
+    EXPECT_EQ(hit.mesh, opaque ? 0u : 1u) << "cutoff " << cutoff;
+    EXPECT_EQ(occluded, opaque ? 1 : 0) << "cutoff " << cutoff;
+  }
+}
+
 // An image's rays from a point above the quad, spread so that the quad's edge crosses tiles, at
 // sizes whose last tiles are partial: intersect_image in each tile shape this CPU runs gives every
 // pixel the hit of its own one-by-one query, to the bit, and writes no pixel twice or not at all
