@@ -219,13 +219,28 @@ TEST(EmbreeScene, EveryRayModeGivesTheSameAnswers) {
   }
 }
 
+// The 2x2 quad in y = 0 (mesh 0) alpha-tested by `mask` at `cutoff`, over a 4x4 floor at y = -1
+// (mesh 1).
+Scene masked_quad_over_floor(const Texture& mask, float cutoff) {
+  Scene scene;
+  scene.textures.push_back(mask);
+  Material masked;
+  masked.alpha_texture = 0;
+  masked.alpha_cutoff = cutoff;
+  scene.materials = {masked, Material{}};
+  scene.meshes.push_back(make_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2}));
+  Mesh floor = make_quad({-2, -1, -2}, {4, 0, 0}, {0, 0, 4});
+  floor.material = 1;
+  scene.meshes.push_back(floor);
+  return scene;
+}
+
 // A quad whose left half is transparent in its alpha mask (u < 1/2: texels of alpha 0 up to a
 // quarter texel from the middle, and from the wrap's edge), over a floor: rays straight down
 // through the transparent half hit the floor and are not occluded on their way to it, through
 // the opaque half they hit the quad, in every ray mode, for 8-bit and float masks.
 TEST(EmbreeScene, AlphaMaskLetsRaysThroughItsTransparentTexels) {
   for (const bool eight_bit : {true, false}) {
-    Scene scene;
     Texture mask;
     mask.width = 8;
     mask.height = 1;
@@ -237,16 +252,8 @@ TEST(EmbreeScene, AlphaMaskLetsRaysThroughItsTransparentTexels) {
         mask.texels.push_back(glm::vec4(1.0f, 1.0f, 1.0f, alpha / 255.0f));
       }
     }
-    scene.textures.push_back(mask);
-    Material masked;
-    masked.alpha_texture = 0;
-    masked.alpha_cutoff = 0.5f;
-    scene.materials = {masked, Material{}};
     // u = (x + 1) / 2 on the quad (make_quad's corners take uv (0, 0), (1, 0), (1, 1), (0, 1)).
-    scene.meshes.push_back(make_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2}));
-    Mesh floor = make_quad({-2, -1, -2}, {4, 0, 0}, {0, 0, 4});
-    floor.material = 1;
-    scene.meshes.push_back(floor);
+    const Scene scene = masked_quad_over_floor(mask, 0.5f);
     const EmbreeScene tracer(scene);
 
     std::mt19937 gen(17);
@@ -281,20 +288,11 @@ TEST(EmbreeScene, AlphaMaskLetsRaysThroughItsTransparentTexels) {
 // (hits with alpha >= cutoff stay), for closest hits and occlusion alike.
 TEST(EmbreeScene, AlphaCutoffDecidesAtPartialAlpha) {
   for (const float cutoff : {0.3f, 0.5f}) {
-    Scene scene;
     Texture mask;
     mask.width = 1;
     mask.height = 1;
     mask.texels8.push_back({255, 255, 255, 102});  // 102 / 255 = 0.4
-    scene.textures.push_back(mask);
-    Material masked;
-    masked.alpha_texture = 0;
-    masked.alpha_cutoff = cutoff;
-    scene.materials = {masked, Material{}};
-    scene.meshes.push_back(make_quad({-1, 0, -1}, {2, 0, 0}, {0, 0, 2}));
-    Mesh floor = make_quad({-2, -1, -2}, {4, 0, 0}, {0, 0, 4});
-    floor.material = 1;
-    scene.meshes.push_back(floor);
+    const Scene scene = masked_quad_over_floor(mask, cutoff);
     const EmbreeScene tracer(scene);
     const Ray down = segment({0.1f, 1.0f, 0.2f}, {0, -1, 0}, 0.0f, 1e30f);
     const Ray to_middle = segment({0.1f, 1.0f, 0.2f}, {0, -1, 0}, 0.0f, 1.5f);

@@ -143,14 +143,8 @@ TEST(WorldGuide, TrainsTheSameWhateverTheThreadCount) {
   EXPECT_EQ(one, many);
 }
 
-// A record's training sample weighs the light the path found after the vertex, not before
-// (host/render/path_tracer.cpp, radiance_before, which the vertex after the record writes). A
-// floor and a wall lit by a delta sun, no emitter and no sky: light arrives only through
-// next-event estimation. With 2 bounces and the world guide recording the first bounce's hit y,
-// what comes after y's bounce is the next vertex's emission, always 0: no cell learns a lobe,
-// and the next frame guides no vertex. With 3 bounces that vertex's light sample adds light
-// after y: cells learn and guide (the control that the first check is not vacuous).
-TEST(WorldGuide, RecordsWeighOnlyTheLightFoundAfterTheVertex) {
+// A Lambert floor and wall lit by a delta sun, no emitter and no sky, seen from the front.
+Scene floor_and_wall_under_a_delta_sun() {
   Scene scene;
   scene.materials.push_back(Material{});
   scene.materials.back().specular = 0.0f;
@@ -162,6 +156,18 @@ TEST(WorldGuide, RecordsWeighOnlyTheLightFoundAfterTheVertex) {
   scene.sun.angular_radius = 0.0f;
   scene.camera.view.position = glm::vec3(0.0f, 1.5f, 4.0f);
   scene.camera.view.look_at = glm::vec3(0.0f, 0.5f, -1.0f);
+  return scene;
+}
+
+// A record's training sample weighs the light the path found after the vertex, not before
+// (host/render/path_tracer.cpp, radiance_before, which the vertex after the record writes). A
+// floor and a wall lit by a delta sun, no emitter and no sky: light arrives only through
+// next-event estimation. With 2 bounces and the world guide recording the first bounce's hit y,
+// what comes after y's bounce is the next vertex's emission, always 0: no cell learns a lobe,
+// and the next frame guides no vertex. With 3 bounces that vertex's light sample adds light
+// after y: cells learn and guide (the control that the first check is not vacuous).
+TEST(WorldGuide, RecordsWeighOnlyTheLightFoundAfterTheVertex) {
+  const Scene scene = floor_and_wall_under_a_delta_sun();
   const auto guided_in_second_frame = [&](int bounces) {
     RenderSettings settings;
     settings.width = 96;
@@ -186,16 +192,7 @@ TEST(WorldGuide, RecordsWeighOnlyTheLightFoundAfterTheVertex) {
 // only where its mixing weight exceeds min_guiding_pi (above the clamp's 0.5 none does, so no
 // vertex of the next frame is guided; at 0 some are). The scene of the test above, 3 bounces.
 TEST(WorldGuide, RecordEveryAndMinimumPiThinWhatTheGuideDoes) {
-  Scene scene;
-  scene.materials.push_back(Material{});
-  scene.materials.back().specular = 0.0f;
-  scene.meshes.push_back(make_quad({-2.0f, 0.0f, -2.0f}, {0.0f, 0.0f, 4.0f}, {4.0f, 0.0f, 0.0f}));
-  scene.meshes.push_back(make_quad({-2.0f, 0.0f, -1.0f}, {4.0f, 0.0f, 0.0f}, {0.0f, 3.0f, 0.0f}));
-  scene.sun.enabled = true;
-  scene.sun.direction = glm::normalize(glm::vec3(0.3f, 1.0f, 0.8f));
-  scene.sun.irradiance = glm::vec3(3.0f);
-  scene.camera.view.position = glm::vec3(0.0f, 1.5f, 4.0f);
-  scene.camera.view.look_at = glm::vec3(0.0f, 0.5f, -1.0f);
+  const Scene scene = floor_and_wall_under_a_delta_sun();
   struct Result {
     double samples_in_first_frame;
     std::uint64_t guided_in_second_frame;
