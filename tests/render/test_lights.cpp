@@ -25,7 +25,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kSamples = 1000000;
 
 // Every chi-square test of this file at an overall level of 0.01.
-const double kAlpha = test::sidak_alpha(0.01, 3);
+const double kAlpha = test::sidak_alpha(0.01, 4);
 
 // A grey floor, so that the scene has bounds (they size the sun's and sky's share).
 Scene floor_scene() {
@@ -227,6 +227,54 @@ TEST(Lights, EmissiveTrianglesMatchTheirDensity) {
   // The one facing away takes its power's share of the attempts and never yields a sample.
   EXPECT_NEAR(right.pdf_integral, right.sample_fraction, 5e-3) << right.describe();
   EXPECT_LT(right.sample_fraction, 0.95) << right.describe();
+  const auto wrong = test::chi_square_test(
+      sampler, [&](const glm::vec3& d) { return pdf(d) * 1.05; }, kSamples / 4, 40, 80, 12);
+  EXPECT_LT(wrong.p_value, 1e-6) << wrong.describe();
+}
+
+// Emissive triangles that are not halves of a parallelogram are sampled one by one, uniformly
+// in area (the square root of the barycentric draw): a kite's two triangles and a lone one,
+// against the density pdf_triangle gives. Without this scene no test sampled a lone triangle
+// since quads became parallelograms (docs/mutation-testing.md, `triangle-sample-nonuniform`).
+TEST(Lights, LoneEmissiveTrianglesMatchTheirDensity) {
+  Scene scene = floor_scene();
+  Material lamp;
+  lamp.emission = glm::vec3(3.0f, 2.0f, 1.0f);
+  scene.materials.push_back(lamp);
+  lamp.emission = glm::vec3(1.5f);
+  scene.materials.push_back(lamp);
+  Mesh kite;  // above p, facing down: corners 0-1-2 and 0-2-3, 3 off the parallelogram
+  kite.positions = {
+      {-0.6f, 1.4f, -0.5f}, {0.4f, 1.4f, -0.5f}, {0.4f, 1.4f, 0.3f}, {-0.6f, 1.4f, 0.6f}};
+  kite.triangles = {{0, 1, 2}, {0, 2, 3}};
+  kite.material = 1;
+  Mesh lone;  // beside p, facing -x towards it, a long thin triangle
+  lone.positions = {{1.1f, 0.1f, -0.6f}, {1.1f, 0.9f, 0.4f}, {1.1f, 0.2f, 0.5f}};
+  lone.triangles = {{0, 2, 1}};
+  lone.material = 2;
+  scene.meshes.push_back(kite);
+  scene.meshes.push_back(lone);
+  const Lights lights(scene);
+  ASSERT_EQ(lights.emitter_count(), 3u);
+  ASSERT_EQ(lights.parallelogram_count(), 0u);
+  const glm::vec3 p(0.1f, 0.3f, 0.1f);
+  const auto pdf = [&](const glm::vec3& d) {
+    const TriangleHit h = first_hit(scene, p, d);
+    if (!h.hit || !scene.materials[scene.meshes[h.mesh].material].is_emissive()) return 0.0;
+    return double(lights.pdf_triangle(h.mesh, h.triangle, p, h.point, glm::vec3(0.0f)));
+  };
+  // Every sample lands on the triangle whose density it reports.
+  for (std::size_t i = 0; i < 2000; ++i) {
+    std::mt19937 gen(static_cast<unsigned>(i));
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    LightSample s;
+    ASSERT_TRUE(lights.sample(p, u(gen), u(gen), u(gen), s));
+    EXPECT_NEAR(s.pdf, pdf(s.direction), 1e-3 * s.pdf);
+  }
+  const LightSampler sampler{lights, p};
+  const auto right = test::chi_square_test(sampler, pdf, kSamples / 4, 40, 80, 32);
+  EXPECT_GT(right.p_value, kAlpha) << right.describe();
+  EXPECT_NEAR(right.pdf_integral, 1.0, 5e-3) << right.describe();
   const auto wrong = test::chi_square_test(
       sampler, [&](const glm::vec3& d) { return pdf(d) * 1.05; }, kSamples / 4, 40, 80, 12);
   EXPECT_LT(wrong.p_value, 1e-6) << wrong.describe();
