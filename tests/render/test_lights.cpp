@@ -35,6 +35,17 @@ Scene floor_scene() {
   return scene;
 }
 
+// floor_scene with two emissive materials after the floor's (materials 1 and 2).
+Scene floor_scene_with_lamps(const glm::vec3& first, const glm::vec3& second) {
+  Scene scene = floor_scene();
+  for (const glm::vec3& emission : {first, second}) {
+    Material lamp;
+    lamp.emission = emission;
+    scene.materials.push_back(lamp);
+  }
+  return scene;
+}
+
 // The directions Lights::sample produces from p, with the pdf each sample reports.
 struct LightSampler {
   const Lights& lights;
@@ -175,12 +186,7 @@ TriangleHit first_hit(const Scene& scene, const glm::vec3& p, const glm::vec3& d
 // by area) and one facing away from p (one-sided: never sampled from p). The density of a
 // direction is pdf_triangle of the emitter it reaches, if that emitter faces p.
 TEST(Lights, EmissiveTrianglesMatchTheirDensity) {
-  Scene scene = floor_scene();
-  Material lamp;
-  lamp.emission = glm::vec3(4.0f, 3.0f, 2.0f);
-  scene.materials.push_back(lamp);
-  lamp.emission = glm::vec3(1.0f);
-  scene.materials.push_back(lamp);
+  Scene scene = floor_scene_with_lamps(glm::vec3(4.0f, 3.0f, 2.0f), glm::vec3(1.0f));
   Mesh big = make_quad({-0.8f, 1.5f, -0.4f}, {0.9f, 0, 0}, {0, 0, 0.6f});  // faces down
   big.material = 1;
   Mesh small = make_quad({1.2f, 0.4f, 0.2f}, {0, 0, 0.2f}, {0, 0.3f, 0});  // faces -x, p
@@ -237,12 +243,7 @@ TEST(Lights, EmissiveTrianglesMatchTheirDensity) {
 // against the density pdf_triangle gives. Without this scene no test sampled a lone triangle
 // since quads became parallelograms (docs/mutation-testing.md, `triangle-sample-nonuniform`).
 TEST(Lights, LoneEmissiveTrianglesMatchTheirDensity) {
-  Scene scene = floor_scene();
-  Material lamp;
-  lamp.emission = glm::vec3(3.0f, 2.0f, 1.0f);
-  scene.materials.push_back(lamp);
-  lamp.emission = glm::vec3(1.5f);
-  scene.materials.push_back(lamp);
+  Scene scene = floor_scene_with_lamps(glm::vec3(3.0f, 2.0f, 1.0f), glm::vec3(1.5f));
   Mesh kite;  // above p, facing down: corners 0-1-2 and 0-2-3, 3 off the parallelogram
   kite.positions = {
       {-0.6f, 1.4f, -0.5f}, {0.4f, 1.4f, -0.5f}, {0.4f, 1.4f, 0.3f}, {-0.6f, 1.4f, 0.6f}};
