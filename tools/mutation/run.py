@@ -21,7 +21,7 @@ Run by hand, not in CI:
     python3 tools/mutation/run.py --list          # the mutants
     python3 tools/mutation/run.py --check         # every find string occurs exactly once
     python3 tools/mutation/run.py                 # everything (about half an hour on 2 cores)
-    python3 tools/mutation/run.py --only ID,ID    # some (report to WORK/report.md)
+    python3 tools/mutation/run.py --only ID,ID    # some (WORK/report.md, WORK/results-only.json)
 """
 
 import argparse
@@ -616,7 +616,7 @@ def write_report(path, info, results, all_mutants):
     w("python3 tools/mutation/run.py --list       # the mutants and their selections")
     w("python3 tools/mutation/run.py --check      # every find string occurs exactly once")
     w("python3 tools/mutation/run.py              # all mutants; rewrites this file")
-    w("python3 tools/mutation/run.py --only ID,ID # some; report in WORK/report.md")
+    w("python3 tools/mutation/run.py --only ID,ID # some; WORK/report.md, WORK/results-only.json")
     w("```")
     w("")
     w("Options: `--work DIR` (default /tmp/rtpg-mutation: `src/` copy, `build/`, `logs/` with each")
@@ -815,7 +815,10 @@ def main():
     except KeyboardInterrupt:
         interrupted = True
         print("interrupted: the mutated file was restored; writing the report so far", file=sys.stderr)
-    name = "results-baseline.json" if args.baseline_only else "results.json"
+    # A run of some mutants keeps its results apart, so that it does not replace the results of
+    # the last full run that --report-from rewrites docs/mutation-testing.md from.
+    name = ("results-baseline.json" if args.baseline_only else
+            "results-only.json" if only else "results.json")
     (Path(args.work) / name).write_text(json.dumps(
         {"info": runner.info, "results": [{**r, "mutant": r["mutant"]["id"]} for r in results]},
         indent=1))
