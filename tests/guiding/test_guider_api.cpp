@@ -321,8 +321,9 @@ TEST(GuiderApi, EachFrameDecidesWhichPixelsShareFromItsOwnGBuffer) {
 }
 
 // The host distribution (include/rtpg/guiding_distribution.h) is the device sampler's: for every
-// direction the sample kernel drew, its density is the kernel's, and its own samples carry
-// their own density.
+// direction the sample kernel drew, its density is the kernel's, whether it is built from the
+// pixel's state (init) or from the mixture the kernel wrote (init_mixture), and its own samples
+// carry their own density.
 TEST(GuiderApi, HostDistributionHasTheSampleKernelsDensity) {
   rtpg::ClRuntime rt;
   const int w = 13, h = 9;
@@ -346,19 +347,27 @@ TEST(GuiderApi, HostDistributionHasTheSampleKernelsDensity) {
   const FloorHost f = floor_host(w, h);
   const rtpg::GuiderGBuffer g = floor_gbuffer(rt, f);
   rtpg::GuiderSamples samples = rtpg::make_guider_samples(rt.context(), w, h);
-  rtpg::GuidingDistribution d(guider.kernel_settings());
+  rtpg::GuidingDistribution d(guider.kernel_settings()), from_mixture(guider.kernel_settings());
   std::size_t checked = 0, guided_pixels = 0;
   for (std::uint32_t frame = 0; frame < 3; ++frame) {
     guider.sample(g, 7u, frame, 0u, samples);
-    std::vector<float> dir(4 * n);
+    std::vector<float> dir(4 * n), mixture_a(4 * n), mixture_b(2 * n);
     rt.queue().enqueueReadBuffer(samples.direction_pdf, CL_TRUE, 0, n * 16, dir.data());
+    rt.queue().enqueueReadBuffer(samples.mixture_a, CL_TRUE, 0, n * 16, mixture_a.data());
+    rt.queue().enqueueReadBuffer(samples.mixture_b, CL_TRUE, 0, n * 8, mixture_b.data());
     for (std::size_t i = static_cast<std::size_t>(w); i < n; ++i) {
       d.init(&lobe[8 * i], &f.normal[4 * i], &f.view[4 * i], &f.bcr[4 * i], &f.ms[4 * i],
              f.flags[i]);
+      // The same pixel from the mixture the kernel wrote (no state on the host).
+      from_mixture.init_mixture(&mixture_a[4 * i], &mixture_b[2 * i], &f.normal[4 * i],
+                                &f.view[4 * i], &f.bcr[4 * i], &f.ms[4 * i]);
       guided_pixels += d.guided();
       EXPECT_FLOAT_EQ(d.mixing_weight(), 0.5f);
+      EXPECT_TRUE(from_mixture.guided()) << i;
+      EXPECT_FLOAT_EQ(from_mixture.mixing_weight(), 0.5f) << i;
       if (dir[4 * i + 3] <= 0.0f) continue;
       EXPECT_NEAR(d.pdf(&dir[4 * i]), dir[4 * i + 3], 1e-5f * dir[4 * i + 3]) << i;
+      EXPECT_NEAR(from_mixture.pdf(&dir[4 * i]), dir[4 * i + 3], 1e-5f * dir[4 * i + 3]) << i;
       ++checked;
       const rtpg::GuidingDirection s = d.sample(0.3f, 0.25f + 0.5f * (i % 2), 0.6f);
       if (s.pdf > 0.0f) {

@@ -872,6 +872,50 @@ TEST(SceneLoaderErrors, CorruptMesh) {
   expect_input_error([&] { load_scene(dir / "u.json"); }, {"empty.obj"});
 }
 
+// The value checks after assimp's import (host/scene/mesh_check.h), which OBJ and PLY files
+// never reach with bad values (their text checks come first): a glTF's non-finite vertex, a
+// base colour above 1 and a negative emission each name the file, the mesh or material, and
+// the value.
+TEST(SceneLoaderErrors, GltfValuesOutOfRangeNameTheFile) {
+  TempDir dir;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // A triangle whose positions are `vertices` (3 x vec3, float32), its material `material`.
+  const auto gltf_scene = [&](const std::string& name, const float(&vertices)[9],
+                              const std::string& material) {
+    write_file(dir / (name + ".bin"),
+               std::string(reinterpret_cast<const char*>(vertices), sizeof(vertices)));
+    write_file(dir / (name + ".gltf"), R"({"asset": {"version": "2.0"},
+      "buffers": [{"uri": ")" + name + R"(.bin", "byteLength": 36}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                     "min": [0, 0, 0], "max": [1, 1, 0]}],
+      "materials": [)" + material + R"(],
+      "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+      "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0})");
+    write_file(dir / (name + ".json"),
+               std::string("{") + kCamera + R"(, "meshes": [{"file": ")" + name + R"(.gltf"}]})");
+    return dir / (name + ".json");
+  };
+  const float good[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const float with_nan[9] = {0, 0, 0, nan, 0, 0, 0, 1, 0};
+  const std::string lamp = R"({"name": "lamp", "emissiveFactor": [1, 1, 1]})";
+  EXPECT_EQ(load_scene(gltf_scene("good", good, lamp)).triangle_count(), 1u);
+  expect_input_error([&] { load_scene(gltf_scene("nan", with_nan, lamp)); },
+                     {"nan.gltf", "mesh 'tri'", "vertex 1", "not finite"});
+  expect_input_error(
+      [&] {
+        load_scene(gltf_scene(
+            "bright", good,
+            R"({"name": "bright", "pbrMetallicRoughness": {"baseColorFactor": [1.5, 0.5, 0.5, 1]}})"));
+      },
+      {"bright.gltf", "material 'bright'", "base colour", "not in [0, 1]"});
+  expect_input_error(
+      [&] {
+        load_scene(gltf_scene("dark", good, R"({"name": "dark", "emissiveFactor": [-1, 0, 0]})"));
+      },
+      {"dark.gltf", "material 'dark'", "emission", "non-negative"});
+}
+
 TEST(SceneLoaderErrors, MissingMtlFile) {
   TempDir dir;
   write_file(dir / "m.obj", "mtllib lost.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
@@ -898,6 +942,22 @@ TEST(SceneLoaderErrors, CorruptTexture) {
   write_file(dir / "s.json", simple_scene("", R"("t": {"normal_texture": "broken.png"},)"));
   expect_input_error([&] { load_scene(dir / "s.json"); },
                      {"broken.png", "materials.t.normal_texture", "s.json"});
+  // Named by an MTL: the texture file is the subject, and the problem is said once, with the
+  // material and the scene that referenced it (host/scene/texture_cache.cpp).
+  write_obj_with_mtl(dir);
+  write_file(dir / "model/tex/height.png", "\x89PNG\r\n\x1a\n not a png either");
+  write_file(dir / "o.json", simple_scene(R"("meshes": [{"file": "model/box.obj"}],)"));
+  try {
+    load_scene(dir / "o.json");
+    ADD_FAILURE() << "no InputError thrown";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    for (const char* part : {"height.png", "map_bump", "textured", "o.json"})
+      EXPECT_NE(message.find(part), std::string::npos) << message;
+    const std::string subject = (dir / "model/tex/height.png") + ": ";
+    EXPECT_EQ(message.rfind(subject), 0u) << message;  // the subject first, and once
+    EXPECT_EQ(message.find(subject, 1), std::string::npos) << message;
+  }
 }
 
 TEST(SceneLoaderErrors, MissingEnvironmentMap) {
