@@ -50,9 +50,10 @@ inline void write_file(const std::string& path, const std::string& content) {
   ASSERT_TRUE(out.good()) << path;
 }
 
-// Runs `f`, expects an InputError whose message contains every one of `parts`.
-inline void expect_input_error(const std::function<void()>& f,
-                               const std::vector<std::string>& parts) {
+// Runs `f`, expects an InputError whose message contains every one of `parts`; returns the
+// message (empty when none was thrown), for checks of its form.
+inline std::string expect_input_error(const std::function<void()>& f,
+                                      const std::vector<std::string>& parts) {
   try {
     f();
     ADD_FAILURE() << "no InputError thrown";
@@ -61,12 +62,14 @@ inline void expect_input_error(const std::function<void()>& f,
     for (const std::string& part : parts)
       EXPECT_NE(message.find(part), std::string::npos)
           << "message \"" << message << "\" lacks \"" << part << "\"";
+    return message;
   }
+  return {};
 }
 
-inline void expect_input_error(const std::function<void()>& f,
-                               std::initializer_list<std::string> parts) {
-  expect_input_error(f, std::vector<std::string>(parts));
+inline std::string expect_input_error(const std::function<void()>& f,
+                                      std::initializer_list<std::string> parts) {
+  return expect_input_error(f, std::vector<std::string>(parts));
 }
 
 }  // namespace rtpg::test
