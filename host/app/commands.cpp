@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 #include <numeric>
+#include <set>
 
 #include <unistd.h>
 
@@ -42,11 +43,51 @@ std::string extension_of(const std::string& path) {
 }
 
 // Every output's folder is checked before any work, so that a bad path fails before an
-// earlier output of the same run has been written.
+// earlier output of the same run has been written; so is the output itself, which must not be
+// an existing folder (the rename into place would fail only after the render and the other
+// outputs).
 void check_output_folder(const std::string& path) {
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty() && !fs::is_directory(parent))
     throw InputError(path, "folder '" + parent.string() + "' does not exist");
+  if (fs::is_directory(path)) throw InputError(path, "is a folder, not a file");
+}
+
+// A file named by a flag: an output the run writes, or an input it reads.
+struct NamedFile {
+  const char* flag;
+  std::string path;
+};
+
+// The same file however it is spelt (relative or absolute, "./", "..", links).
+fs::path file_identity(const std::string& path) {
+  std::error_code error;
+  const fs::path canonical = fs::weakly_canonical(fs::absolute(path), error);
+  return error ? fs::absolute(path).lexically_normal() : canonical;
+}
+
+// No two outputs of a run may be one file (the later would replace the earlier: an EXR holding
+// the statistics' JSON), and no output may be one of its inputs (the reference, read before the
+// render, would be replaced by it). Checked before any work, like the folders.
+void check_distinct_files(const std::vector<NamedFile>& outputs,
+                          const std::vector<NamedFile>& inputs) {
+  std::vector<std::pair<fs::path, const NamedFile*>> seen;
+  for (const NamedFile& input : inputs)
+    if (!input.path.empty()) seen.emplace_back(file_identity(input.path), &input);
+  const std::size_t input_count = seen.size();
+  for (const NamedFile& output : outputs) {
+    if (output.path.empty()) continue;
+    const fs::path id = file_identity(output.path);
+    for (std::size_t k = 0; k < seen.size(); ++k)
+      if (seen[k].first == id)
+        throw InputError(output.flag,
+                         fmt::format("'{}' is also the {} ({} '{}'): {}", output.path,
+                                     k < input_count ? "input" : "output", seen[k].second->flag,
+                                     seen[k].second->path,
+                                     k < input_count ? "the run would overwrite what it reads"
+                                                     : "one output would replace the other"));
+    seen.emplace_back(id, &output);
+  }
 }
 
 void check_output_path(const std::string& path, const char* flag, bool png_allowed) {
@@ -231,14 +272,27 @@ int run_render(const RenderCommand& command) {
                                                     command.frames - 1, command.frames));
   if (command.max_bounces < 0)
     throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
+  {
+    std::vector<NamedFile> outputs = {{"--output", command.output},
+                                      {"--noisy-output", command.noisy_output},
+                                      {"--stats-json", command.stats_json}};
+    // Each frame once (--save-frames 2,2 writes frame 2 once).
+    const std::set<int> frames(command.save_frames.begin(), command.save_frames.end());
+    for (int f : frames) {
+      if (!command.output.empty())
+        outputs.push_back({"--save-frames", frame_output_path(command.output, f)});
+      if (!command.noisy_output.empty())
+        outputs.push_back({"--save-frames", frame_output_path(command.noisy_output, f)});
+    }
+    check_distinct_files(outputs,
+                         {{"--reference", command.reference}, {"the scene", command.common.scene}});
+  }
   ImageRgb reference;
   if (!command.reference.empty()) {
-    reference = load_quietly([&] { return read_image(command.reference); });
-    if (reference.width != command.settings.width || reference.height != command.settings.height)
-      throw InputError(
-          command.reference,
-          fmt::format("reference is {}x{}, the render is {}x{}", reference.width, reference.height,
-                      command.settings.width, command.settings.height));
+    // Its size is checked against the render's before its pixels are read.
+    reference = load_quietly([&] {
+      return read_image(command.reference, command.settings.width, command.settings.height);
+    });
   }
   const std::string scene_path =
       command.common.scene.empty() ? default_scene_path() : command.common.scene;
@@ -257,6 +311,11 @@ int run_render(const RenderCommand& command) {
       command.world_guide_max_depth > 0 ? command.world_guide_max_depth : 1 << 30;
   settings.world_guide_settings.em = to_kernel_settings(command.guiding_settings);
   if (command.world_guide_pi_max >= 0.0f) {
+    // Below 1, as --pg-pi-max: at 1 a guided vertex never samples its BSDF, and the directions
+    // outside its cell's hemisphere (up to about 55 degrees from its own) could not be reached.
+    if (!(command.world_guide_pi_max < 1.0f))
+      throw InputError("--world-guide-pi-max",
+                       fmt::format("must be below 1, got {}", command.world_guide_pi_max));
     if (command.world_guide_pi_max < settings.world_guide_settings.em.pi_min)
       throw InputError("--world-guide-pi-max",
                        fmt::format("{} is below --pg-pi-min ({})", command.world_guide_pi_max,
@@ -467,6 +526,8 @@ int run_render(const RenderCommand& command) {
 int run_reference(const ReferenceCommand& command) {
   check_output_path(command.output, "--output", false);
   if (!command.stats_json.empty()) check_output_folder(command.stats_json);
+  check_distinct_files({{"--output", command.output}, {"--stats-json", command.stats_json}},
+                       {{"the scene", command.common.scene}});
   if (command.spp <= 0) throw InputError("--spp", "must be at least 1");
   if (command.max_bounces < 0)
     throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");

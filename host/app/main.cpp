@@ -64,8 +64,8 @@ void add_guiding_options(CLI::App* cmd, rtpg::RenderCommand& r) {
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   cmd->add_option("--world-guide-pi-max", r.world_guide_pi_max,
-                  "With --guide-vertices world: the cells' largest mixing weight (default: "
-                  "--pg-pi-max's)")
+                  "With --guide-vertices world: the cells' largest mixing weight, below 1 "
+                  "(default: --pg-pi-max's)")
       ->check(CLI::Range(0.0f, 1.0f));
   cmd->add_option("--world-guide-min-pi", r.world_guide_min_pi,
                   "With --guide-vertices world: a cell guides only where its mixing weight is "

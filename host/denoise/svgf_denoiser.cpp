@@ -9,6 +9,7 @@
 #include "denoise/svgf_reference.h"
 #include "rtpg/cl_error.h"
 #include "rtpg/errors.h"
+#include "rtpg/image_size.h"
 
 namespace rtpg {
 namespace {
@@ -41,9 +42,8 @@ SvgfDenoiser::SvgfDenoiser(ClRuntime& runtime, int width, int height, const Svgf
                                   HostTransfer::in_place),
       upload_bytes_per_pixel_(zero_copy_ ? 0.0 : kUploadBytesPerPixel) {
   validate(settings);
-  if (width <= 0 || height <= 0)
-    throw InputError("svgf", "image size must be positive, got " + std::to_string(width) + "x" +
-                                 std::to_string(height));
+  const std::string size_problem = image_size_problem(width, height);
+  if (!size_problem.empty()) throw InputError("svgf", "image size " + size_problem);
   kernel_settings_ = to_kernel_settings(settings);
   // The filters' edge-stopping weights run through exp() down into float's denormal range (a
   // tap's weight ~1e-20 squared for the variance), where x86 cores take a slow path per

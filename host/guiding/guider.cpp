@@ -4,6 +4,7 @@
 
 #include "cl/work_groups.h"
 #include "guiding/kernel_args.h"
+#include "rtpg/image_size.h"
 #include "shared/pmm.h"
 
 namespace rtpg {
@@ -17,9 +18,8 @@ static_assert(sizeof(shared::pg_pmm_state) == 4 * PG_STATE_FLOATS_PER_PIXEL,
               "the state's floats per pixel");
 
 std::size_t pixels(int width, int height) {
-  if (width <= 0 || height <= 0)
-    throw GuiderError("guiding: resolution must be positive, got " + std::to_string(width) + "x" +
-                      std::to_string(height));
+  const std::string problem = image_size_problem(width, height);
+  if (!problem.empty()) throw GuiderError("guiding: resolution " + problem);
   return static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
 }
 

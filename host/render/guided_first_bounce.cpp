@@ -229,7 +229,11 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
   }
   const Guider::Wait wait = sample_overlap_ ? Guider::Wait::later : Guider::Wait::finish;
   auto t = Clock::now();
-  previous_gbuffer_ = current_gbuffer_;
+  // Last frame's G-buffer becomes the previous one only once this frame's is in place: a frame
+  // refused on the way (the checks below, a packed G-buffer that does not fit) leaves the
+  // sampler as it was, so the next good frame reprojects from the last good one
+  // (GBufferPacker.ARefusedFrameLeavesTheHistoryAsItWas).
+  const GuiderGBuffer previous = current_gbuffer_;
   if (zero_copy_) {
     // The host wrote this G-buffer after last frame's buffers over it were released; had it
     // written last frame's, there would be no previous G-buffer left to reproject from.
@@ -240,18 +244,24 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
     current_gbuffer_ = wrap_host_gbuffer(runtime_.context(), g);
     current_host_ = g.position_depth.data();
   } else {
-    owned_current_ = 1 - owned_current_;
-    current_gbuffer_ = owned_gbuffers_[owned_current_];
+    const int next = 1 - owned_current_;
     if (packed_) {
+      // Packed into the staging first: it refuses a G-buffer that does not fit before anything
+      // is enqueued or swapped.
       upload_staging_->begin();
       stage_packed_gbuffer(*upload_staging_, g, packed_gbuffer_);
+      owned_current_ = next;
+      current_gbuffer_ = owned_gbuffers_[owned_current_];
       if (!sample_overlap_) translate_cl_errors([&] { runtime_.queue().finish(); });
       bytes_ += kPackedGBufferBytes * g.pixel_count();
     } else {
+      owned_current_ = next;
+      current_gbuffer_ = owned_gbuffers_[owned_current_];
       copy_to_device(g, current_gbuffer_, kGBufferBytes * g.pixel_count(), !sample_overlap_);
     }
     copied_from_ = &g;
   }
+  previous_gbuffer_ = previous;
   upload_ms_ = ms_since(t);
   if (packed_) guider_->unpack_gbuffer(packed_gbuffer_, current_gbuffer_, gbuffer_cameras(g), wait);
   if (have_previous_) {

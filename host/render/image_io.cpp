@@ -1,5 +1,6 @@
 #include "render/image_io.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -7,8 +8,10 @@
 #include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 
 #include "rtpg/errors.h"
+#include "rtpg/image_size.h"
 
 namespace rtpg {
 namespace fs = std::filesystem;
@@ -63,11 +66,19 @@ void write_png(const std::string& path, int width, int height,
   write_atomically(path, width, height, 4, OIIO::TypeDesc::UINT8, rgba8.data(), {});
 }
 
-ImageRgb read_image(const std::string& path) {
+ImageRgb read_image(const std::string& path, int expected_width, int expected_height) {
   if (!fs::exists(path)) throw InputError(path, "no such file");
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw InputError(path, "cannot read image: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
+  if (spec.depth > 1) throw InputError(path, "volume images are not supported");
+  if (spec.nchannels <= 0) throw InputError(path, "image has no channels");
+  if (expected_width > 0 && expected_height > 0 &&
+      (spec.width != expected_width || spec.height != expected_height))
+    throw InputError(path, fmt::format("image is {}x{}, expected {}x{}", spec.width, spec.height,
+                                       expected_width, expected_height));
+  const std::string size_problem = image_size_problem(spec.width, spec.height);
+  if (!size_problem.empty()) throw InputError(path, "image size " + size_problem);
   ImageRgb image;
   image.width = spec.width;
   image.height = spec.height;
@@ -78,6 +89,10 @@ ImageRgb read_image(const std::string& path) {
   for (std::size_t i = 0; i < image.pixels.size(); ++i) {
     const float* px = &data[i * spec.nchannels];
     image.pixels[i] = spec.nchannels >= 3 ? glm::vec3(px[0], px[1], px[2]) : glm::vec3(px[0]);
+    const glm::vec3& v = image.pixels[i];
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+      throw InputError(path, fmt::format("pixel ({}, {}) is not finite", i % spec.width,
+                                         i / static_cast<std::size_t>(spec.width)));
   }
   return image;
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "scene/alpha_mask.h"
 #include "shared/compat.h"
 
 namespace rtpg {
@@ -93,8 +94,12 @@ Lights::Lights(const Scene& scene) : scene_(scene) {
       if (!(e.area > 0.0f)) continue;
       e.normal = glm::normalize(c);
       e.radiance = mat.emission;
+      if (has_alpha_mask(scene, mesh)) {
+        e.masked_mesh = static_cast<std::int32_t>(m);
+        e.triangle = static_cast<std::uint32_t>(t);
+      }
       const bool pair =
-          t + 1 < mesh.triangles.size() &&
+          e.masked_mesh < 0 && t + 1 < mesh.triangles.size() &&
           parallelogram_of(mesh.triangles[t], mesh.triangles[t + 1], mesh.positions, e.normal, e);
       triangle_index_[m][t] = static_cast<std::int32_t>(triangles_.size());
       if (pair) {
@@ -220,6 +225,11 @@ inline bool Lights::sample_triangle(const glm::vec3& p, float u_triangle, float 
     // Uniform point on the triangle (pbrt's square-root parameterisation).
     const float su = std::sqrt(u1);
     const float b1 = u2 * su;
+    // On a transparent texel of a masked emitter there is nothing to see: a ray towards it
+    // passes through (the ray queries' alpha filter), so the sample carries no light, and the
+    // density stays that of the whole triangle, which pdf_triangle gives the hits that do find
+    // it (docs/robustness.md, "Alpha-masked emitters").
+    if (e.masked_mesh >= 0 && !masked_point_emits(e, 1.0f - su, b1)) return false;
     y = e.p0 + e.e1 * (1.0f - su) + e.e2 * b1;
   }
   const glm::vec3 to = y - p;
@@ -234,6 +244,13 @@ inline bool Lights::sample_triangle(const glm::vec3& p, float u_triangle, float 
   out.pdf = p_kind * p_tri * d2 / (cos_light * e.area);
   out.delta = false;
   return true;
+}
+
+bool Lights::masked_point_emits(const EmissiveTriangle& e, float u, float v) const {
+  const Mesh& mesh = scene_.meshes[static_cast<std::size_t>(e.masked_mesh)];
+  const Material& mat = scene_.materials[mesh.material];
+  return passes_alpha_test(mesh, scene_.textures[static_cast<std::size_t>(mat.alpha_texture)],
+                           mat.alpha_cutoff, e.triangle, u, v);
 }
 
 bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2,
@@ -270,7 +287,11 @@ bool Lights::sample(const glm::vec3& p, float u_select, float u1, float u2,
     out.radiance = escaped_radiance(out.direction);
     out.pdf = pdf_escaped(out.direction);
     out.delta = false;
-    return true;
+    // Rounding can put a direction drawn at the cone's rim (u1 within about 2e-5 of 1) just
+    // outside the float test of pdf_escaped; with no sky behind the sun its density is then 0,
+    // and the sample is refused instead of dividing 0 by 0 (docs/robustness.md, "The sun's
+    // cone").
+    return out.pdf > 0.0f;
   }
   // Environment.
   out.distance = kInfinity;

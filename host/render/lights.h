@@ -61,6 +61,12 @@ class Lights {
     float area;
     glm::vec3 radiance;
     bool parallelogram = false;
+    // Where its mesh is alpha-tested (scene/alpha_mask.h): the mesh and the triangle, so that a
+    // point drawn on a transparent texel is refused as a ray there passes through; -1 where
+    // not. A masked triangle is never part of a parallelogram (its point needs its own
+    // barycentrics).
+    std::int32_t masked_mesh = -1;
+    std::uint32_t triangle = 0;
   };
   enum Kind : std::size_t { kTriangles = 0, kSun = 1, kEnvironment = 2 };
 
@@ -73,6 +79,9 @@ class Lights {
   [[gnu::always_inline]] inline bool sample_triangle(const glm::vec3& p, float u_triangle,
                                                      float p_kind, float u1, float u2,
                                                      LightSample& out) const;
+  // Whether the point (1 - u - v) p0 + u p1 + v p2 of masked emitter e passes its mesh's alpha
+  // test. Out of line: the one masked emitters' cost.
+  bool masked_point_emits(const EmissiveTriangle& e, float u, float v) const;
   // Whether direction d (unit) lies in the sun's cone: by the sine of its angle to the axis.
   bool in_sun_cone(const glm::vec3& d) const;
   glm::vec3 environment_radiance(const glm::vec3& direction) const;

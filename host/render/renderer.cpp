@@ -11,8 +11,10 @@
 #include "render/camera_rays.h"
 #include "render/surface.h"
 #include "rtpg/guiding_layout.h"
+#include "shared/gbuffer_packing.h"
 #include "shared/rng.h"
 #include "rtpg/errors.h"
+#include "rtpg/image_size.h"
 
 namespace rtpg {
 namespace {
@@ -26,15 +28,9 @@ double ms_since(Clock::time_point start) {
 
 Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
     : scene_(scene), settings_(settings) {
-  if (settings.width <= 0 || settings.height <= 0)
-    throw RenderSettingError("resolution", "must be positive, got " +
-                                               std::to_string(settings.width) + "x" +
-                                               std::to_string(settings.height));
+  const std::string size_problem = image_size_problem(settings.width, settings.height);
+  if (!size_problem.empty()) throw RenderSettingError("resolution", size_problem);
   const std::uint64_t pixels = static_cast<std::uint64_t>(settings.width) * settings.height;
-  if (pixels > kMaxPixels)
-    throw RenderSettingError(
-        "resolution", std::to_string(settings.width) + "x" + std::to_string(settings.height) +
-                          " is too large (at most " + std::to_string(kMaxPixels) + " pixels)");
   if (settings.spp <= 0) throw RenderSettingError("spp", "must be at least 1");
   if (!settings.camera_path.empty() && !scene.camera.paths.count(settings.camera_path))
     throw RenderSettingError("camera_path",
@@ -157,9 +153,10 @@ void Renderer::build_gbuffer(int frame, FrameStats& stats) {
         g.flags[i] = flags;
         float px = 0.0f, py = 0.0f;
         if (!static_camera && previous.project(sp.position, px, py))
-          g.motion[i] =
-              glm::vec2(px * static_cast<float>(g.width) - (static_cast<float>(x) + 0.5f),
-                        py * static_cast<float>(g.height) - (static_cast<float>(y) + 0.5f));
+          g.motion[i] = glm::vec2(shared::pg_bounded_motion(px * static_cast<float>(g.width) -
+                                                            (static_cast<float>(x) + 0.5f)),
+                                  shared::pg_bounded_motion(py * static_cast<float>(g.height) -
+                                                            (static_cast<float>(y) + 0.5f)));
       }
   });
   stats.time_ms["gbuffer"] += ms_since(start);

@@ -109,7 +109,4 @@ class Renderer {
   LargeVector<Hit> camera_hits_;
 };
 
-// Largest image the renderer accepts (pixels); beyond it buffers would not fit in memory.
-constexpr std::uint64_t kMaxPixels = 8192ull * 8192ull;
-
 }  // namespace rtpg

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <vector>
@@ -17,6 +18,12 @@ namespace rtpg {
 
 namespace {
 
+// The largest texture or environment map rtpg reads: a 16384x16384 image (a 16K
+// equirectangular map is 16384x8192), 4 GiB of float texels at four channels; a side of up to
+// 65536 pixels.
+constexpr int kMaxTextureSide = 65536;
+constexpr std::uint64_t kMaxTextureTexels = 16384ull * 16384ull;
+
 // The OIIO message, or a fallback when it set none.
 std::string reason(std::string message, const char* fallback) {
   while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
@@ -28,6 +35,14 @@ Texture read_opened(OIIO::ImageInput& in, const std::string& name, ImageDecode d
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
     throw InputError(name, "image has no pixels");
   if (spec.depth > 1) throw InputError(name, "volume images are not supported");
+  // Checked on the header, before the pixels are allocated: a header may claim any size.
+  if (spec.width > kMaxTextureSide || spec.height > kMaxTextureSide ||
+      static_cast<std::uint64_t>(spec.width) * static_cast<std::uint64_t>(spec.height) >
+          kMaxTextureTexels)
+    throw InputError(name, "image of " + std::to_string(spec.width) + "x" +
+                               std::to_string(spec.height) + " pixels is too large (at most " +
+                               std::to_string(kMaxTextureSide) + " a side and " +
+                               std::to_string(kMaxTextureTexels) + " in all)");
 
   const int nch = std::min(spec.nchannels, 4);
   const bool eight_bit = spec.format == OIIO::TypeDesc::UINT8;
@@ -55,6 +70,18 @@ Texture read_opened(OIIO::ImageInput& in, const std::string& name, ImageDecode d
                                    std::to_string(i % nch) + " is not finite");
       }
       values[i] = std::max(values[i], 0.0f);
+      // A material's map above 1 (a float texture in [0, 1] with some rounding, up to 1 + 2^-10,
+      // is read as 1).
+      if (decode.unit_range && values[i] > 1.0f) {
+        if (values[i] > 1.0f + 0x1p-10f) {
+          const std::size_t pixel = i / static_cast<std::size_t>(nch);
+          throw InputError(name, "pixel (" + std::to_string(pixel % spec.width) + ", " +
+                                     std::to_string(pixel / spec.width) + ") channel " +
+                                     std::to_string(i % nch) + " is " + std::to_string(values[i]) +
+                                     ", above 1 (a material's texture holds values in [0, 1])");
+        }
+        values[i] = 1.0f;
+      }
     }
 
   // Which input channel holds alpha: OIIO knows for most formats; a 2- or 4-channel image

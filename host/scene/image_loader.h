@@ -17,6 +17,10 @@ struct ImageDecode {
   // An alpha mask: when the file has no alpha channel, its first channel (a grey mask such as
   // an OBJ map_d) becomes the alpha, since alpha testing reads the alpha channel.
   bool mask = false;
+  // A material's texture (a colour, roughness, metallic, normal, bump or alpha map): a float
+  // image's values must lie in [0, 1], as 8- and 16-bit ones do by their encoding (an albedo
+  // above 1 would create energy). False for an environment map, whose radiance is unbounded.
+  bool unit_range = true;
 };
 
 // Grey images expand to RGB; alpha is 1 where the file has none. Throws

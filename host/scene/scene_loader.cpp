@@ -311,10 +311,13 @@ class SceneBuilder {
   void read_sun(const JsonNode& node) {
     node.check_object({"direction", "irradiance", "angular_radius_deg"});
     const JsonNode direction = node.child("direction");
-    const glm::vec3 d = direction.vec3();
-    if (!(glm::dot(d, d) > 0.0f)) direction.fail("direction must not be zero");
+    // Normalised in double: a float's squared length overflows from components of about 2e19,
+    // and glm::normalize then returned the zero vector (a sun that lit nothing).
+    const glm::dvec3 d(direction.vec3());
+    const double length = glm::length(d);
+    if (!(length > 0.0)) direction.fail("direction must not be zero");
     scene_.sun.enabled = true;
-    scene_.sun.direction = glm::normalize(d);
+    scene_.sun.direction = glm::vec3(d / length);
     const JsonNode irradiance = node.child("irradiance");
     scene_.sun.irradiance = irradiance.vec3();
     for (int i = 0; i < 3; ++i)
@@ -340,7 +343,7 @@ class SceneBuilder {
     const JsonNode file = node.child("file");
     env.kind = Environment::Kind::Map;
     // Float maps (hdr, exr) are linear; an 8-bit map is an sRGB photograph.
-    env.map_texture = texture(file, ImageDecode{true, false});
+    env.map_texture = texture(file, ImageDecode{true, false, false});
     const float intensity = node.number_or("intensity", 1.0f);
     if (!(intensity >= 0.0f)) node.child("intensity").fail("intensity must not be negative");
     env.color = glm::vec3(intensity);
@@ -352,9 +355,20 @@ class SceneBuilder {
       if (!mesh.triangles.empty() && scene_.materials.at(mesh.material).is_emissive()) return true;
     const glm::vec3 sun = scene_.sun.irradiance;
     if (scene_.sun.enabled && (sun.x > 0.0f || sun.y > 0.0f || sun.z > 0.0f)) return true;
-    const glm::vec3 env = scene_.environment.color;
-    return scene_.environment.kind != Environment::Kind::None &&
-           (env.x > 0.0f || env.y > 0.0f || env.z > 0.0f);
+    const Environment& environment = scene_.environment;
+    const glm::vec3 env = environment.color;
+    if (environment.kind == Environment::Kind::None ||
+        !(env.x > 0.0f || env.y > 0.0f || env.z > 0.0f))
+      return false;
+    if (environment.kind != Environment::Kind::Map) return true;
+    // A map lights only where it is not black in a channel its colour keeps.
+    const Texture& map = scene_.textures.at(static_cast<std::size_t>(environment.map_texture));
+    for (int y = 0; y < map.height; ++y)
+      for (int x = 0; x < map.width; ++x) {
+        const glm::vec4 t = map.fetch(x, y);
+        if (t.x * env.x > 0.0f || t.y * env.y > 0.0f || t.z * env.z > 0.0f) return true;
+      }
+    return false;
   }
 
   const std::string& path_;

@@ -34,7 +34,7 @@ Texture with_context(const std::string& subject, const std::string& context, Loa
 }  // namespace
 
 int TextureCache::file(const std::string& path, ImageDecode decode, const std::string& context) {
-  const Key key{canonical_key(path), decode.srgb, decode.mask};
+  const Key key{canonical_key(path), decode.srgb, decode.mask, decode.unit_range};
   const auto found = index_.find(key);
   if (found != index_.end()) return found->second;
   textures_.push_back(with_context(path, context, [&] { return load_image(path, decode); }));
@@ -45,7 +45,7 @@ int TextureCache::file(const std::string& path, ImageDecode decode, const std::s
 
 int TextureCache::memory(const std::string& key_name, const void* data, std::size_t size,
                          ImageDecode decode, const std::string& context) {
-  const Key key{"embedded:" + key_name, decode.srgb, decode.mask};
+  const Key key{"embedded:" + key_name, decode.srgb, decode.mask, decode.unit_range};
   const auto found = index_.find(key);
   if (found != index_.end()) return found->second;
   textures_.push_back(with_context(

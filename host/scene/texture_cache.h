@@ -27,7 +27,7 @@ class TextureCache {
              const std::string& context);
 
  private:
-  using Key = std::tuple<std::string, bool, bool>;
+  using Key = std::tuple<std::string, bool, bool, bool>;  // path, srgb, mask, unit_range
   std::vector<Texture>& textures_;
   std::map<Key, int> index_;
 };

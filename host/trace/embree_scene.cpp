@@ -11,6 +11,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "scene/alpha_mask.h"
+
 namespace rtpg {
 namespace {
 
@@ -21,14 +23,6 @@ struct AlphaMask {
   float cutoff = 0.5f;
 };
 
-bool alpha_passes(const AlphaMask& mask, std::uint32_t prim, float u, float v) {
-  const Mesh& mesh = *mask.mesh;
-  if (mesh.uvs.empty()) return true;
-  const glm::uvec3 tri = mesh.triangles[prim];
-  const glm::vec2 uv = (1.0f - u - v) * mesh.uvs[tri.x] + u * mesh.uvs[tri.y] + v * mesh.uvs[tri.z];
-  return mask.texture->sample(uv).w >= mask.cutoff;
-}
-
 // One callback for closest-hit and occlusion queries: rejects hits on transparent texels.
 void alpha_filter(const RTCFilterFunctionNArguments* args) {
   const auto* mask = static_cast<const AlphaMask*>(args->geometryUserPtr);
@@ -37,7 +31,8 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
     const std::uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
     const float u = RTCHitN_u(args->hit, args->N, i);
     const float v = RTCHitN_v(args->hit, args->N, i);
-    if (!alpha_passes(*mask, prim, u, v)) args->valid[i] = 0;
+    if (!passes_alpha_test(*mask->mesh, *mask->texture, mask->cutoff, prim, u, v))
+      args->valid[i] = 0;
   }
 }
 
@@ -108,7 +103,7 @@ EmbreeScene::EmbreeScene(const Scene& scene) : impl_(std::make_unique<Impl>()) {
       indices[3 * i + 2] = mesh.triangles[i].z;
     }
     const Material& material = scene.materials.at(mesh.material);
-    if (material.alpha_texture >= 0 && !mesh.uvs.empty()) {
+    if (has_alpha_mask(scene, mesh)) {
       impl_->masks.push_back(
           {&mesh, &scene.textures.at(material.alpha_texture), material.alpha_cutoff});
       rtcSetGeometryUserData(geom, &impl_->masks.back());

@@ -99,8 +99,20 @@ PG_FN float4 pg_gbuffer_view_dir(float3 ray) {
   float3 v = -normalize(ray);
   return pg_make_float4(v.x, v.y, v.z, 0.0f);
 }
+/* A motion vector's component clamped to PG_MAX_MOTION pixels either way (a NaN to -PG_MAX_MOTION):
+ * a point just in front of last frame's camera projects through a division by nearly 0, up to
+ * infinity, and a position formed from such a vector would leave float's exact integers and make
+ * its conversion to int undefined (OpenCL C 1.2, 6.2.3.3), where a clamped one lies off the image
+ * whatever the pixel (rtpg/image_size.h: sides of at most 65536 pixels), so no history is found
+ * there, as for any point off screen. The host's G-buffer clamps its motion the same way. */
+#define PG_MAX_MOTION 65536.0f
+PG_FN float pg_bounded_motion(float m) {
+  return fmin(fmax(m, -PG_MAX_MOTION), PG_MAX_MOTION);
+}
+
 /* The offset in pixels from pixel (x, y) to where `position` was in the previous camera's image
- * (CameraFrame::project); zero where the camera did not move or the point was behind it. */
+ * (CameraFrame::project), each component pg_bounded_motion; zero where the camera did not move or
+ * the point was behind it. */
 PG_FN float2 pg_gbuffer_motion(pg_gbuffer_cameras cameras, float3 position, uint x, uint y) {
   if (!cameras.moved) return pg_make_float2(0.0f, 0.0f);
   pg_pinhole_camera c = cameras.previous;
@@ -111,8 +123,8 @@ PG_FN float2 pg_gbuffer_motion(pg_gbuffer_cameras cameras, float3 position, uint
   float py = dot(d, pg_make_float3(c.up_x, c.up_y, c.up_z)) / z;
   float sx = 0.5f * (px / (c.tan_half_fov_y * c.aspect) + 1.0f);
   float sy = 0.5f * (1.0f - py / c.tan_half_fov_y);
-  return pg_make_float2(sx * (float)cameras.width - ((float)x + 0.5f),
-                        sy * (float)cameras.height - ((float)y + 0.5f));
+  return pg_make_float2(pg_bounded_motion(sx * (float)cameras.width - ((float)x + 0.5f)),
+                        pg_bounded_motion(sy * (float)cameras.height - ((float)y + 0.5f)));
 }
 
 PG_NAMESPACE_END

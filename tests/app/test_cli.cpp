@@ -244,6 +244,14 @@ TEST_F(Cli, RejectsZeroResolution) {
   expect_rejected(render("--res 0x0"), "--res");
 }
 
+// A side beyond 65536 pixels, even where the whole image is small (rtpg/image_size.h), and more
+// than 8192^2 pixels in all.
+TEST_F(Cli, RejectsResolutionsTooLarge) {
+  expect_rejected(render("--res 70000x8"), "--res");
+  expect_rejected(render("--res 8x70000"), "--res");
+  expect_rejected(render("--res 16384x8193"), "--res");
+}
+
 TEST_F(Cli, RejectsNonNumericResolution) {
   expect_rejected(render("--res abc"), "--res");
 }
@@ -319,6 +327,59 @@ TEST_F(Cli, RejectsReferenceOfWrongSize) {
       run_rtpg(dir(), "render --res 16x8 --spp 1 --guiding off -q -o reference.exr");
   ASSERT_EQ(made.exit_code, 0) << describe(made);
   expect_rejected(render("--res 32x32 --reference reference.exr"), "reference.exr");
+}
+
+// The outputs of a run are distinct files, none of them an input: -o onto the reference would
+// replace what the run reads, -o and --stats-json in one file would leave an "EXR" of JSON.
+// Spellings of one path count as one ("./"). Refused before any work, the reference unchanged.
+TEST_F(Cli, RejectsOutputsThatAreOneFileOrAnInput) {
+  const RunResult made =
+      run_rtpg(dir(), "render --res 16x16 --spp 1 --guiding off -q -o reference.exr");
+  ASSERT_EQ(made.exit_code, 0) << describe(made);
+  expect_rejected(
+      "render --res 16x16 --spp 1 --guiding off --reference reference.exr -o "
+      "./reference.exr",
+      "reference.exr", {});
+  expect_rejected("render --res 16x16 --spp 1 --guiding off -o same.exr --stats-json same.exr",
+                  "--stats-json", {"same.exr"});
+  expect_rejected(
+      "render --res 16x16 --spp 1 --frames 2 --guiding off -o out.exr --denoise svgf "
+      "--noisy-output out.exr",
+      "--noisy-output", {"out.exr"});
+  expect_rejected("reference " + shell_quote(source_dir() + "/scenes/cornell-box.json") +
+                      " --res 16x16 --spp 1 -o ref.exr --stats-json ref.exr",
+                  "--stats-json", {"ref.exr"});
+}
+
+// An output that is an existing folder is refused before the render: the rename into place
+// would fail only after the frames saved beside it were written.
+TEST_F(Cli, RejectsAnOutputThatIsAFolder) {
+  fs::create_directory(dir() / "folder.exr");
+  expect_rejected(
+      "render --res 16x16 --spp 1 --frames 2 --save-frames 0 --guiding off -o "
+      "folder.exr",
+      "folder.exr", {});
+  expect_rejected("render --res 16x16 --spp 1 --guiding off -o out.exr --stats-json folder.exr",
+                  "folder.exr", {"out.exr"});
+}
+
+// A reference whose header claims another size is refused before its pixels are allocated (a
+// 55-byte HDR file claiming 100000x100000 pixels used to end in std::bad_alloc), and one with a
+// NaN pixel is refused instead of making every relMSE NaN.
+TEST_F(Cli, RejectsAHugeOrNonFiniteReference) {
+  write("huge.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n");
+  expect_rejected(render("--res 16x16 --reference huge.hdr"), "huge.hdr");
+  {
+    std::vector<float> pixels(16 * 16 * 3, 0.5f);
+    pixels[3 * 37 + 1] = std::nanf("");
+    auto out = OIIO::ImageOutput::create("nan.exr");
+    ASSERT_TRUE(out);
+    const OIIO::ImageSpec spec(16, 16, 3, OIIO::TypeDesc::FLOAT);
+    ASSERT_TRUE(out->open((dir() / "nan.exr").string(), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    ASSERT_TRUE(out->close());
+  }
+  expect_rejected(render("--res 16x16 --reference nan.exr"), "pixel (5, 2) is not finite");
 }
 
 TEST_F(Cli, RejectsMissingReference) {
@@ -781,6 +842,13 @@ TEST_F(Cli, DenoiseWritesTheFilteredAndTheNoisyFrameWithTheirStatistics) {
   ASSERT_TRUE(last.contains("zero_copy"));
   EXPECT_EQ(last.value("svgf_host_device_bytes_per_pixel", -1.0),
             last.value("zero_copy", 0.0) == 1.0 ? 0.0 : 40.0);
+}
+
+// The world guide's cells' mixing weight must stay below 1, as the pixels' (--pg-pi-max): at 1 a
+// guided vertex would never sample its BSDF.
+TEST_F(Cli, RejectsAWorldGuideMixingWeightOfOne) {
+  expect_rejected(render("--res 16x16 --guide-vertices world --world-guide-pi-max 1"),
+                  "--world-guide-pi-max");
 }
 
 TEST_F(Cli, RejectsBadDenoiserSettings) {

@@ -524,6 +524,7 @@ TEST(SvgfKernels, BadInputIsAClearError) {
   late.history_iteration = 5;
   expect_refused(late, "history_iteration");
   EXPECT_THROW(SvgfDenoiser(rt, 0, 8), InputError);
+  EXPECT_THROW(SvgfDenoiser(rt, 70000, 1), InputError);  // a side beyond rtpg/image_size.h's
   SvgfSettings half_auto;  // a work-group size of 0 is per device in both directions or neither
   half_auto.local_x = 0;
   half_auto.local_y = 8;

@@ -15,6 +15,7 @@
 #include "rtpg/cl_runtime.h"
 #include "rtpg/guider.h"
 #include "rtpg/guiding_distribution.h"
+#include "rtpg/image_size.h"
 #include "rtpg/vpl_packing.h"
 
 namespace {
@@ -457,6 +458,23 @@ TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
 
 // rows_per_model 0 (the default) shares a model over at most 1/135 of the image's height, in
 // groups of 1, 2, 4 or 8 rows; an explicit value is kept whatever the height.
+// The Guider refuses the image sizes the renderer refuses (rtpg/image_size.h), before it
+// allocates anything: a side of zero or beyond 65536 pixels, more than 8192^2 pixels in all.
+TEST(GuiderApi, RefusesImageSizesOutOfRange) {
+  rtpg::ClRuntime rt;
+  for (const auto& [w, h] :
+       std::vector<std::pair<int, int>>{{0, 8}, {8, -1}, {70000, 1}, {1, 70000}, {16384, 8193}}) {
+    try {
+      rtpg::Guider guider(rt, w, h);
+      ADD_FAILURE() << w << "x" << h << " accepted";
+    } catch (const rtpg::GuiderError& e) {
+      EXPECT_NE(std::string(e.what()).find("resolution"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(rtpg::image_size_problem(65536, 1024), "");
+  EXPECT_NE(rtpg::image_size_problem(65537, 1), "");
+}
+
 TEST(GuidingSettingsTable, RowsPerModelByTheImagesHeight) {
   EXPECT_EQ(rtpg::GuidingSettings{}.rows_per_model, 0);
   const std::pair<int, int> heights[] = {{0, 1},    {1, 1},    {135, 1},  {269, 1},

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -347,6 +348,101 @@ TEST(Lights, QuadLightsAreSampledAsOneParallelogram) {
     }
     // Binomial(20000, 1/2): 5 standard deviations are 354.
     EXPECT_NEAR(static_cast<double>(in_first), samples / 2.0, 354.0) << k.name;
+  }
+}
+
+// A lamp whose alpha mask makes its left half transparent (a quad over the square x, z in
+// [-0.5, 0.5] at y = 1, facing down, texture u = x + 0.5; eight texels in u, alpha 0 in the left
+// four) emits only where a ray would find it: Embree's alpha filter lets rays through the
+// transparent texels, so a light sample drawn there would add light that no BSDF-sampled ray
+// can find, a bias (docs/robustness.md, "Alpha-masked emitters"). Its samples land only on the
+// opaque half, about half of them are refused, and each keeps the density of the whole lamp,
+// which pdf_triangle gives the hits; its two triangles stay two emitters.
+TEST(Lights, MaskedEmittersDrawNoLightFromTransparentTexels) {
+  Scene scene = floor_scene();
+  Texture mask;
+  mask.width = 8;
+  mask.height = 1;
+  for (int x = 0; x < mask.width; ++x)
+    mask.texels8.push_back({255, 255, 255, static_cast<std::uint8_t>(x < 4 ? 0 : 255)});
+  scene.textures.push_back(mask);
+  Material lamp;
+  lamp.emission = glm::vec3(2.0f);
+  lamp.alpha_texture = 0;
+  lamp.alpha_cutoff = 0.5f;
+  scene.materials.push_back(lamp);
+  // make_quad's corners take uv (0, 0), (1, 0), (1, 1), (0, 1): u runs along e1 (+x).
+  Mesh mesh = make_quad({-0.5f, 1.0f, -0.5f}, {1.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f});
+  ASSERT_FALSE(mesh.uvs.empty());
+  mesh.material = 1;
+  scene.meshes.push_back(mesh);
+  Scene opaque = scene;
+  opaque.materials[1].alpha_texture = -1;
+  const Lights lights(scene), unmasked(opaque);
+  EXPECT_EQ(lights.emitter_count(), 2u);
+  EXPECT_EQ(lights.parallelogram_count(), 0u);
+  EXPECT_EQ(unmasked.parallelogram_count(), 1u);
+
+  const glm::vec3 p(0.1f, 0.2f, -0.05f);
+  const std::size_t n = 40000;
+  std::size_t accepted = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    shared::pg_rng rng = shared::pg_rng_make(5u, static_cast<shared::uint>(i), 0u, 0u, 5u);
+    const float a = shared::pg_rng_next(&rng), b = shared::pg_rng_next(&rng),
+                c = shared::pg_rng_next(&rng);
+    LightSample s;
+    if (!lights.sample(p, a, b, c, s)) continue;
+    ++accepted;
+    const glm::vec3 y = p + s.direction * s.distance;
+    const float u = y.x + 0.5f;
+    // Bilinear alpha: below the cutoff from a quarter texel short of the middle down to a
+    // quarter texel from the wrap's edge (u = 1/16 .. 7/16), so no sample lands there.
+    EXPECT_FALSE(u > 1.5f / 16.0f && u < 6.5f / 16.0f) << "sample " << i << " at u = " << u;
+    EXPECT_GT(s.pdf, 0.0f);
+    const float whole = unmasked.pdf_triangle(1, 0, p, y, glm::vec3(0, -1, 0));
+    EXPECT_NEAR(s.pdf, whole, 1e-4f * whole) << "sample " << i;
+    for (std::uint32_t t = 0; t < 2; ++t) {
+      const float hit = lights.pdf_triangle(1, t, p, y, glm::vec3(0, -1, 0));
+      EXPECT_NEAR(hit, s.pdf, 1e-4f * s.pdf) << "sample " << i << " triangle " << t;
+    }
+  }
+  // Opaque where alpha >= 1/2: u in [7/16, 1) and [0, 1/16), half the lamp. Binomial(40000,
+  // 1/2): 5 standard deviations are 500.
+  EXPECT_NEAR(static_cast<double>(accepted), n / 2.0, 500.0);
+}
+
+// The sun's cone drawn at its rim: directions from u1 within 2^-15 of 1 (where rounding puts a
+// few of them just outside the cone's float test) are either refused or carry a positive, finite
+// density and radiance, with no sky behind the sun to give them one; before the refusal a rim
+// sample reported density 0 with radiance 0, and next-event estimation divided 0 by 0 (a NaN
+// pixel sample). Some are refused, so the sweep reaches the case.
+TEST(Lights, SunConeSamplesAtItsRimHaveADensity) {
+  for (const float radius_deg : {0.27f, 2.0f}) {
+    Scene scene = floor_scene();
+    scene.sun.enabled = true;
+    scene.sun.direction = glm::normalize(glm::vec3(0.3f, 0.8f, 0.2f));
+    scene.sun.irradiance = glm::vec3(3.0f);
+    scene.sun.angular_radius = radius_deg * static_cast<float>(kPi / 180.0);
+    const Lights lights(scene);
+    std::size_t refused = 0, drawn = 0;
+    for (int k = 1; k <= 512; ++k) {
+      const float u1 = 1.0f - static_cast<float>(k) * 0x1p-24f;
+      for (int j = 0; j < 256; ++j) {
+        const float u2 = (static_cast<float>(j) + 0.5f) / 256.0f;
+        LightSample s;
+        ++drawn;
+        if (!lights.sample(glm::vec3(0.0f, 0.5f, 0.0f), 0.5f, u1, u2, s)) {
+          ++refused;
+          continue;
+        }
+        ASSERT_TRUE(s.pdf > 0.0f && std::isfinite(s.pdf))
+            << radius_deg << " deg, u1 = 1 - " << k << " * 2^-24, u2 = " << u2 << ": pdf " << s.pdf;
+        ASSERT_TRUE(std::isfinite(s.radiance.x) && s.radiance.x > 0.0f) << radius_deg << " deg";
+      }
+    }
+    std::printf("sun of %.2f degrees: %zu of %zu rim samples refused\n", radius_deg, refused,
+                drawn);
+    EXPECT_GT(refused, 0u) << radius_deg << " deg: the sweep did not reach the rim's case";
   }
 }
 

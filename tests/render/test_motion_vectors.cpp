@@ -10,9 +10,12 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "render/gbuffer.h"
 #include "render/renderer.h"
+#include "shared/gbuffer_packing.h"
 #include "same_image.h"
 #include "scene/scene_loader.h"
+#include "scene/shapes.h"
 
 namespace rtpg {
 namespace {
@@ -80,6 +83,69 @@ TEST(MotionVectors, EqualTheProjectionIntoThePreviousFrame) {
   EXPECT_GT(checked, 5 * 37 * 23 / 2);
   std::printf("motion vectors: %d pixels, largest motion %.3f px, largest error %.2e px\n", checked,
               largest_motion, largest_error);
+}
+
+// A camera that backs away from a wall it stood 1e-12 in front of: the wall's points lie just in
+// front of the previous camera's plane, where the projection divides by about 1e-12, and their
+// motion is clamped to 65536 pixels either way (pg_bounded_motion, kernels/shared/
+// gbuffer_packing.h) instead of reaching about 1e13 pixels, beyond the int the kernels convert a
+// position to (docs/robustness.md, "Image sizes"). Every motion is finite and within the bound,
+// and most of the wall's pixels take the bound itself.
+TEST(MotionVectors, ClampedWherePointsWereJustInFrontOfTheCamera) {
+  Scene scene;
+  scene.materials.push_back(Material{});
+  // A 20 x 20 wall in the plane z = -1e-12, facing +z.
+  scene.meshes.push_back(
+      make_quad({-10.0f, -10.0f, -1e-12f}, {20.0f, 0.0f, 0.0f}, {0.0f, 20.0f, 0.0f}));
+  CameraPath path;
+  path.times = {0.0f, 1.0f / 30.0f};
+  CameraView near_view, far_view;
+  near_view.position = glm::vec3(0.0f);
+  near_view.look_at = glm::vec3(0.0f, 0.0f, -1.0f);
+  far_view.position = glm::vec3(0.0f, 0.0f, 5.0f);
+  far_view.look_at = glm::vec3(0.0f, 0.0f, -1.0f);
+  path.views = {near_view, far_view};
+  scene.camera.view = near_view;
+  scene.camera.paths["back"] = path;
+  RenderSettings settings;
+  settings.width = 33;
+  settings.height = 21;
+  settings.camera_path = "back";
+  settings.path_tracer.max_bounces = 1;
+  Renderer renderer(scene, settings);
+  renderer.render_frame(0);
+  renderer.render_frame(1);
+  const GBuffer& g = renderer.gbuffer();
+  int surfaces = 0, at_bound = 0;
+  for (std::size_t i = 0; i < g.pixel_count(); ++i) {
+    if (!g.has_surface(i)) continue;
+    ++surfaces;
+    for (const float m : {g.motion[i].x, g.motion[i].y}) {
+      ASSERT_TRUE(std::isfinite(m)) << "pixel " << i;
+      ASSERT_LE(std::fabs(m), 65536.0f) << "pixel " << i;
+    }
+    if (std::fabs(g.motion[i].x) == 65536.0f || std::fabs(g.motion[i].y) == 65536.0f) ++at_bound;
+  }
+  EXPECT_EQ(surfaces, 33 * 21);
+  EXPECT_GT(at_bound, surfaces / 2);
+  // The device's own motion (pg_gbuffer_motion, from a packed G-buffer's depth) is bounded the
+  // same way: the wall's pixels at the bound where the host's are.
+  const pg_gbuffer_cameras cameras = gbuffer_cameras(g);
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * g.width + x;
+      const glm::vec4 p = g.position_depth[i];
+      const shared::float2 m =
+          shared::pg_gbuffer_motion(cameras, shared::float3(p.x, p.y, p.z),
+                                    static_cast<shared::uint>(x), static_cast<shared::uint>(y));
+      for (int c = 0; c < 2; ++c) {
+        const float device = c == 0 ? m.x : m.y, host = g.motion[i][c];
+        ASSERT_TRUE(std::isfinite(device) && std::fabs(device) <= 65536.0f) << x << "," << y;
+        if (std::fabs(host) == 65536.0f) {
+          EXPECT_EQ(device, host) << x << "," << y;
+        }
+      }
+    }
 }
 
 // A static camera has zero motion on every frame, jitter or not: no camera path, or a path

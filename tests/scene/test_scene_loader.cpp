@@ -339,8 +339,16 @@ TEST(ImageLoader, DecodesSrgbOnlyForColourAndExpandsGrey) {
   EXPECT_NEAR(rgba.fetch(0, 0).x, 0.2158605f, 1e-4f);  // colour not premultiplied by alpha
   EXPECT_NEAR(rgba.fetch(0, 0).w, 0.2f, 1e-6f);        // alpha never sRGB-decoded
 
+  // An environment map's radiance is unbounded; a material's float texture lies in [0, 1].
   write_float_image(dir / "env.exr", 2, 1, 7.5f);
-  EXPECT_FLOAT_EQ(load_image(dir / "env.exr", ImageDecode{true, false}).texels[1].y, 7.5f);
+  EXPECT_FLOAT_EQ(load_image(dir / "env.exr", ImageDecode{true, false, false}).texels[1].y, 7.5f);
+  expect_input_error(
+      [&] {
+        load_image(dir / "env.exr", ImageDecode{true, false});
+      },
+      {"env.exr", "pixel (0, 0) channel 0 is 7.5", "above 1"});
+  write_float_image(dir / "rounded.exr", 2, 1, 1.0f + 0x1p-12f);  // rounding above 1: read as 1
+  EXPECT_EQ(load_image(dir / "rounded.exr", ImageDecode{false, false}).texels[1].y, 1.0f);
 }
 
 // ---- a valid scene with every feature ------------------------------------------------------
@@ -819,6 +827,31 @@ TEST(SceneLoaderErrors, NoLightSources) {
   write_file(dir / "dark.json", std::string("{") + kCamera + R"(, "materials": {"m": {}},
     "shapes": [{"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "m"}]})");
   expect_input_error([&] { load_scene(dir / "dark.json"); }, {"dark.json", "no light sources"});
+}
+
+// An environment map black in every texel lights nothing, like a black constant sky: with no
+// other light the scene is refused.
+TEST(SceneLoaderErrors, BlackEnvironmentMapIsNoLight) {
+  TempDir dir;
+  write_float_image(dir / "black.exr", 4, 2, 0.0f);
+  write_file(dir / "s.json", std::string("{") + kCamera + R"(,
+    "environment": {"file": "black.exr"}, "materials": {"m": {}},
+    "shapes": [{"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "m"}]})");
+  expect_input_error([&] { load_scene(dir / "s.json"); }, {"s.json", "no light sources"});
+  write_float_image(dir / "black.exr", 4, 2, 0.5f);
+  EXPECT_NO_THROW(load_scene(dir / "s.json"));
+}
+
+// A sun direction whose components square beyond float's range is still a direction: its
+// normalisation used to give the zero vector, a sun that lit nothing.
+TEST(SceneLoader, SunDirectionOfHugeComponentsNormalises) {
+  TempDir dir;
+  write_file(dir / "s.json", std::string("{") + kCamera + R"(,
+    "sun": {"direction": [1e20, 2e20, 1e20], "irradiance": [1, 1, 1]}, "materials": {"m": {}},
+    "shapes": [{"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "m"}]})");
+  const Scene scene = load_scene(dir / "s.json");
+  const glm::vec3 expected = glm::normalize(glm::vec3(1.0f, 2.0f, 1.0f));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(scene.sun.direction[c], expected[c], 1e-6f);
 }
 
 TEST(SceneLoaderErrors, MissingMesh) {
