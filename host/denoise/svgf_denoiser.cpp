@@ -152,8 +152,11 @@ double SvgfDenoiser::run(cl::Kernel& kernel, int lanes, const WorkGroupShape& sh
 SvgfDenoiser::~SvgfDenoiser() {
   try {
     unmap_output();
-    runtime_.queue().finish();
-  } catch (...) {  // a failing queue at teardown has nothing left to corrupt
+  } catch (...) {  // a failing unmap at teardown leaves the finish below to do
+  }
+  try {
+    runtime_.queue().finish();  // kernels still reading the caller's images finish first
+  } catch (...) {               // a failing queue at teardown has nothing left to corrupt
   }
 }
 

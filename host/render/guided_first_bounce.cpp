@@ -180,6 +180,11 @@ GuidedFirstBounce::~GuidedFirstBounce() {
 #undef RTPG_UNMAP_STAGING
       }
     }
+  } catch (...) {  // a failing unmap at teardown leaves the finish below to do
+  }
+  // Apart from the unmaps: kernels still running (training overlapped with the host) read the
+  // renderer's G-buffer and VPLs in place, which the renderer frees after this destructor.
+  try {
     runtime_.queue().finish();
   } catch (...) {  // a failing queue at teardown has nothing left to corrupt
   }

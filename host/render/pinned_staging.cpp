@@ -28,8 +28,11 @@ PinnedStaging::PinnedStaging(const cl::Context& context, const cl::CommandQueue&
 PinnedStaging::~PinnedStaging() {
   try {
     queue_.enqueueUnmapMemObject(buffer_, mapped_);
-    queue_.finish();
-  } catch (...) {  // a failing queue at teardown has nothing left to corrupt
+  } catch (...) {  // a failing unmap at teardown leaves the finish below to do
+  }
+  try {
+    queue_.finish();  // copies still reading the staging finish before it is freed
+  } catch (...) {     // a failing queue at teardown has nothing left to corrupt
   }
 }
 

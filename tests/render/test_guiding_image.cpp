@@ -646,8 +646,9 @@ TEST(GuidingImage, TrainingOverlappedGivesTheSameImage) {
 }
 
 // The G-buffer's upload, reproject and sample left running on the device while the host makes
-// the primary hit's light samples (Overlap::on for sampling, the default where the device has
-// memory of its own) change nothing but the order of the work: with every host transfer, with
+// the primary hit's light samples (Overlap::on for sampling; off by default everywhere, docs/
+// guiding.md, "The bus and the sampling's overlap on an H200") change nothing but the order of
+// the work: with every host transfer, with
 // the training waited for and overlapped, along a moving camera at 2 spp and an odd size, the
 // image, the state and the statistics are those of sampling waited for, to the bit. So they are
 // where the host reads the mixture (later vertices borrowing it) and where next-event
