@@ -13,6 +13,7 @@
 
 #include "scene/scene.h"
 #include "scene/shapes.h"
+#include "support/scene_edits.h"
 #include "trace/embree_scene.h"
 
 namespace rtpg {
@@ -241,17 +242,7 @@ Scene masked_quad_over_floor(const Texture& mask, float cutoff) {
 // the opaque half they hit the quad, in every ray mode, for 8-bit and float masks.
 TEST(EmbreeScene, AlphaMaskLetsRaysThroughItsTransparentTexels) {
   for (const bool eight_bit : {true, false}) {
-    Texture mask;
-    mask.width = 8;
-    mask.height = 1;
-    for (int x = 0; x < mask.width; ++x) {
-      const std::uint8_t alpha = x < 4 ? 0 : 255;
-      if (eight_bit) {
-        mask.texels8.push_back({255, 255, 255, alpha});
-      } else {
-        mask.texels.push_back(glm::vec4(1.0f, 1.0f, 1.0f, alpha / 255.0f));
-      }
-    }
+    const Texture mask = test::left_half_transparent_mask(eight_bit);
     // u = (x + 1) / 2 on the quad (make_quad's corners take uv (0, 0), (1, 0), (1, 1), (0, 1)).
     const Scene scene = masked_quad_over_floor(mask, 0.5f);
     const EmbreeScene tracer(scene);

@@ -18,6 +18,7 @@
 #include "scene/shapes.h"
 #include "shared/rng.h"
 #include "support/chi_square.h"
+#include "support/scene_edits.h"
 
 namespace rtpg {
 namespace {
@@ -360,12 +361,7 @@ TEST(Lights, QuadLightsAreSampledAsOneParallelogram) {
 // which pdf_triangle gives the hits; its two triangles stay two emitters.
 TEST(Lights, MaskedEmittersDrawNoLightFromTransparentTexels) {
   Scene scene = floor_scene();
-  Texture mask;
-  mask.width = 8;
-  mask.height = 1;
-  for (int x = 0; x < mask.width; ++x)
-    mask.texels8.push_back({255, 255, 255, static_cast<std::uint8_t>(x < 4 ? 0 : 255)});
-  scene.textures.push_back(mask);
+  scene.textures.push_back(test::left_half_transparent_mask());
   Material lamp;
   lamp.emission = glm::vec3(2.0f);
   lamp.alpha_texture = 0;

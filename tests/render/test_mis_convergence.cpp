@@ -14,6 +14,7 @@
 #include "render/mis.h"
 #include "render/renderer.h"
 #include "scene/scene_loader.h"
+#include "support/scene_edits.h"
 #include "support/statistics.h"
 
 namespace rtpg {
@@ -197,12 +198,7 @@ TEST_F(MisConvergence, RejectsATwoPercentBrighterLight) {
 // emitters"), a bias of most of the direct light of the half that is not there.
 TEST(MisConvergenceMasked, AlphaMaskedLightAgreesWithBsdfSampling) {
   Scene scene = load_scene(source_dir() + "/scenes/cornell-box.json");
-  Texture mask;
-  mask.width = 8;
-  mask.height = 1;
-  for (int x = 0; x < mask.width; ++x)
-    mask.texels8.push_back({255, 255, 255, static_cast<std::uint8_t>(x < 4 ? 0 : 255)});
-  scene.textures.push_back(mask);
+  scene.textures.push_back(test::left_half_transparent_mask());
   int masked = 0;
   for (Material& m : scene.materials)
     if (m.is_emissive()) {

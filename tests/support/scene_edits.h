@@ -1,6 +1,8 @@
 // Edits of a loaded scene that tests make to reach a case the scene files do not have.
 #pragma once
 
+#include <cstdint>
+
 #include <glm/glm.hpp>
 
 #include "scene/scene.h"
@@ -30,6 +32,25 @@ inline void rotate_meshes(Scene& scene, const glm::mat3& rotation, const glm::ve
     for (glm::vec3& n : mesh.normals) n = rotation * n;
     for (glm::vec4& t : mesh.tangents) t = glm::vec4(rotation * glm::vec3(t), t.w);
   }
+}
+
+// An alpha mask whose left half is transparent: 8x1 texels, alpha 0 in the left four and 1 in
+// the right four (8-bit, or float texels), white. On make_quad's uv (u along its first edge) the
+// quad is then open for u below about 1/2: bilinear alpha falls below 1/2 from a quarter texel
+// short of the middle, and from the wrap's edge (u = 1/16 .. 7/16 certainly open).
+inline Texture left_half_transparent_mask(bool eight_bit = true) {
+  Texture mask;
+  mask.width = 8;
+  mask.height = 1;
+  for (int x = 0; x < mask.width; ++x) {
+    const std::uint8_t alpha = x < 4 ? 0 : 255;
+    if (eight_bit) {
+      mask.texels8.push_back({255, 255, 255, alpha});
+    } else {
+      mask.texels.push_back(glm::vec4(1.0f, 1.0f, 1.0f, alpha / 255.0f));
+    }
+  }
+  return mask;
 }
 
 }  // namespace rtpg::test
