@@ -39,6 +39,9 @@ VARIANTS = {
     "alpha 0.05": ["--svgf-alpha-colour", 0.05, "--svgf-alpha-moments", 0.05],
     "phi_l 2, alpha 0.1": ["--svgf-phi-luminance", 2, "--svgf-alpha-colour", 0.1,
                            "--svgf-alpha-moments", 0.1],
+    # The depth weight's slope from the pixel's plane instead of its jittered neighbours' depths
+    # (docs/denoising.md, "Where we deviate").
+    "plane slope": ["--svgf-depth-slope-from-normal", 1],
 }
 LAST = 8  # frames whose relMSE is averaged (bench/experiments.py's final_frame_metrics)
 

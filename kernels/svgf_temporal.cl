@@ -36,7 +36,7 @@ __kernel void svgf_temporal(__global const float* colour, __global const float4*
                             __global float4* kept_position_depth,
                             __global float4* kept_shading_normal, __global uint* kept_material,
                             uint width, uint height, uint has_history,
-                            pg_svgf_settings settings) {
+                            pg_svgf_settings settings, pg_svgf_view view) {
   /* clang-format on */
   uint x = get_global_id(0), y = get_global_id(1);
   if (x >= width || y >= height) return;
@@ -60,7 +60,9 @@ __kernel void svgf_temporal(__global const float* colour, __global const float4*
   float z_right = x + 1u < width ? position_depth[i + 1u].w : 0.0f;
   float z_down = y > 0u ? position_depth[i - width].w : 0.0f;
   float z_up = y + 1u < height ? position_depth[i + width].w : 0.0f;
-  depth_slope[i] = pg_svgf_depth_slope(pd.w, z_left, z_right, z_down, z_up);
+  depth_slope[i] = settings.depth_slope_from_normal
+                       ? pg_svgf_plane_slope(normal, pd.xyz, pd.w, view)
+                       : pg_svgf_depth_slope(pd.w, z_left, z_right, z_down, z_up);
 
   float3 albedo = pg_svgf_albedo(base_color_roughness[i], settings.albedo_floor);
   float3 illumination = pg_svgf_demodulate(vload3(i, colour), emission[i].xyz, albedo);

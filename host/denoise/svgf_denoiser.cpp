@@ -14,7 +14,8 @@
 namespace rtpg {
 namespace {
 
-static_assert(sizeof(shared::pg_svgf_settings) == 11 * 4, "pg_svgf_settings: 4-byte fields only");
+static_assert(sizeof(shared::pg_svgf_settings) == 12 * 4, "pg_svgf_settings: 4-byte fields only");
+static_assert(sizeof(shared::pg_svgf_view) == 10 * 4, "pg_svgf_view: 4-byte fields only");
 static_assert(sizeof(glm::vec4) == sizeof(cl_float4), "glm::vec4 must match cl_float4");
 static_assert(sizeof(glm::vec3) == 3 * sizeof(cl_float), "glm::vec3 must be three packed floats");
 
@@ -259,6 +260,7 @@ const std::vector<glm::vec3>& SvgfDenoiser::denoise(const std::vector<glm::vec3>
     temporal_.setArg(a++, h);
     temporal_.setArg(a++, static_cast<cl_uint>(has_history_ ? 1 : 0));
     temporal_.setArg(a++, kernel_settings_);
+    temporal_.setArg(a++, to_svgf_view(g.camera, height_));
     times_["svgf_temporal"] = run(temporal_, 1, pixel_groups_);
 
     a = 0;

@@ -38,6 +38,9 @@ const std::vector<SvgfSettingInfo>& svgf_settings_table() {
       integer("history_fallback", &S::history_fallback, 0, 1,
               "1: where no bilinear tap keeps history, the 3x3 neighbourhood's same-surface pixels "
               "(SVGF's reference implementation); 0: the history restarts there"),
+      integer("depth_slope_from_normal", &S::depth_slope_from_normal, 0, 1,
+              "1: the depth weight's slope from the pixel's plane (normal and camera); 0: from the "
+              "neighbours' depths"),
       integer("iterations", &S::iterations, 1, 12, "A-trous iterations (steps 1, 2, 4, ...)"),
       integer("atrous_radius", &S::atrous_radius, 1, 2,
               "A-trous kernel radius after the history iteration: 2 the paper's 5x5 B3 spline, 1 a "
@@ -90,7 +93,17 @@ shared::pg_svgf_settings to_kernel_settings(const SvgfSettings& c) {
   p.reproject_normal = c.reproject_normal;
   p.albedo_floor = c.albedo_floor;
   p.history_fallback = static_cast<std::uint32_t>(c.history_fallback);
+  p.depth_slope_from_normal = static_cast<std::uint32_t>(c.depth_slope_from_normal);
   return p;
+}
+
+shared::pg_svgf_view to_svgf_view(const CameraFrame& camera, int height) {
+  return shared::pg_svgf_view{
+      camera.position.x, camera.position.y,
+      camera.position.z, camera.right.x,
+      camera.right.y,    camera.right.z,
+      camera.up.x,       camera.up.y,
+      camera.up.z,       2.0f * camera.tan_half_fov_y / static_cast<float>(height)};
 }
 
 }  // namespace rtpg

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rtpg/setting_info.h"
+#include "scene/camera.h"
 #include "shared/svgf.h"
 
 namespace rtpg {
@@ -28,6 +29,10 @@ struct SvgfSettings {
   // reference implementation; docs/denoising.md, "History from the neighbourhood"); 0: the
   // history restarts there.
   int history_fallback = 1;
+  // 1: the depth weight's slope is that of the plane through the pixel with its normal
+  // (pg_svgf_plane_slope); 0: from the neighbours' depths, which the camera's per-pixel jitter
+  // puts 0 to 2 pixels apart (docs/denoising.md, "Where we deviate").
+  int depth_slope_from_normal = 0;
   int iterations = 5;  // a-trous iterations (steps 1, 2, 4, ...)
   // The a-trous kernel's radius: 2, the paper's 5x5 B3 spline; 1, a 3x3 kernel (1/4, 1/2, 1/4)
   // at 44% of the 5x5's cost per iteration (docs/denoising.md, "A 3x3 a-trous kernel"), in the
@@ -57,5 +62,7 @@ const std::vector<SvgfSettingInfo>& svgf_settings_table();
 void validate(const SvgfSettings& settings);
 
 shared::pg_svgf_settings to_kernel_settings(const SvgfSettings& settings);
+// The camera of an image `height` pixels high as pg_svgf_plane_slope takes it.
+shared::pg_svgf_view to_svgf_view(const CameraFrame& camera, int height);
 
 }  // namespace rtpg

@@ -32,18 +32,29 @@ PG_NAMESPACE_BEGIN
 /* Every tunable of the SVGF kernels, passed by value (plain 4-byte fields). The host builds it
  * from rtpg::SvgfSettings (host/denoise/svgf_settings.h), which documents each. */
 typedef struct pg_svgf_settings {
-  float alpha_colour;       /* temporal blend weight of the new illumination (paper: 0.2) */
-  float alpha_moments;      /* ... of the new luminance moments (paper: 0.2) */
-  float max_history;        /* history length cap, frames */
-  float min_history;        /* below this many frames variance is estimated spatially (4) */
-  float phi_depth;          /* sigma_z of the depth edge-stopping function (paper: 1) */
-  uint phi_normal;          /* sigma_n, the normal weight's exponent (paper: 128) */
-  float phi_luminance;      /* sigma_l, scales the luminance weight by the std. dev. (4) */
-  float reproject_position; /* history test (shared/same_surface.h): relative distance */
-  float reproject_normal;   /* ... and normal cosine */
-  float albedo_floor;       /* demodulation divides by max(albedo, albedo_floor) */
-  uint history_fallback;    /* 1: the 3x3 neighbourhood where no bilinear tap keeps history */
+  float alpha_colour;           /* temporal blend weight of the new illumination (paper: 0.2) */
+  float alpha_moments;          /* ... of the new luminance moments (paper: 0.2) */
+  float max_history;            /* history length cap, frames */
+  float min_history;            /* below this many frames variance is estimated spatially (4) */
+  float phi_depth;              /* sigma_z of the depth edge-stopping function (paper: 1) */
+  uint phi_normal;              /* sigma_n, the normal weight's exponent (paper: 128) */
+  float phi_luminance;          /* sigma_l, scales the luminance weight by the std. dev. (4) */
+  float reproject_position;     /* history test (shared/same_surface.h): relative distance */
+  float reproject_normal;       /* ... and normal cosine */
+  float albedo_floor;           /* demodulation divides by max(albedo, albedo_floor) */
+  uint history_fallback;        /* 1: the 3x3 neighbourhood where no bilinear tap keeps history */
+  uint depth_slope_from_normal; /* 1: pg_svgf_plane_slope; 0: the neighbours' depths */
 } pg_svgf_settings;
+
+/* The camera as the depth slope of pg_svgf_plane_slope needs it: its position, its right and up
+ * axes (unit), and pixel_size = 2 tan(fov_y / 2) / height, how far the view ray at unit depth
+ * moves from one pixel to the next, along either axis. */
+typedef struct pg_svgf_view {
+  float position_x, position_y, position_z;
+  float right_x, right_y, right_z;
+  float up_x, up_y, up_z;
+  float pixel_size;
+} pg_svgf_view;
 
 /* Below this a depth slope counts as flat: keeps phi_z above 0 for surfaces facing the camera,
  * relative to the depth so that no absolute length enters. */
@@ -94,6 +105,22 @@ PG_FN float pg_svgf_one_axis_slope(float z, float z_before, float z_after) {
   float b = z_after > 0.0f ? fabs(z_after - z) : PG_FLOAT_MAX;
   float s = fmin(a, b);
   return s < PG_FLOAT_MAX ? s : 0.0f;
+}
+
+/* max(|dz/dx|, |dz/dy|) of the plane through a pixel's surface point p (camera depth z > 0) with
+ * its normal n: along the view ray D = (p - camera) / z (unit depth), a pixel's step moves D by
+ * pixel_size along right or up, and the plane's depth z = const / (n . D) changes by
+ * z pixel_size |n . axis| / |n . D|. Independent of the neighbours' depths, which under the
+ * camera's per-pixel jitter lie 0 to 2 pixels apart and make the differences below
+ * underestimate the slope (docs/denoising.md, "Where we deviate"). |n . D| is bounded below by
+ * 1e-3 (a surface seen edge-on: a large slope, so the depth term stops little there and the
+ * normal term decides). */
+PG_FN float pg_svgf_plane_slope(float3 n, float3 p, float z, pg_svgf_view v) {
+  float3 d = (p - pg_make_float3(v.position_x, v.position_y, v.position_z)) / z;
+  float nd = fmax(fabs(dot(n, d)), 1e-3f);
+  float nr = fabs(dot(n, pg_make_float3(v.right_x, v.right_y, v.right_z)));
+  float nu = fabs(dot(n, pg_make_float3(v.up_x, v.up_y, v.up_z)));
+  return z * v.pixel_size * fmax(nr, nu) / nd;
 }
 
 /* max(|dz/dx|, |dz/dy|) at a pixel with depth z from its four neighbours' depths (0 outside the

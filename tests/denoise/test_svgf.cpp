@@ -123,6 +123,7 @@ struct Case {
   int width, height, local_x, local_y, lanes;
   int atrous_radius = 2, history_atrous_radius = 2;
   int phi_normal = 128;  // a build option of the kernels (kernels/shared/svgf.h)
+  int depth_slope_from_normal = 0;
 };
 
 // Every stage of three frames of a panning camera, device against host, for each case: the
@@ -137,9 +138,11 @@ void expect_equal_to_the_host_reference(ClRuntime& rt, const std::vector<Case>& 
                  std::to_string(c.local_x) + "x" + std::to_string(c.local_y) + ", lanes " +
                  std::to_string(c.lanes) + ", a-trous radius " + std::to_string(c.atrous_radius) +
                  " (" + std::to_string(c.history_atrous_radius) +
-                 " up to the history), phi_normal " + std::to_string(c.phi_normal));
+                 " up to the history), phi_normal " + std::to_string(c.phi_normal) +
+                 ", depth slope from the normal " + std::to_string(c.depth_slope_from_normal));
     SvgfSettings s;
     s.phi_normal = c.phi_normal;
+    s.depth_slope_from_normal = c.depth_slope_from_normal;
     s.atrous_radius = c.atrous_radius;
     s.history_atrous_radius = c.history_atrous_radius;
     s.local_x = c.local_x;
@@ -231,6 +234,67 @@ TEST(SvgfKernels, EqualTheHostReferenceAtOtherNormalExponents) {
       for (int lanes : {1, 16}) cases.push_back({37, 23, 4, 4, lanes, 2, 2, phi});
   }
   expect_equal_to_the_host_reference(rt, cases);
+}
+
+// pg_svgf_plane_slope is the screen-space depth slope of the plane through the pixel: for
+// planes at several tilts seen through pixel centres, it equals max(|dz/dx|, |dz/dy|), in depth
+// per pixel, of the plane's exact depth (in double, by central differences a thousandth of a
+// pixel wide) to 1e-3 relative.
+TEST(SvgfPlaneSlope, IsTheDepthSlopeOfThePlaneThroughThePixel) {
+  const int width = 160, height = 90;
+  CameraView view;
+  view.position = glm::vec3(0.3f, 1.2f, 4.0f);
+  view.look_at = glm::vec3(0.0f, 0.5f, 0.0f);
+  const CameraFrame camera = make_camera_frame(view, static_cast<float>(width) / height);
+  const shared::pg_svgf_view v = to_svgf_view(camera, height);
+  int checked = 0;
+  for (const glm::vec3& normal_unnormalised : {glm::vec3(0, 1, 0), glm::vec3(0.2f, 1, 0.5f),
+                                               glm::vec3(1, 0.1f, 0.3f), glm::vec3(0, 0, 1)}) {
+    const glm::dvec3 n = glm::normalize(glm::dvec3(normal_unnormalised));
+    const glm::dvec3 on_plane(0.0, 0.2, 0.0), eye(camera.position), forward(camera.forward);
+    // The camera depth where the ray through film point (px, py) pixels meets the plane.
+    const auto depth_at = [&](double px, double py) {
+      const double tan_y = camera.tan_half_fov_y, aspect = camera.aspect;
+      const glm::dvec3 d = forward +
+                           (2.0 * px / width - 1.0) * tan_y * aspect * glm::dvec3(camera.right) +
+                           (1.0 - 2.0 * py / height) * tan_y * glm::dvec3(camera.up);
+      const double t = glm::dot(n, on_plane - eye) / glm::dot(n, d);  // d has unit depth
+      return t;
+    };
+    for (int y = 10; y < height - 10; y += 7)
+      for (int x = 10; x < width - 10; x += 9) {
+        const double cx = x + 0.5, cy = y + 0.5, h = 1e-3;
+        const double z = depth_at(cx, cy);
+        if (!(z > 0.0)) continue;
+        const double slope = std::max(std::fabs(depth_at(cx + h, cy) - depth_at(cx - h, cy)),
+                                      std::fabs(depth_at(cx, cy + h) - depth_at(cx, cy - h))) /
+                             (2.0 * h);
+        const glm::dvec3 d =
+            forward +
+            (2.0 * cx / width - 1.0) * camera.tan_half_fov_y * camera.aspect *
+                glm::dvec3(camera.right) +
+            (1.0 - 2.0 * cy / height) * camera.tan_half_fov_y * glm::dvec3(camera.up);
+        // Seen nearly edge-on the slope is bounded through |n . D| >= 1e-3: left out here.
+        if (std::fabs(glm::dot(n, d)) < 0.05) continue;
+        const glm::vec3 p(eye + d * z);
+        const float plane = shared::pg_svgf_plane_slope(
+            shared::float3(static_cast<float>(n.x), static_cast<float>(n.y),
+                           static_cast<float>(n.z)),
+            shared::float3(p.x, p.y, p.z), static_cast<float>(z), v);
+        EXPECT_NEAR(plane, slope, 1e-3 * slope + 1e-7)
+            << "normal " << n.x << "," << n.y << "," << n.z << " pixel " << x << "," << y;
+        ++checked;
+      }
+  }
+  EXPECT_GT(checked, 200);
+}
+
+// The depth weight's slope from the pixel's plane (depth_slope_from_normal): every stage still
+// equals the host reference, one pixel per work-item and in lanes.
+TEST(SvgfKernels, EqualTheHostReferenceWithThePlaneSlope) {
+  ClRuntime rt;
+  expect_equal_to_the_host_reference(
+      rt, {{37, 23, 4, 4, 1, 2, 2, 128, 1}, {40, 9, 7, 3, 16, 2, 2, 128, 1}});
 }
 
 // A frame whose illumination is the same everywhere comes out as it went in, texture included:
