@@ -146,8 +146,10 @@ decltype(auto) with_flag_names(F&& f) {
   try {
     return f();
   } catch (const RenderSettingError& e) {
-    static const std::map<std::string, std::string> flags = {
-        {"resolution", "--res"}, {"spp", "--spp"}, {"camera_path", "--camera-path"}};
+    static const std::map<std::string, std::string> flags = {{"resolution", "--res"},
+                                                             {"spp", "--spp"},
+                                                             {"camera_path", "--camera-path"},
+                                                             {"max_bounces", "--max-bounces"}};
     const auto it = flags.find(e.setting());
     throw InputError(it != flags.end() ? it->second : e.setting(), e.problem());
   }
@@ -233,9 +235,18 @@ SharedRandoms parse_shared_randoms(const std::string& name) {
       "unknown value '" + name + "' (none, first-bounce, primary-vertex or second-vertex)");
 }
 
+// --max-bounces: 0 (the scene's default) to kMaxPathBounces, as a scene's integrator.max_bounces.
+void check_max_bounces(int flag) {
+  if (flag < 0) throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
+  if (flag > kMaxPathBounces)
+    throw InputError("--max-bounces", fmt::format("must be at most {} (a scene's integrator "
+                                                  "max_bounces too), got {}",
+                                                  kMaxPathBounces, flag));
+}
+
 // The flag wins, then the scene's integrator setting, then the renderer's default.
 int bounces_for(const Scene& scene, int flag) {
-  if (flag < 0) throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
+  check_max_bounces(flag);
   if (flag > 0) return flag;
   return scene.max_bounces > 0 ? scene.max_bounces : PathTracerSettings{}.max_bounces;
 }
@@ -270,8 +281,7 @@ int run_render(const RenderCommand& command) {
     if (f < 0 || f >= command.frames)
       throw InputError("--save-frames", fmt::format("frame {} is outside 0..{} (--frames {})", f,
                                                     command.frames - 1, command.frames));
-  if (command.max_bounces < 0)
-    throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
+  check_max_bounces(command.max_bounces);
   {
     std::vector<NamedFile> outputs = {{"--output", command.output},
                                       {"--noisy-output", command.noisy_output},
@@ -529,8 +539,7 @@ int run_reference(const ReferenceCommand& command) {
   check_distinct_files({{"--output", command.output}, {"--stats-json", command.stats_json}},
                        {{"the scene", command.common.scene}});
   if (command.spp <= 0) throw InputError("--spp", "must be at least 1");
-  if (command.max_bounces < 0)
-    throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
+  check_max_bounces(command.max_bounces);
   const Scene scene = load(command.common);
   RenderSettings settings;
   settings.width = command.width;

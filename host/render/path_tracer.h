@@ -324,6 +324,7 @@ class PathTracer {
   std::size_t world_stride_ = 1;             // records per path: max(1, world_depths_)
   LargeVector<std::uint8_t> world_depth_;    // per path: vertices recorded (or kNotRecording)
   static constexpr std::uint8_t kNotRecording = 0xff;
+  static_assert(kMaxPathBounces < kNotRecording, "a path's recorded depth fits below the mark");
   // Blocks of kWorldBlock paths of each pass, in order; world_blocks_used_ of them hold this
   // frame's samples (the vectors keep their memory).
   std::vector<std::vector<WorldTrainingSample>> world_blocks_;

@@ -32,6 +32,10 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
   if (!size_problem.empty()) throw RenderSettingError("resolution", size_problem);
   const std::uint64_t pixels = static_cast<std::uint64_t>(settings.width) * settings.height;
   if (settings.spp <= 0) throw RenderSettingError("spp", "must be at least 1");
+  if (settings.path_tracer.max_bounces < 0 || settings.path_tracer.max_bounces > kMaxPathBounces)
+    throw RenderSettingError("max_bounces", "must lie in [0, " + std::to_string(kMaxPathBounces) +
+                                                "], got " +
+                                                std::to_string(settings.path_tracer.max_bounces));
   if (!settings.camera_path.empty() && !scene.camera.paths.count(settings.camera_path))
     throw RenderSettingError("camera_path",
                              "scene has no camera path named '" + settings.camera_path + "'");

@@ -46,6 +46,11 @@ struct Material {
   }
 };
 
+// The most path vertices after the primary hit a render takes (a scene's integrator.max_bounces,
+// --max-bounces): paths record their depth in a byte (the world guide's), and Russian roulette
+// ends real paths long before.
+constexpr int kMaxPathBounces = 64;
+
 // One triangle mesh in world space (instances and transforms are flattened at load time).
 struct Mesh {
   std::string name;

@@ -175,7 +175,8 @@ class SceneBuilder {
     if (node.has("max_bounces")) {
       const JsonNode value = node.child("max_bounces");
       const int bounces = value.integer();
-      if (bounces < 1 || bounces > 64) value.fail("expected an integer in [1, 64]");
+      if (bounces < 1 || bounces > kMaxPathBounces)
+        value.fail("expected an integer in [1, " + std::to_string(kMaxPathBounces) + "]");
       scene_.max_bounces = bounces;
     }
   }

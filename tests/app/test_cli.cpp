@@ -279,8 +279,10 @@ TEST_F(Cli, RejectsSavedFramesWithoutOutput) {
                   "--save-frames", {"out-f0001.exr"});
 }
 
-TEST_F(Cli, RejectsNegativeMaxBounces) {
+TEST_F(Cli, RejectsMaxBouncesOutOfRange) {
   expect_rejected(render("--res 16x16 --max-bounces -1"), "--max-bounces");
+  // At most 64, as a scene's integrator.max_bounces: a path's depth is recorded in a byte.
+  expect_rejected(render("--res 16x16 --max-bounces 65"), "--max-bounces");
 }
 
 TEST_F(Cli, RejectsUnknownGuidingMode) {

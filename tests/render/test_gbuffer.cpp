@@ -62,3 +62,39 @@ TEST(GBuffer, EachPixelsFlagsAreThoseOfTheMaterialItSees) {
 
 }  // namespace
 }  // namespace rtpg
+
+namespace rtpg {
+namespace {
+
+// The renderer refuses the settings it cannot work with, naming them (the command line then names
+// its flag): a size out of rtpg/image_size.h's range, no sample, more bounces than a path's depth
+// byte records (kMaxPathBounces, 64: the world guide's per-path record; a deeper path wrapped
+// around to depth 0 and the mark of a path not recording).
+TEST(RendererSettings, RefusedWithTheSettingNamed) {
+  const Scene scene = load_scene(std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json");
+  const auto refused = [&](RenderSettings s, const std::string& setting) {
+    try {
+      Renderer renderer(scene, s);
+      ADD_FAILURE() << setting << " accepted";
+    } catch (const RenderSettingError& e) {
+      EXPECT_EQ(e.setting(), setting) << e.what();
+    }
+  };
+  RenderSettings s;
+  s.width = 8;
+  s.height = 8;
+  RenderSettings wide = s;
+  wide.width = 70000;
+  refused(wide, "resolution");
+  RenderSettings none = s;
+  none.spp = 0;
+  refused(none, "spp");
+  RenderSettings deep = s;
+  deep.path_tracer.max_bounces = kMaxPathBounces + 1;
+  refused(deep, "max_bounces");
+  deep.path_tracer.max_bounces = kMaxPathBounces;
+  EXPECT_NO_THROW(Renderer(scene, deep));
+}
+
+}  // namespace
+}  // namespace rtpg
