@@ -235,13 +235,10 @@ SharedRandoms parse_shared_randoms(const std::string& name) {
       "unknown value '" + name + "' (none, first-bounce, primary-vertex or second-vertex)");
 }
 
-// --max-bounces: 0 (the scene's default) to kMaxPathBounces, as a scene's integrator.max_bounces.
+// --max-bounces: not negative (0 = the scene's default); its upper bound, kMaxPathBounces, is the
+// renderer's to check (with_flag_names names the flag).
 void check_max_bounces(int flag) {
   if (flag < 0) throw InputError("--max-bounces", "must not be negative (0 = the scene's default)");
-  if (flag > kMaxPathBounces)
-    throw InputError("--max-bounces", fmt::format("must be at most {} (a scene's integrator "
-                                                  "max_bounces too), got {}",
-                                                  kMaxPathBounces, flag));
 }
 
 // The flag wins, then the scene's integrator setting, then the renderer's default.

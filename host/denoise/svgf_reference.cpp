@@ -92,6 +92,7 @@ const std::vector<glm::vec3>& SvgfReference::denoise(const std::vector<glm::vec3
 
 void SvgfReference::temporal(const std::vector<glm::vec3>& colour, const GBuffer& g) {
   const sh::pg_svgf_settings& s = kernel_settings_;
+  const sh::pg_svgf_view view = to_svgf_view(g.camera, height_);
   for (int y = 0; y < height_; ++y)
     for (int x = 0; x < width_; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * width_ + x;
@@ -109,11 +110,10 @@ void SvgfReference::temporal(const std::vector<glm::vec3>& colour, const GBuffer
       const float z_right = x + 1 < width_ ? g.position_depth[i + 1].w : 0.0f;
       const float z_down = y > 0 ? g.position_depth[i - width_].w : 0.0f;
       const float z_up = y + 1 < height_ ? g.position_depth[i + width_].w : 0.0f;
-      depth_slope_[i] =
-          s.depth_slope_from_normal
-              ? sh::pg_svgf_plane_slope(sh::float3(n.x, n.y, n.z), sh::float3(pd.x, pd.y, pd.z),
-                                        pd.w, to_svgf_view(g.camera, height_))
-              : sh::pg_svgf_depth_slope(pd.w, z_left, z_right, z_down, z_up);
+      depth_slope_[i] = s.depth_slope_from_normal
+                            ? sh::pg_svgf_plane_slope(sh::float3(n.x, n.y, n.z),
+                                                      sh::float3(pd.x, pd.y, pd.z), pd.w, view)
+                            : sh::pg_svgf_depth_slope(pd.w, z_left, z_right, z_down, z_up);
 
       const glm::vec3 albedo = sh::pg_svgf_albedo(g.base_color_roughness[i], s.albedo_floor);
       const glm::vec3 illumination = sh::pg_svgf_demodulate(colour[i], xyz(g.emission[i]), albedo);

@@ -13,6 +13,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "rtpg/errors.h"
+#include "rtpg/image_size.h"
 
 namespace rtpg {
 
@@ -36,13 +37,9 @@ Texture read_opened(OIIO::ImageInput& in, const std::string& name, ImageDecode d
     throw InputError(name, "image has no pixels");
   if (spec.depth > 1) throw InputError(name, "volume images are not supported");
   // Checked on the header, before the pixels are allocated: a header may claim any size.
-  if (spec.width > kMaxTextureSide || spec.height > kMaxTextureSide ||
-      static_cast<std::uint64_t>(spec.width) * static_cast<std::uint64_t>(spec.height) >
-          kMaxTextureTexels)
-    throw InputError(name, "image of " + std::to_string(spec.width) + "x" +
-                               std::to_string(spec.height) + " pixels is too large (at most " +
-                               std::to_string(kMaxTextureSide) + " a side and " +
-                               std::to_string(kMaxTextureTexels) + " in all)");
+  const std::string size_problem =
+      image_size_problem(spec.width, spec.height, kMaxTextureSide, kMaxTextureTexels);
+  if (!size_problem.empty()) throw InputError(name, "image size " + size_problem);
 
   const int nch = std::min(spec.nchannels, 4);
   const bool eight_bit = spec.format == OIIO::TypeDesc::UINT8;

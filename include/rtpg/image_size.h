@@ -17,13 +17,15 @@ constexpr int kMaxImageSide = 1 << 16;
 
 // Why a width x height image is refused ("must be positive, got 0x8", ...), or "" where it is
 // accepted.
-inline std::string image_size_problem(int width, int height) {
+// The scene's textures take their own limits (host/scene/image_loader.cpp).
+inline std::string image_size_problem(int width, int height, int max_side = kMaxImageSide,
+                                      std::uint64_t max_pixels = kMaxImagePixels) {
   const std::string size = std::to_string(width) + "x" + std::to_string(height);
   if (width <= 0 || height <= 0) return "must be positive, got " + size;
-  if (width > kMaxImageSide || height > kMaxImageSide)
-    return size + " is too large (at most " + std::to_string(kMaxImageSide) + " pixels a side)";
-  if (static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) > kMaxImagePixels)
-    return size + " is too large (at most " + std::to_string(kMaxImagePixels) + " pixels)";
+  if (width > max_side || height > max_side)
+    return size + " is too large (at most " + std::to_string(max_side) + " pixels a side)";
+  if (static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) > max_pixels)
+    return size + " is too large (at most " + std::to_string(max_pixels) + " pixels)";
   return "";
 }
 
