@@ -62,6 +62,8 @@ def kind(path):
         return "time"
     if any(w in p for w in ERROR_WORDS):
         return "error"
+    if p.startswith("/convergence/") and "/static/" in p:
+        return "error"  # the static camera's per-frame relMSE, listed without the word
     return "other"
 
 

@@ -37,13 +37,14 @@ LABEL = {"off": "PT", "pmm": "PG"}
 # T: training frames of the equal-frame comparison; sweep: other T (all from one static run of
 # max(sweep) frames per method, saved with --save-frames). path_*: convergence along the scene's
 # camera path, per-frame references of path_ref_spp. trade_res: trade-offs, against the main
-# reference box-filtered down (metrics.downsample_box).
+# reference box-filtered down (metrics.downsample_box). repeats: even, so that each method takes
+# each place in the equal-time pairs as often (suite/equal_time.py, method_order; 3 before 2026-12-08).
 MODES = {
     "quick": dict(res="48x32", ref_spp=64, T=8, sweep=[2, 8], time_frames=6, repeats=2, flicker_frames=4,
                   path_res="24x16", path_frames=[1, 4], path_ref_spp=64, trade_res="24x16", trade_frames=8,
                   svgf_large_res="96x64",
                   scenes=["cornell-box", "cornell-indirect"], tradeoff_scenes=["cornell-indirect"]),
-    "full": dict(res="960x540", ref_spp=1024, T=32, sweep=[1, 4, 8, 16, 32, 64], time_frames=32, repeats=3,
+    "full": dict(res="960x540", ref_spp=1024, T=32, sweep=[1, 4, 8, 16, 32, 64], time_frames=32, repeats=4,
                  flicker_frames=24, path_res="480x270", path_frames=[7, 15, 31, 59], path_ref_spp=256,
                  trade_res="480x270", trade_frames=32, svgf_large_res="1920x1080",
                  scenes=["cornell-box", "cornell-indirect", "cornell-glossy", "veach-ajar", "sponza"],
@@ -72,8 +73,11 @@ def final_frame_metrics(stats, img, ref, T, exposure):
     """What equal-frame and denoised report of one method's run: the relMSE and LDR-FLIP (at the
     scene's exposure) of frame T, the mean relMSE of frames T-7..T with its standard error, and
     median times per stage."""
-    mean, sem = runner.mean_sem(f["relmse"] for f in stats["frames"][T - LAST:T])
+    frames = [f["relmse"] for f in stats["frames"][T - LAST:T]]
+    mean, sem = runner.mean_sem(frames)
+    # The frames themselves too: the report's verdict pairs them with the other method's (same seed).
     return {"relmse": metrics.relmse(img, ref), "relmse_last8": mean, "relmse_last8_sem": sem,
+            "relmse_frames": frames,
             "flip_ldr": metrics.flip_ldr(img, ref, exposure),
             "time_ms": {k: runner.median_frame_ms(stats, k) for k in stats["frames"][-1]["time_ms"]}}
 
@@ -476,7 +480,9 @@ def main():
     results["references"] = sorted(ctx.refs.timings.values(), key=lambda r: (r["scene"], r["res"], r["spp"]))
     results["finished"] = time.strftime("%Y-%m-%d %H:%M:%S")
     (ctx.out / "results.json").write_text(json.dumps(results, indent=2))
-    report_dir = Path(args.report) if args.report else (ctx.out / "report" if args.quick else runner.ROOT / "docs" / "results")
+    # Beside the results, never over docs/results/README.md, which is the project's log of runs
+    # (a run's report is copied into it by hand, with what it measured and why).
+    report_dir = Path(args.report) if args.report else ctx.out / "report"
     report.write(results, report_dir)
     print(f"report: {report_dir / 'README.md'}")
 

@@ -33,6 +33,7 @@ relMSE (a row per scene and method), with the standard error over seeds; writes
 --out/split.json.
 """
 import argparse
+import hashlib
 import json
 import statistics
 import sys
@@ -86,12 +87,16 @@ def main():
 
     out = Path(args.out)
     refs = runner.ReferenceCache(out / "references")
+    binary = runner.binary_fingerprint()
 
     def figure(scene, method, run, seed):
         guiding, extra, tag_prefix = methods[method]
         many, shared = RUNS[run]
         spp = args.spp if many else 1
-        tag = f"{tag_prefix}-{run}-{spp}spp-{seed}"
+        # The cached run's key holds what else decides its figures: the binary, the variant's
+        # arguments, the size, the frames and the reference they are errors against.
+        key = json.dumps([binary, guiding, extra, args.res, args.frames, args.ref_spp])
+        tag = f"{tag_prefix}-{run}-{spp}spp-{seed}-{hashlib.sha256(key.encode()).hexdigest()[:10]}"
         cached = out / scene / f"{tag}.json"
         if cached.exists():
             stats = json.loads(cached.read_text())

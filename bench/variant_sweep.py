@@ -107,8 +107,9 @@ def main():
     binary = runner.binary_fingerprint()
 
     def run_key(extra, frames):
-        """The cache key of a run: what else decides it besides scene, variant name and seed."""
-        key = json.dumps([binary, [str(a) for a in extra], args.res, frames])
+        """The cache key of a run: what else decides it besides scene, variant name and seed (the
+        reference too: the cached figures are errors against it)."""
+        key = json.dumps([binary, [str(a) for a in extra], args.res, frames, args.ref_spp, args.ref_seed])
         return hashlib.sha256(key.encode()).hexdigest()[:10]
 
     def path_relmse(scene, tag, seed, guiding, extra):

@@ -10,13 +10,16 @@ are made so), and the order within a round matters too: the same binary run twic
 Sponza took 1-4% less the second time in three rounds of four, and 1% more on the Cornell box
 (docs/host-path-tracer.md, "The order within a round"). So the rounds alternate the order
 (`--order alternate`, the default: the runs as given, then reversed, and so on), which cancels a
-drift within a round over every two rounds; `--order fixed` keeps the order given.
+drift within a round over every two rounds; `--order fixed` keeps the order given. With alternate
+orders the rounds must be even, and each summary is the median over pairs of rounds of the pair's
+mean: a median over an odd number of rounds, or over single rounds, takes its value from one order
+(with three rounds, the order two of them share).
 
 A --run is "NAME: [VAR=VALUE ...] BINARY [ARGUMENT ...]": environment assignments, the rtpg binary,
 and arguments added to `render SCENE --res RES --frames FRAMES`.
 
 Usage:
-  ab_frames.py --scene scenes/sponza.json [--res 960x540] [--frames 8] [--skip 2] [--rounds 3]
+  ab_frames.py --scene scenes/sponza.json [--res 960x540] [--frames 8] [--skip 2] [--rounds 4]
                [--order alternate|fixed] --run "before: /tmp/rtpg-old --guiding off" --run "after: build/rtpg --guiding off"
 """
 import argparse
@@ -56,13 +59,21 @@ def stage_medians(stats_path, skip):
     return medians
 
 
+def summary(values, alternate):
+    """The median over pairs of rounds of each pair's mean (alternate orders: each pair holds both
+    orders once), else the median over the rounds."""
+    if alternate and len(values) >= 2:
+        values = [0.5 * (values[k] + values[k + 1]) for k in range(0, len(values) - 1, 2)]
+    return statistics.median(values)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", required=True)
     parser.add_argument("--res", default="960x540")
     parser.add_argument("--frames", type=int, default=8)
     parser.add_argument("--skip", type=int, default=2, help="frames left out at the start")
-    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--rounds", type=int, default=4, help="even with --order alternate")
     parser.add_argument("--order", choices=["alternate", "fixed"], default="alternate",
                         help="the runs' order within a round: as given, then reversed, and so on "
                              "(alternate), or always as given (fixed)")
@@ -70,6 +81,8 @@ def main():
     args = parser.parse_args()
     if args.frames < 1 or args.rounds < 1 or args.skip < 0:
         sys.exit("ab_frames: --frames and --rounds must be at least 1, --skip at least 0")
+    if args.order == "alternate" and args.rounds % 2 != 0:
+        sys.exit("ab_frames: --rounds must be even with --order alternate (each order as often)")
     runs = [parse_run(r) for r in args.run]
     if len({name for name, _, _, _ in runs}) != len(runs):
         sys.exit("ab_frames: two runs share a name")
@@ -94,6 +107,8 @@ def main():
                       ", ".join(f"{s} {v:.2f}" for s, v in medians.items()), flush=True)
 
     stages = [s for s in STAGES if any(s in m for ms in results.values() for m in ms)]
+    alternate = args.order == "alternate"
+    label = "median of pair means" if alternate else "median"
     order = "each round's order the reverse of the one before" if args.order == "alternate" \
         else "the same order every round"
     print(f"\n{args.scene} at {args.res}, {args.frames} frames, medians of frames "
@@ -105,14 +120,14 @@ def main():
         for ms in results.values():
             values = [m.get(s, 0.0) for m in ms]
             cells.append(", ".join(f"{v:.2f}" for v in values) +
-                         (f" (median {statistics.median(values):.2f})" if len(values) > 1 else ""))
+                         (f" ({label} {summary(values, alternate):.2f})" if len(values) > 1 else ""))
         print(f"| {s} | " + " | ".join(cells) + " |")
 
     names = list(results)
     if len(names) < 2:
         return
     first = names[0]
-    print(f"\nEach run's time over {first}'s in the same round, and their median:\n")
+    print(f"\nEach run's time over {first}'s in the same round, and their {label}:\n")
     print("| stage | " + " | ".join(f"{n} / {first}" for n in names[1:]) + " |")
     print("|---" * len(names) + "|")
     for s in stages:
@@ -121,7 +136,7 @@ def main():
             ratios = [m.get(s, 0.0) / f[s] for m, f in zip(results[n], results[first])
                       if f.get(s, 0.0) > 0.0]
             cells.append(", ".join(f"{v:.3f}" for v in ratios) +
-                         (f" (median {statistics.median(ratios):.3f})" if len(ratios) > 1 else "")
+                         (f" ({label} {summary(ratios, alternate):.3f})" if len(ratios) > 1 else "")
                          if ratios else "-")
         print(f"| {s} | " + " | ".join(cells) + " |")
 

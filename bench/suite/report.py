@@ -29,8 +29,36 @@ def _ms(value):
     return f"{value:.0f} ms" if value >= 100 else f"{value:.3g} ms"
 
 
+# Two-sided 1% quantiles of Student's t by degrees of freedom (1-30; the normal's beyond).
+_T_995 = [63.657, 9.925, 5.841, 4.604, 4.032, 3.707, 3.499, 3.355, 3.250, 3.169, 3.106, 3.055, 3.012, 2.977,
+          2.947, 2.921, 2.898, 2.878, 2.861, 2.845, 2.831, 2.819, 2.807, 2.797, 2.787, 2.779, 2.771, 2.763,
+          2.756, 2.750]
+
+
+def paired_verdict(pt_frames, pg_frames):
+    """Better / worse from the frames' paired differences pg - pt: both methods render with one seed,
+    so their frames share the camera jitter and most random streams and their errors move together
+    (correlation 0.99 on the Cornell box); the two means' own standard errors, combined as if the runs
+    were independent, hid real differences. Significant where |mean| exceeds the two-sided 1% t bound
+    of the differences' standard error. Returns (verdict, mean difference, its standard error)."""
+    d = [g - p for p, g in zip(pt_frames, pg_frames)]
+    n = len(d)
+    if n < 2:
+        return "no significant difference", float("nan"), float("nan")
+    mean = sum(d) / n
+    sem = (sum((x - mean) ** 2 for x in d) / (n - 1) / n) ** 0.5
+    bound = (_T_995[n - 2] if n - 1 <= len(_T_995) else 2.576) * sem
+    if mean < -bound:
+        return "PG better", mean, sem
+    if mean > bound:
+        return "PT better", mean, sem
+    return "no significant difference", mean, sem
+
+
 def verdict(pt_mean, pt_sem, pg_mean, pg_sem):
-    """Better / worse when the difference of the means exceeds 3 combined standard errors."""
+    """Better / worse when the difference of the means exceeds 3 combined standard errors: for results
+    without the per-frame errors (before 2026-12-08), and for the denoised frames, which are neither
+    independent of each other (SVGF carries its history from frame to frame) nor of the other method's."""
     gap = 3.0 * (pt_sem ** 2 + pg_sem ** 2) ** 0.5
     if pg_mean < pt_mean - gap:
         return "PG better"
@@ -39,11 +67,28 @@ def verdict(pt_mean, pt_sem, pg_mean, pg_sem):
     return "no significant difference"
 
 
-def _relmse_cells(pt, pg):
-    """The table cells 'relMSE PT (± s.e.) | relMSE PG (± s.e.) | verdict' of two methods' figures."""
-    return (f"| {pt['relmse_last8']:.4g} ± {pt['relmse_last8_sem']:.2g} "
-            f"| {pg['relmse_last8']:.4g} ± {pg['relmse_last8_sem']:.2g} "
-            f"| {verdict(pt['relmse_last8'], pt['relmse_last8_sem'], pg['relmse_last8'], pg['relmse_last8_sem'])} ")
+def _relmse_cells(pt, pg, pt_frames=None, pg_frames=None):
+    """The table cells 'relMSE PT (± s.e.) | relMSE PG (± s.e.) | verdict' of two methods' figures: the
+    paired verdict where both runs' per-frame errors are given, with PG/PT and its paired standard
+    error, else the unpaired one."""
+    cells = (f"| {pt['relmse_last8']:.4g} ± {pt['relmse_last8_sem']:.2g} "
+             f"| {pg['relmse_last8']:.4g} ± {pg['relmse_last8_sem']:.2g} ")
+    if pt_frames and pg_frames:
+        said, mean, sem = paired_verdict(pt_frames, pg_frames)
+        base = max(pt["relmse_last8"], 1e-30)
+        return cells + f"| {said} (PG/PT {1.0 + mean / base:.3f} ± {sem / base:.3f}, paired) "
+    return cells + f"| {verdict(pt['relmse_last8'], pt['relmse_last8_sem'], pg['relmse_last8'], pg['relmse_last8_sem'])} "
+
+
+def _frames_of(method_figures, convergence, scene, method, T, last=8):
+    """A method's per-frame relMSE of frames T-7..T: recorded with the figures since 2026-12-08, else read
+    from the convergence experiment's static curve, which comes from the same run."""
+    if method_figures.get("relmse_frames"):
+        return method_figures["relmse_frames"]
+    curve = (convergence or {}).get(scene, {}).get("static", {}).get(method)
+    if curve and len(curve) >= T:
+        return curve[T - last:T]
+    return None
 
 
 def _exposures(ex):
@@ -52,7 +97,7 @@ def _exposures(ex):
     return ", ".join(f"{scene} {r.get('exposure', 1.0):g}" for scene, r in ex.items())
 
 
-def _equal_frame(ex, report_dir):
+def _equal_frame(ex, report_dir, convergence=None):
     lines = ["## Equal frame: 1 spp after T frames (paper, figure 3)", "",
              "| scene | PT FLIP | PG FLIP | ratio | relMSE ratio | frame time PT | frame time PG | guiding overhead |",
              "|---|---|---|---|---|---|---|---|"]
@@ -70,12 +115,15 @@ def _equal_frame(ex, report_dir):
               "|---|---|---|---|---|---|---|---|"]
     for scene, r in ex.items():
         pt, pg = r["methods"]["off"], r["methods"]["pmm"]
+        frames = [_frames_of(f, convergence, scene, m, r["T"]) for f, m in ((pt, "off"), (pg, "pmm"))]
         lines.append(f"| {scene} | {pt['flip_hdr']:.3f} | {pg['flip_hdr']:.3f} "
-                     f"{_relmse_cells(pt, pg)}"
+                     f"{_relmse_cells(pt, pg, *frames)}"
                      f"| {pg.get('guided_fraction', float('nan')):.2f} | {pg.get('mean_pi', float('nan')):.2f} |")
-    lines += ["", "Verdict: the difference of the relMSE means against three combined standard errors (the 8 "
-              "frames have independent noise). Guided pixels: share of surface pixels that sampled a trained "
-              "mixture at frame T; mean pi: their mean Gaussian weight.", ""]
+    lines += ["", "Verdict: the two runs share their seed, so their frames' errors move together; the verdict is "
+              "that of the 8 paired differences PG - PT of frames T-7..T against the two-sided 1% t bound, with "
+              "PG/PT and its standard error from them (results without the per-frame errors: the difference of the "
+              "means against three combined standard errors, as if independent). Guided pixels: share of surface "
+              "pixels that sampled a trained mixture at frame T; mean pi: their mean Gaussian weight.", ""]
     lines += _figures(ex, report_dir, "comparison")
     lines += ["Training sweep (relMSE and LDR-FLIP of the frame after T frames; one run per method, frames saved "
               "with `--save-frames`):", "", "| scene | T | relMSE PT | relMSE PG | FLIP PT | FLIP PG |",
@@ -266,7 +314,7 @@ def write(results, report_dir):
     if results.get("skipped_scenes"):
         lines += ["Skipped scenes: " + ", ".join(f"{k} ({v})" for k, v in results["skipped_scenes"].items()), ""]
     if "equal_frame" in ex:
-        lines += _equal_frame(ex["equal_frame"], report_dir)
+        lines += _equal_frame(ex["equal_frame"], report_dir, ex.get("convergence"))
     if "equal_time" in ex:
         lines += _equal_time(ex["equal_time"], report_dir, st)
     if "flicker" in ex:

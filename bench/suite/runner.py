@@ -146,7 +146,10 @@ class ReferenceCache:
         self.timings = {}  # what each reference used in this run cost (_note)
 
     def get(self, scene, res, spp, seed=1000, camera_path="", frame=0, max_bounces=0):
-        key = json.dumps([scene, res, spp, seed, camera_path, frame, max_bounces, self.source_hash])
+        # The scene file's bytes too: a scene edited (its bounces, lights, camera) is another image.
+        # Its assets are the shared ones (../shared/scenes), which do not change.
+        scene_hash = hashlib.sha256(Path(scene_path(scene)).read_bytes()).hexdigest()[:16]
+        key = json.dumps([scene, res, spp, seed, camera_path, frame, max_bounces, self.source_hash, scene_hash])
         digest = hashlib.sha256(key.encode()).hexdigest()[:20]
         path = self.folder / f"{scene}-{res}-{spp}spp-{digest}.exr"
         timing = self.folder / f"{path.stem}.stats.json"

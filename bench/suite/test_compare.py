@@ -57,6 +57,12 @@ class CompareTests(unittest.TestCase):
         self.assertAlmostEqual(s["error"]["max"], 0.2)
         self.assertIn("flip_ldr", s["error"]["worst"])
 
+    def test_convergence_curves_are_errors(self):
+        # The static curves are per-frame relMSE lists without the word in their path.
+        self.assertEqual(compare.kind("/convergence/s/static/off[3]"), "error")
+        self.assertEqual(compare.kind("/convergence/s/path/pmm/relmse[1]"), "error")
+        self.assertEqual(compare.kind("/convergence/s/path/pmm/frames[1]"), "other")
+
     def test_relmse_at_pt_budget_of_pt_is_an_error(self):
         # PT's error at its own budget is its final error, seeded: a 20% change is a failure.
         b = set_leaf(RESULTS, "/equal_time/s/relmse_at_pt_budget/off", 0.012)

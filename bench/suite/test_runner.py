@@ -82,5 +82,37 @@ class ReferenceSourceTests(unittest.TestCase):
                 base = changed
 
 
+
+class ReferenceSceneTests(unittest.TestCase):
+    def test_an_edited_scene_file_gets_a_new_reference(self):
+        """The cache key holds the scene file's bytes: a scene whose bounces or lights changed is
+        rendered again, not served the old image."""
+        with tempfile.TemporaryDirectory() as d:
+            root = Path(d)
+            scene = root / "box.json"
+            scene.write_text('{"integrator": {"max_bounces": 2}}\n')
+            rendered = []
+
+            def fake_run(args, quiet=True):
+                out = Path(args[args.index("-o") + 1])
+                out.write_bytes(b"exr")
+                rendered.append(out)
+                return ""
+
+            saved = (runner.run, runner.scene_path)
+            runner.run, runner.scene_path = fake_run, lambda name: str(root / f"{name}.json")
+            try:
+                cache = runner.ReferenceCache(root / "refs")
+                first = cache.get("box", "8x8", 4)
+                self.assertEqual(cache.get("box", "8x8", 4), first)
+                self.assertEqual(len(rendered), 1)
+                scene.write_text('{"integrator": {"max_bounces": 8}}\n')
+                second = cache.get("box", "8x8", 4)
+                self.assertNotEqual(second, first)
+                self.assertEqual(len(rendered), 2)
+            finally:
+                runner.run, runner.scene_path = saved
+
+
 if __name__ == "__main__":
     unittest.main()

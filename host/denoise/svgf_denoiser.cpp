@@ -207,10 +207,15 @@ const std::vector<glm::vec3>& SvgfDenoiser::denoise(const std::vector<glm::vec3>
       if (on_device != nullptr) {
         const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
         const auto check = [&](const cl::Buffer& b, std::size_t bytes, const char* name) {
-          if (b.getInfo<CL_MEM_SIZE>() < n * bytes)
+          // Exactly the image's size, as the Guider asks: a larger buffer is another image,
+          // whose rows the kernels would read at this one's width.
+          if (b.getInfo<CL_MEM_SIZE>() != n * bytes)
             throw InputError("svgf", std::string("the device G-buffer's ") + name + " holds " +
-                                         std::to_string(b.getInfo<CL_MEM_SIZE>()) +
-                                         " bytes, fewer than " + std::to_string(n * bytes));
+                                         std::to_string(b.getInfo<CL_MEM_SIZE>()) + " bytes, not " +
+                                         std::to_string(n * bytes));
+          if (b.getInfo<CL_MEM_CONTEXT>()() != runtime_.context()())
+            throw InputError("svgf", std::string("the device G-buffer's ") + name +
+                                         " belongs to another OpenCL context");
           return b;
         };
         position_depth_in = check(on_device->position_depth, 16, "position_depth");

@@ -111,6 +111,9 @@ class SvgfDenoiser {
   // (util/huge_pages.h; docs/denoising.md, "The denoiser's images in huge pages"). Declared
   // before the buffers, so that it outlives them.
   std::vector<LargeVector<glm::vec4>> host_images_;
+  // The denoised colour, which output_ reads in place where zero_copy_ (declared before it, so
+  // that it outlives it).
+  std::vector<glm::vec3> output_host_;
   std::array<Surfaces, 2> surfaces_;
   std::array<cl::Buffer, 2> moments_;  // this frame's and last frame's
   int current_ = 0;
@@ -122,8 +125,7 @@ class SvgfDenoiser {
   // The a-trous ping-pong ([0], [1]) and the variance pass's output ([2]).
   std::array<cl::Buffer, 3> illumination_;
   const cl::Buffer* filtered_ = nullptr;  // the last iteration's output
-  std::vector<glm::vec3> output_host_;
-  void* mapped_output_ = nullptr;  // output_ mapped for reading, from denoise() to the next
+  void* mapped_output_ = nullptr;         // output_ mapped for reading, from denoise() to the next
   std::map<std::string, double> times_;
 };
 

@@ -26,6 +26,21 @@ void check_svgf_input(int width, int height, const std::vector<glm::vec3>& colou
   if (colour.size() != n)
     throw InputError("svgf",
                      std::to_string(colour.size()) + " colour pixels for a " + size + " denoiser");
+  // The channels the denoiser reads, each of one element a pixel: a shorter one would be read
+  // past its end where the device reads host memory in place.
+  const auto check = [&](std::size_t elements, const char* channel) {
+    if (elements != n)
+      throw InputError("svgf", std::string("the G-buffer's ") + channel + " channel holds " +
+                                   std::to_string(elements) + " pixels, not the " + size +
+                                   " image's " + std::to_string(n));
+  };
+  check(g.emission.size(), "emission");
+  check(g.position_depth.size(), "position_depth");
+  check(g.shading_normal.size(), "shading_normal");
+  check(g.base_color_roughness.size(), "base_color_roughness");
+  check(g.flags.size(), "flags");
+  check(g.material.size(), "material");
+  check(g.motion.size(), "motion");
 }
 
 SvgfReference::SvgfReference(int width, int height, const SvgfSettings& settings)

@@ -205,6 +205,9 @@ void Guider::check_buffer(const cl::Buffer& b, std::size_t element_size,
                           const std::string& name) const {
   const std::size_t need = element_size * static_cast<std::size_t>(width_) * height_;
   if (b() == nullptr) throw GuiderError(name + ": buffer is not set");
+  // Another context's buffer is undefined in OpenCL (under an ICD loader, another driver's).
+  if (translate_cl_errors([&] { return b.getInfo<CL_MEM_CONTEXT>()(); }) != runtime_.context()())
+    throw GuiderError(name + ": buffer belongs to another OpenCL context");
   const std::size_t have = translate_cl_errors([&] { return b.getInfo<CL_MEM_SIZE>(); });
   // Exactly: a larger buffer is another resolution's, whose rows this guider would misread.
   if (have != need)
@@ -456,13 +459,16 @@ void Guider::wait_for_training() {
 
 void Guider::wait_for_kernels() {
   wait_for_training();
+  // The list is emptied whatever happens: a kernel that failed is reported once, not again by
+  // every later wait.
+  auto pending = std::move(pending_);
+  pending_.clear();
   translate_cl_errors([&] {
-    for (auto& [done, ms] : pending_) {
+    for (auto& [done, ms] : pending) {
       done.wait();
       *ms = ClRuntime::event_ms(done);
     }
   });
-  pending_.clear();
 }
 
 void Guider::read_state(std::vector<float>& state) {

@@ -133,6 +133,11 @@ void validate(const GuidingSettings& s) {
   if (s.n_min > s.n_max)
     fail("n_min (" + setting_number(s.n_min) + ") must not exceed n_max (" +
          setting_number(s.n_max) + ")");
+  const int memory = static_cast<int>(s.train_memory);
+  if (memory != static_cast<int>(GuidingSettings::TrainMemory::Auto) &&
+      memory != static_cast<int>(GuidingSettings::TrainMemory::Local) &&
+      memory != static_cast<int>(GuidingSettings::TrainMemory::Global))
+    fail("train_memory = " + std::to_string(memory) + " is none of Auto, Local and Global");
 }
 
 int rows_per_model_for_height(int height) {
@@ -142,6 +147,9 @@ int rows_per_model_for_height(int height) {
 }
 
 pg_kernel_settings to_kernel_settings(const GuidingSettings& c, int image_height) {
+  // Settings out of range are refused before any arithmetic on them (the window's stride of an
+  // absurd apron overflowed an int).
+  validate(c);
   pg_kernel_settings p{};
   p.pi_min = c.pi_min;
   p.pi_max = c.pi_max;

@@ -196,7 +196,7 @@ glm::vec3 Lights::environment_radiance(const glm::vec3& d) const {
   if (env_map_) {
     const glm::vec2 uv = direction_to_equirect(d);
     // Texture::sample has v = 0 at the bottom row; the map's v = 0 is the zenith (top row).
-    return glm::vec3(env_map_->sample({uv.x, 1.0f - uv.y})) * env.color;
+    return glm::vec3(env_map_->sample_lat_long({uv.x, 1.0f - uv.y})) * env.color;
   }
   return glm::vec3(0.0f);
 }

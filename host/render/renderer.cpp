@@ -39,6 +39,18 @@ Renderer::Renderer(const Scene& scene, const RenderSettings& settings)
   if (!settings.camera_path.empty() && !scene.camera.paths.count(settings.camera_path))
     throw RenderSettingError("camera_path",
                              "scene has no camera path named '" + settings.camera_path + "'");
+  if (settings.world_guide) {
+    const int cells_log2 = settings.world_guide_settings.max_cells_log2;
+    if (cells_log2 < 0 || cells_log2 > kMaxCellsLog2)
+      throw RenderSettingError("world_guide_settings.max_cells_log2",
+                               "must lie in [0, " + std::to_string(kMaxCellsLog2) + "], got " +
+                                   std::to_string(cells_log2));
+    // A vertex guided by a borrowed pixel mixture would be recorded in that pixel's frame, not
+    // its cell's (the command line offers one or the other: --guide-vertices).
+    if (settings.path_tracer.guide_secondary)
+      throw RenderSettingError("world_guide",
+                               "cannot be combined with path_tracer.guide_secondary");
+  }
   try {
     gbuffers_[0].resize(settings.width, settings.height);
     image_.assign(pixels, glm::vec3(0.0f));

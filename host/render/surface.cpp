@@ -159,8 +159,7 @@ namespace {
                                       const TriangleFacts& facts, const TriangleVertices& vertices,
                                       const Hit& hit, const glm::vec3& ng, glm::vec3& ns,
                                       glm::vec3& base, float& roughness, float& metallic) {
-  glm::vec2 uv(0.0f);
-  if (!mesh.uvs.empty()) uv = interpolate(vertices.uv, hit.u, hit.v);
+  const glm::vec2 uv = interpolate(vertices.uv, hit.u, hit.v);
   if (mat.base_color_texture >= 0)
     base *= glm::vec3(scene.textures[mat.base_color_texture].sample(uv));
   if (mat.roughness_texture >= 0)
@@ -218,7 +217,9 @@ SurfacePoint surface_point(const Scene& scene, const TriangleFacts& facts,
   float roughness = mat.roughness, metallic = mat.metallic;
   // Out of line: a material without textures pays one test (docs/host-path-tracer.md, "What a
   // scene does not use, skipped").
-  if (mat.has_textures())
+  // A mesh without texture coordinates takes none of its material's textures (scenes/README.md),
+  // as it takes no alpha mask (scene/alpha_mask.h).
+  if (mat.has_textures() && !mesh.uvs.empty())
     apply_textures(scene, mesh, mat, facts, *vertices, hit, ng, ns, base, roughness, metallic);
   sp.geometric_normal = ng;
   sp.offset_distance = facts.offset_distance;

@@ -68,7 +68,9 @@ WorldGuide::WorldGuide(const glm::vec3& bounds_min, const glm::vec3& bounds_max,
   inverse_cell_ = 1.0f / cell;
   // Half a cell of margin: points on the bounds' faces stay inside.
   origin_ = bounds_min - glm::vec3(0.5f * cell);
-  slots_.resize(std::size_t{1} << 12);
+  // 4096 slots to start with, fewer where at most 2^max_cells_log2 cells (half the slots) may be
+  // made; the Renderer keeps max_cells_log2 in [0, kMaxCellsLog2].
+  slots_.resize(std::size_t{2} << std::clamp(settings.max_cells_log2, 0, 11));
   states_.resize(slots_.size());
   mask_ = slots_.size() - 1;
 }
@@ -92,6 +94,8 @@ std::size_t WorldGuide::home(std::uint64_t cell) const {
 }
 
 std::size_t WorldGuide::find(std::uint64_t cell) const {
+  // kNoCell is also the empty slots' key: it has no slot.
+  if (cell == kNoCell) return slots_.size();
   for (std::size_t s = home(cell);; s = (s + 1) & mask_) {
     if (slots_[s].cell == cell) return s;
     if (slots_[s].cell == kNoCell) return slots_.size();
@@ -99,20 +103,22 @@ std::size_t WorldGuide::find(std::uint64_t cell) const {
 }
 
 std::size_t WorldGuide::find_or_insert(std::uint64_t cell) {
+  if (cell == kNoCell) return slots_.size();
+  // A cell made earlier in this frame's training is found, not refused by a full table (the
+  // samples after its first would be dropped) nor a reason to grow.
+  const std::size_t found = find(cell);
+  if (found != slots_.size()) return found;
   // Linear probing stays short while at most half the slots are used.
   if (2 * (used_ + 1) > slots_.size()) {
     if (slots_.size() >= (std::size_t{2} << settings_.max_cells_log2)) return slots_.size();
     grow();
   }
-  for (std::size_t s = home(cell);; s = (s + 1) & mask_) {
-    if (slots_[s].cell == cell) return s;
-    if (slots_[s].cell == kNoCell) {
-      slots_[s].cell = cell;
-      states_[s] = shared::pg_pmm_initial_state();
-      ++used_;
-      return s;
-    }
-  }
+  std::size_t s = home(cell);
+  while (slots_[s].cell != kNoCell) s = (s + 1) & mask_;
+  slots_[s].cell = cell;
+  states_[s] = shared::pg_pmm_initial_state();
+  ++used_;
+  return s;
 }
 
 void WorldGuide::grow() {

@@ -19,9 +19,13 @@
 
 namespace rtpg {
 
+// The largest WorldGuideSettings::max_cells_log2: the training's slot indices are 32 bits.
+constexpr int kMaxCellsLog2 = 30;
+
 struct WorldGuideSettings {
   int resolution = 32;      // cells along the scene's longest extent
-  int max_cells_log2 = 20;  // at most 2^n cells (the table doubles as cells are made)
+  int max_cells_log2 = 20;  // at most 2^n cells, n in [0, kMaxCellsLog2] (the table doubles as
+                            // cells are made)
   int max_depth = 2;        // the deepest path vertex guided and trained (y is 1)
   int record_every = 1;     // one path in n records its vertices for training (all sample)
   // A cell guides only where its lobe's mixing weight exceeds this (0: every cell with a model;

@@ -86,6 +86,17 @@ Texture read_opened(OIIO::ImageInput& in, const std::string& name, ImageDecode d
   int alpha = spec.alpha_channel;
   if (alpha >= nch || (alpha < 0 && (nch == 2 || nch == 4))) alpha = nch - 1;
   const int colour_channels = alpha >= 0 ? alpha : nch;
+  // A mask whose alpha channel is opaque everywhere holds its mask in the first channel, as a
+  // mask without alpha does: Crytek Sponza's leaf, chain and plant masks are grey + alpha PNGs
+  // with alpha 255 in every texel, and read by their alpha they cut nothing (docs/robustness.md,
+  // "Masks with an opaque alpha channel").
+  if (decode.mask && alpha >= 0) {
+    bool opaque = true;
+    const std::size_t stride = static_cast<std::size_t>(nch);
+    for (std::size_t i = static_cast<std::size_t>(alpha); opaque && i < count; i += stride)
+      opaque = eight_bit ? bytes[i] == 255 : values[i] >= 1.0f;
+    if (opaque) alpha = -1;
+  }
   const bool linearise = decode.srgb && !spec.format.is_floating_point();
 
   Texture texture;

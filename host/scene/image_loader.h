@@ -14,8 +14,9 @@ struct ImageDecode {
   // (roughness, metallic, normal, bump, alpha), which is stored linearly. Float formats
   // (hdr, exr) are always linear. The alpha channel is never sRGB-decoded.
   bool srgb = false;
-  // An alpha mask: when the file has no alpha channel, its first channel (a grey mask such as
-  // an OBJ map_d) becomes the alpha, since alpha testing reads the alpha channel.
+  // An alpha mask: when the file has no alpha channel, or one that is opaque in every texel,
+  // its first channel (a grey mask such as an OBJ map_d) becomes the alpha, since alpha testing
+  // reads the alpha channel.
   bool mask = false;
   // A material's texture (a colour, roughness, metallic, normal, bump or alpha map): a float
   // image's values must lie in [0, 1], as 8- and 16-bit ones do by their encoding (an albedo

@@ -89,30 +89,52 @@ Bilinear bilinear_at(glm::vec2 uv, int width, int height) {
           y - fy};
 }
 
-}  // namespace
+// bilinear_at for a latitude-longitude map: u repeats, v is clamped to [0, 1] (a non-finite v
+// to 0) and the taps beyond the first and last rows' centres take those rows.
+Bilinear bilinear_lat_long_at(glm::vec2 uv, int width, int height) {
+  Bilinear b = bilinear_at({uv.x, 0.5f}, width, height);
+  const float v = std::isfinite(uv.y) ? std::clamp(uv.y, 0.0f, 1.0f) : 0.0f;
+  const float y = (1.0f - v) * static_cast<float>(height) - 0.5f;
+  const float fy = std::floor(y);
+  b.y0 = std::clamp(static_cast<int>(fy), 0, height - 1);
+  b.y1 = std::clamp(static_cast<int>(fy) + 1, 0, height - 1);
+  b.ty = y - fy;
+  return b;
+}
 
-glm::vec4 Texture::sample(glm::vec2 uv) const {
-  if (width <= 0 || height <= 0 || (texels.empty() && texels8.empty())) return glm::vec4(1.0f);
-  const Bilinear b = bilinear_at(uv, width, height);
-  const std::size_t w = static_cast<std::size_t>(width);
-  if (texels8.size() == w * static_cast<std::size_t>(height)) {
-    // What fetch() does for the four taps, which bilinear_at has wrapped into the image: no
+// The bilinear sample of t's four texels named by b (t not empty).
+glm::vec4 sample_taps(const Texture& t, const Bilinear& b) {
+  const std::size_t w = static_cast<std::size_t>(t.width);
+  if (t.texels8.size() == w * static_cast<std::size_t>(t.height)) {
+    // What fetch() does for the four taps, which the Bilinear has put inside the image: no
     // clamps or size tests per texel, the decode tables chosen once (Sponza's textures took a
     // fifth of a path-traced frame; docs/host-path-tracer.md).
-    const std::array<float, 256>& rgb = srgb ? srgb_decode_table() : unorm_decode_table();
+    const std::array<float, 256>& rgb = t.srgb ? srgb_decode_table() : unorm_decode_table();
     const std::array<float, 256>& unorm = unorm_decode_table();
     const auto texel = [&](int x, int y) {
-      const std::array<std::uint8_t, 4>& t =
-          texels8[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(x)];
-      return glm::vec4(rgb[t[0]], rgb[t[1]], rgb[t[2]], unorm[t[3]]);
+      const std::array<std::uint8_t, 4>& c =
+          t.texels8[static_cast<std::size_t>(y) * w + static_cast<std::size_t>(x)];
+      return glm::vec4(rgb[c[0]], rgb[c[1]], rgb[c[2]], unorm[c[3]]);
     };
     const glm::vec4 top = glm::mix(texel(b.x0, b.y0), texel(b.x1, b.y0), b.tx);
     const glm::vec4 bottom = glm::mix(texel(b.x0, b.y1), texel(b.x1, b.y1), b.tx);
     return glm::mix(top, bottom, b.ty);
   }
-  const glm::vec4 top = glm::mix(fetch(b.x0, b.y0), fetch(b.x1, b.y0), b.tx);
-  const glm::vec4 bottom = glm::mix(fetch(b.x0, b.y1), fetch(b.x1, b.y1), b.tx);
+  const glm::vec4 top = glm::mix(t.fetch(b.x0, b.y0), t.fetch(b.x1, b.y0), b.tx);
+  const glm::vec4 bottom = glm::mix(t.fetch(b.x0, b.y1), t.fetch(b.x1, b.y1), b.tx);
   return glm::mix(top, bottom, b.ty);
+}
+
+}  // namespace
+
+glm::vec4 Texture::sample(glm::vec2 uv) const {
+  if (width <= 0 || height <= 0 || (texels.empty() && texels8.empty())) return glm::vec4(1.0f);
+  return sample_taps(*this, bilinear_at(uv, width, height));
+}
+
+glm::vec4 Texture::sample_lat_long(glm::vec2 uv) const {
+  if (width <= 0 || height <= 0 || (texels.empty() && texels8.empty())) return glm::vec4(1.0f);
+  return sample_taps(*this, bilinear_lat_long_at(uv, width, height));
 }
 
 void Texture::prefetch(glm::vec2 uv) const {

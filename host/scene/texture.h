@@ -36,6 +36,10 @@ struct Texture {
   glm::vec4 fetch(int x, int y) const;
   // uv in texture space with (0,0) = bottom-left (OBJ/glTF convention after loading), repeat.
   glm::vec4 sample(glm::vec2 uv) const;
+  // The same, repeating in u only and clamping v to the first and last rows: a latitude-longitude
+  // map, whose top and bottom rows are the two poles and must not blend with each other
+  // (docs/robustness.md, "The environment map's poles").
+  glm::vec4 sample_lat_long(glm::vec2 uv) const;
   // d(channel 0)/du and d/dv at uv per unit of uv, as one-texel forward differences of the
   // bilinear sample: from `slopes` when prepared, else from three samples.
   glm::vec2 sample_gradient(glm::vec2 uv) const;

@@ -114,9 +114,12 @@ void enqueue_write(cl::CommandQueue& queue, const cl::Buffer& buffer, const Chan
                 "a host channel's element size differs from include/rtpg/guiding_layout.h");
   const std::size_t bytes = host.size() * Bytes;
   translate_cl_errors([&] {
-    if (bytes > buffer.getInfo<CL_MEM_SIZE>())
+    // Exactly the device buffer's size: a shorter channel would leave the rest of the image as
+    // whatever the buffer held (another image size, or a channel never filled).
+    const std::size_t have = buffer.getInfo<CL_MEM_SIZE>();
+    if (bytes != have)
       throw GuiderError(std::string("upload of ") + name + ": " + std::to_string(bytes) +
-                        " bytes do not fit in its device buffer");
+                        " bytes for a device buffer of " + std::to_string(have));
     queue.enqueueWriteBuffer(buffer, CL_FALSE, 0, bytes, host.data());
   });
 }
@@ -130,11 +133,19 @@ cl::Buffer wrap_channel(cl::Context& context, const Channel& host, const char* n
   return b;
 }
 template <std::size_t Bytes, class Channel>
-void enqueue_read(cl::CommandQueue& queue, const cl::Buffer& buffer, Channel& host) {
+void enqueue_read(cl::CommandQueue& queue, const cl::Buffer& buffer, Channel& host,
+                  const char* name) {
   static_assert(sizeof(typename Channel::value_type) == Bytes,
                 "a host channel's element size differs from include/rtpg/guiding_layout.h");
-  translate_cl_errors(
-      [&] { queue.enqueueReadBuffer(buffer, CL_FALSE, 0, host.size() * Bytes, host.data()); });
+  const std::size_t bytes = host.size() * Bytes;
+  translate_cl_errors([&] {
+    const std::size_t have = buffer.getInfo<CL_MEM_SIZE>();
+    if (bytes != have)
+      throw GuiderError(std::string("download of ") + name + ": a host channel of " +
+                        std::to_string(bytes) + " bytes for a device buffer of " +
+                        std::to_string(have));
+    queue.enqueueReadBuffer(buffer, CL_FALSE, 0, bytes, host.data());
+  });
 }
 }  // namespace detail
 
@@ -174,7 +185,7 @@ void enqueue_download(cl::CommandQueue& queue, const GuiderSamples& dev, HostSam
                       SampleOutputs outputs = SampleOutputs::directions_and_mixture) {
 #define RTPG_DOWNLOAD(name, type, bytes)                                              \
   if (outputs == SampleOutputs::directions_and_mixture || !is_mixture_channel(#name)) \
-    detail::enqueue_read<bytes>(queue, dev.name, host.name);
+    detail::enqueue_read<bytes>(queue, dev.name, host.name, #name);
   PG_SAMPLE_CHANNELS(RTPG_DOWNLOAD)
 #undef RTPG_DOWNLOAD
 }
@@ -182,7 +193,8 @@ void enqueue_download(cl::CommandQueue& queue, const GuiderSamples& dev, HostSam
 template <class HostPackedSamples>
 void enqueue_download(cl::CommandQueue& queue, const GuiderPackedSamples& dev,
                       HostPackedSamples& host) {
-#define RTPG_DOWNLOAD(name, type, bytes) detail::enqueue_read<bytes>(queue, dev.name, host.name);
+#define RTPG_DOWNLOAD(name, type, bytes) \
+  detail::enqueue_read<bytes>(queue, dev.name, host.name, #name);
   PG_PACKED_SAMPLE_CHANNELS(RTPG_DOWNLOAD)
 #undef RTPG_DOWNLOAD
 }

@@ -31,7 +31,9 @@ struct GuidingSettings {
   int n_min = 5, n_max = 20;           // N = (1 - k/k_max) * (n_max - n_min) + n_min (paper 4.2);
                                        // n_min == n_max gives a fixed N
   int apron = 2;                       // neighbourhood radius: a (2*apron+1)^2 window of VPLs
-  float max_weight = 1e8f;             // training weights above this are dropped as absurd
+  float max_weight = 1e30f;            // training weights above this are dropped as absurd:
+                                       // beyond any radiance unit, below what a batch's sums
+                                       // can hold (docs/robustness.md, "Radiance scale")
   float reproject_position = 0.05f;    // relative distance (to the depth) that rejects history
   float reproject_normal = 0.9f;       // normal cosine below which history is rejected
   float reproject_view_memory = 0.0f;  // where a pixel's BSDF has a glossy lobe, its carried
@@ -99,6 +101,7 @@ int rows_per_model_for_height(int height);
 // The block the kernels read. Host code that evaluates the mixture itself (the
 // GuidingDistribution) uses the same block. image_height resolves rows_per_model 0
 // (rows_per_model_for_height); 0, for a block that serves no image (the world guide's EM), gives 1.
+// Throws GuiderError where validate() does.
 pg_kernel_settings to_kernel_settings(const GuidingSettings& settings, int image_height = 0);
 
 }  // namespace rtpg

@@ -59,8 +59,12 @@ typedef struct pg_svgf_view {
 /* Below this a depth slope counts as flat: keeps phi_z above 0 for surfaces facing the camera,
  * relative to the depth so that no absolute length enters. */
 #define PG_SVGF_DEPTH_EPSILON 1.0e-3f
-/* Added to the standard deviation of the luminance weight (SVGF: 1e-10 on the variance). */
-#define PG_SVGF_LUMINANCE_EPSILON 1.0e-10f
+/* Added to the luminance weight's scale, phi_luminance * standard deviation, so that a pixel of
+ * zero variance divides by a number (SVGF adds 1e-10 to the variance). The smallest normal
+ * float: any absolute radiance would change the weights of scenes lit in small units (radiance
+ * 1e-12 has a standard deviation near 1e-12), and this one is below half an ulp of every scale
+ * above 2^-102 (docs/robustness.md, "Radiance scale"). */
+#define PG_SVGF_LUMINANCE_EPSILON 1.17549435e-38f
 /* Illumination is clamped to this magnitude, so that its square and sums of squares over a
  * filter window stay finite in float. */
 #define PG_SVGF_MAX_ILLUMINATION 1.0e17f

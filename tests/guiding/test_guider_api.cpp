@@ -3,6 +3,7 @@
 // are the ones include/rtpg/guiding_layout.h documents.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -454,6 +455,54 @@ TEST(GuidingSettingsTable, DefaultsPassAndEveryRowRefusesItsOutsideValues) {
   // The window walk's stride visits all 49 cells of a 7x7 window: coprime with 49.
   EXPECT_GT(k.stride, 0);
   EXPECT_NE(k.stride % 7, 0);
+  // Settings out of range are refused before the block is built (an apron of 2^30 overflowed
+  // the window's size, undefined behaviour, before the Guider validated its settings), and an
+  // enumerator that is none of the three.
+  s = rtpg::GuidingSettings{};
+  s.apron = 1 << 30;
+  EXPECT_THROW(rtpg::to_kernel_settings(s), rtpg::GuiderError);
+  rtpg::ClRuntime rt;
+  EXPECT_THROW(rtpg::Guider(rt, 8, 8, s), rtpg::GuiderError);
+  s = rtpg::GuidingSettings{};
+  s.train_memory = static_cast<rtpg::GuidingSettings::TrainMemory>(7);
+  EXPECT_THROW(rtpg::validate(s), rtpg::GuiderError);
+}
+
+// Every row of the settings table that the kernels use reaches their block: changed alone to a
+// valid value away from its default, it changes the block's bytes (the kernels' host reference
+// reads the same block, so a field the conversion forgot would pass every kernel test). The
+// work-group sizes and lane counts choose how the kernels are launched and built, not what they
+// compute: they stay out of the block.
+TEST(GuidingSettingsTable, EveryKernelSettingReachesTheKernelsBlock) {
+  const std::vector<std::string> host_only = {"local_x", "local_y", "train_lanes", "sample_lanes"};
+  const rtpg::pg_kernel_settings defaults = rtpg::to_kernel_settings(rtpg::GuidingSettings{}, 540);
+  for (const rtpg::GuidingSettingInfo& row : rtpg::guiding_settings_table()) {
+    SCOPED_TRACE(row.name);
+    const double d = row.get(rtpg::GuidingSettings{});
+    bool changed = false;
+    for (const double v : {2.0 * d, 0.5 * d, d + 1.0, d - 1.0, row.min, row.max}) {
+      rtpg::GuidingSettings s;
+      if (!row.in_range(v) || v == d) continue;
+      row.set(s, v);
+      if (row.get(s) == d) continue;
+      // The work-group size is per device in both directions or in neither.
+      if (std::string(row.name) == "local_x") s.local_y = s.local_x;
+      if (std::string(row.name) == "local_y") s.local_x = s.local_y;
+      try {
+        rtpg::validate(s);
+      } catch (const rtpg::GuiderError&) {
+        continue;  // a value the other settings do not allow with it (n_min above n_max)
+      }
+      const rtpg::pg_kernel_settings k = rtpg::to_kernel_settings(s, 540);
+      const bool differs = std::memcmp(&k, &defaults, sizeof k) != 0;
+      const bool is_host_only =
+          std::find(host_only.begin(), host_only.end(), row.name) != host_only.end();
+      EXPECT_EQ(differs, !is_host_only) << "at " << v;
+      changed = true;
+      break;
+    }
+    EXPECT_TRUE(changed) << "no valid value away from the default was found";
+  }
 }
 
 // rows_per_model 0 (the default) shares a model over at most 1/135 of the image's height, in

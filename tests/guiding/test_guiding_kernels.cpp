@@ -1701,6 +1701,47 @@ TEST(GuidingKernels, UnpackVplsMatchesTheHostUnpack) {
 
 // unpack_gbuffer refuses a G-buffer kernels may not write, packed channels of another size and
 // cameras of another image, naming them; pack_samples samples it may not read.
+// Transfers between host channels and device buffers of other sizes are refused, naming the
+// channel: a short upload left the rest of the image as the buffer held it, a short download
+// read part of it. And buffers of another OpenCL context are refused by every call that takes
+// them.
+TEST(GuiderMisuse, MissizedTransfersAndForeignBuffersAreRefused) {
+  ClRuntime rt;
+  const int w = 13, h = 7;
+  Random r(405);
+  const HostGBuffer hg = random_gbuffer(r, w, h);
+  const GuiderGBuffer dev = make_guider_gbuffer(rt.context(), w, h);
+  for (const std::size_t size : {hg.n() - 1, std::size_t{0}, hg.n() + 1}) {
+    HostGBuffer bad = hg;
+    bad.position_depth.resize(size);
+    expect_guider_error([&] { enqueue_upload(rt.queue(), bad, dev); }, "position_depth");
+  }
+  const GuiderSamples samples = make_guider_samples(rt.context(), w, h);
+  struct HostSampleChannels {
+#define RTPG_TEST_CHANNEL(name, type, bytes) std::vector<shared::type> name;
+    PG_SAMPLE_CHANNELS(RTPG_TEST_CHANNEL)
+#undef RTPG_TEST_CHANNEL
+  } host;
+#define RTPG_TEST_RESIZE(name, type, bytes) host.name.resize(hg.n());
+  PG_SAMPLE_CHANNELS(RTPG_TEST_RESIZE)
+#undef RTPG_TEST_RESIZE
+  enqueue_download(rt.queue(), samples, host);
+  rt.queue().finish();
+  host.direction_pdf.resize(hg.n() - 1);
+  expect_guider_error([&] { enqueue_download(rt.queue(), samples, host); }, "direction_pdf");
+  rt.queue().finish();
+
+  ClRuntime other;
+  Guider guider(rt, w, h);
+  const GuiderGBuffer good = upload(rt, hg);
+  const GuiderGBuffer foreign = make_guider_gbuffer(other.context(), w, h);
+  expect_guider_error([&] { guider.sample(foreign, 1, 0, 0, samples); }, "another OpenCL context");
+  expect_guider_error([&] { guider.reproject(good, foreign); }, "another OpenCL context");
+  expect_guider_error(
+      [&] { guider.sample(good, 1, 0, 0, make_guider_samples(other.context(), w, h)); },
+      "another OpenCL context");
+}
+
 TEST(GuiderMisuse, UnpackGBufferRefusesReadOnlyAndMissizedBuffers) {
   ClRuntime rt;
   const int w = 9, h = 5;

@@ -1193,3 +1193,29 @@ TEST(PmmReframe, CovarianceMatchesCarriedSamples) {
   std::printf("reframe: %d cases; J^T rejected in %d, flipped Sigma_xy in %d\n", checked,
               transposed_rejected, flipped_rejected);
 }
+
+// The walk through a training window visits each of its (2 apron + 1)^2 VPLs once in as many
+// steps, from any start, for every apron the settings allow: the stride the settings give must
+// be coprime with the window's size. At aprons 1, 4 and 7 the first candidate stride (a third
+// of the size) is not, and the search must move on (a stride of 3 at apron 1 visits 3 of 9).
+TEST(TrainWindow, TheWalkVisitsEveryVplOnceForEveryApron) {
+  for (int apron = 0; apron <= 8; ++apron) {
+    rtpg::GuidingSettings s;
+    s.apron = apron;
+    const rtpg::pg_kernel_settings p = rtpg::to_kernel_settings(s);
+    const int size = (2 * apron + 1) * (2 * apron + 1);
+    // pg_train_walk_start draws the start in [0, size).
+    for (const unsigned drawn : {0u, 1u, 5u, 77u, 288u}) {
+      const unsigned start = drawn % static_cast<unsigned>(size);
+      std::vector<int> seen(static_cast<std::size_t>(size), 0);
+      for (int k = 0; k < size; ++k) {
+        const int c = pg_train_window_index(start, k, p);
+        ASSERT_GE(c, 0);
+        ASSERT_LT(c, size);
+        ++seen[static_cast<std::size_t>(c)];
+      }
+      EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), size)
+          << "apron " << apron << ", stride " << p.stride << ", start " << start;
+    }
+  }
+}

@@ -778,6 +778,9 @@ TEST(GuidingImage, EverySettingAwayFromItsDefaultStillGuides) {
   RenderSettings settings;
   settings.width = 48;
   settings.height = 27;
+  // Along the pan: with a still camera every motion is 0 and the settings that act on moving
+  // pixels (reproject_view_memory) would not act at all.
+  settings.camera_path = "pan";
   for (const GuidingSettingInfo& row : guiding_settings_table()) {
     SCOPED_TRACE(row.name);
     const auto it = values.find(row.name);

@@ -597,6 +597,40 @@ TEST(Lights, NoSkyWithoutAnEnvironmentOrASunsDisc) {
   EXPECT_EQ(sun_lights.escaped_radiance(side), glm::vec3(0.0f));
 }
 
+// The map's top and bottom rows are the two poles: within half a texel of a pole the bilinear
+// lookup blends along the row only, never with the other pole's row (a lookup that wraps
+// vertically gave the zenith half of the nadir's radiance; docs/robustness.md, "The environment
+// map's poles").
+TEST(Lights, SkyNearAPoleIsThatPolesRow) {
+  Scene scene = floor_scene();
+  Texture map;
+  map.width = 8;
+  map.height = 4;
+  for (int y = 0; y < map.height; ++y)
+    for (int x = 0; x < map.width; ++x)  // every texel its own value: x + 8 y + 1
+      map.texels.push_back(glm::vec4(glm::vec3(static_cast<float>(x + map.width * y + 1)), 1.0f));
+  scene.textures.push_back(map);
+  scene.environment.kind = Environment::Kind::Map;
+  scene.environment.map_texture = 0;
+  scene.environment.color = glm::vec3(1.0f);
+  const Lights lights(scene);
+  const double half_texel = 0.5 * kPi / map.height;
+  for (const double from_pole : {0.0, 0.1 * half_texel, 0.9 * half_texel})
+    for (int a = 0; a < 16; ++a) {
+      const double phi = 2.0 * kPi * (a + 0.25) / 16.0;
+      for (const bool zenith : {true, false}) {
+        const double theta = zenith ? from_pole : kPi - from_pole;
+        const glm::vec3 d(static_cast<float>(std::sin(theta) * std::cos(phi)),
+                          static_cast<float>(std::cos(theta)),
+                          static_cast<float>(std::sin(theta) * std::sin(phi)));
+        const float row_first = zenith ? 1.0f : 25.0f, row_last = row_first + 7.0f;
+        const float got = lights.escaped_radiance(d).x;
+        EXPECT_GE(got, row_first - 1e-4f) << (zenith ? "zenith" : "nadir") << ", " << from_pole;
+        EXPECT_LE(got, row_last + 1e-4f) << (zenith ? "zenith" : "nadir") << ", " << from_pole;
+      }
+    }
+}
+
 // What the sky looks like, not only how it is sampled (the chi-square tests above compare samples
 // with densities derived from the same lookups, so an upside-down map, a map turned the wrong way
 // or a wrong scale passes them): the radiance of the direction through each texel centre of an

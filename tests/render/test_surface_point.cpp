@@ -305,6 +305,25 @@ TEST(SurfacePoint, TexturesTiltTheShadingNormalAndScaleTheMaterial) {
   EXPECT_NEAR(sp.material.metallic, 0.9f, 1e-6f);
   EXPECT_EQ(sp.material.base_color.x, 0.3f);
   EXPECT_EQ(sp.shading_normal, glm::vec3(0.0f, 1.0f, 0.0f));
+
+  // A mesh without texture coordinates takes none of its textures (scenes/README.md, as it
+  // takes no alpha mask): not the texel at uv (0, 0) for its colour, nor a tilt of its normal.
+  Scene bare;
+  bare.textures.push_back(texture_of(1, 1, {glm::vec4(0.0f, 0.0f, 0.0f, 1.0f)}));
+  bare.textures.push_back(texture_of(1, 1, {normal_texel({s30, 0.0f, c30})}));
+  Material textured;
+  textured.base_color = glm::vec3(0.3f, 0.4f, 0.5f);
+  textured.base_color_texture = 0;
+  textured.normal_texture = 1;
+  bare.materials.push_back(textured);
+  Mesh no_uvs = make_quad({-1, 0, -1}, {0, 0, 2}, {2, 0, 0});
+  no_uvs.uvs.clear();
+  no_uvs.tangents.clear();
+  bare.meshes.push_back(no_uvs);
+  ASSERT_TRUE(surface_below(bare, glm::vec3(0.1f, 1.0f, 0.2f), sp));
+  EXPECT_EQ(sp.material.base_color.x, 0.3f);
+  EXPECT_EQ(sp.material.base_color.z, 0.5f);
+  EXPECT_EQ(sp.shading_normal, glm::vec3(0.0f, 1.0f, 0.0f));
 }
 
 TEST(SurfacePoint, NextFloatIsStdNextafter) {

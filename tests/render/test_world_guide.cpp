@@ -120,6 +120,56 @@ TEST(WorldGuide, AFullTableDropsNewCells) {
   EXPECT_LE(guide.cell_count(), std::size_t{2048});
 }
 
+// The cells of the frame that fills the table keep every sample: each cell's second sample
+// arrives after the table's last cell was made, and a lookup that checked the table's room before
+// looking for the cell dropped it (and, below the cap, grew the table for a cell it had). So a
+// table capped at the 2,048 cells it is given trains the same models as one with room to spare.
+TEST(WorldGuide, TheFrameThatFillsTheTableTrainsEveryCellOnAllItsSamples) {
+  const auto models = [](int max_cells_log2) {
+    WorldGuideSettings s = settings_for_test(100);
+    s.max_cells_log2 = max_cells_log2;
+    WorldGuide guide(glm::vec3(0.0f), glm::vec3(100.0f), s);
+    guide.train(many_cells(guide, 2048, 2, 11u));
+    EXPECT_EQ(guide.cell_count(), 2048u);
+    std::vector<float> out;
+    for (int c = 0; c < 2048; ++c) {
+      PixelGuide g;
+      const glm::vec3 p(static_cast<float>(c % 50) + 0.5f, static_cast<float>(c / 50) + 0.5f, 0.5f);
+      if (guide.guide(guide.cell_of(p, glm::vec3(0.0f, 0.0f, 1.0f)), g))
+        out.insert(out.end(),
+                   {g.model.pi, g.model.mx, g.model.my, g.model.l11, g.model.l21, g.model.l22});
+    }
+    return out;
+  };
+  const std::vector<float> capped = models(11), roomy = models(20);
+  ASSERT_EQ(roomy.size(), 2048u * 6u);
+  EXPECT_EQ(capped, roomy);
+}
+
+// max_cells_log2 below the table's first size still bounds the cells: at most 2^5 here.
+TEST(WorldGuide, ASmallCapIsKept) {
+  WorldGuideSettings s = settings_for_test(100);
+  s.max_cells_log2 = 5;
+  WorldGuide guide(glm::vec3(0.0f), glm::vec3(100.0f), s);
+  guide.train(many_cells(guide, 100, 2, 3u));
+  EXPECT_EQ(guide.cell_count(), 32u);
+}
+
+// kNoCell (a point outside the grid) is the empty slots' key: samples of it are dropped, and it
+// never has a model (a lookup once found the first empty slot, trained it, and then read the
+// frame of a normal bin that does not exist).
+TEST(WorldGuide, NoCellIsNeitherTrainedNorGuided) {
+  WorldGuide guide(glm::vec3(0.0f), glm::vec3(1.0f), settings_for_test(4));
+  const std::uint64_t outside = guide.cell_of(glm::vec3(-5.0f), glm::vec3(0.0f, 1.0f, 0.0f));
+  ASSERT_EQ(outside, WorldGuide::kNoCell);
+  std::vector<std::vector<WorldTrainingSample>> blocks(1);
+  for (int k = 0; k < 10; ++k) blocks[0].push_back({outside, 1.0f, 0.4f, 0.6f, 0.3f, 0.3f});
+  for (int frame = 0; frame < 3; ++frame) guide.train(blocks);
+  PixelGuide g;
+  EXPECT_FALSE(guide.guide(outside, g));
+  EXPECT_EQ(guide.cell_count(), 0u);
+}
+
 // Training sums each cell's samples in the blocks' order, so one thread and many give the same
 // models to the bit.
 TEST(WorldGuide, TrainsTheSameWhateverTheThreadCount) {
@@ -219,6 +269,24 @@ TEST(WorldGuide, RecordEveryAndMinimumPiThinWhatTheGuideDoes) {
   EXPECT_LT(share, 0.28);
   EXPECT_GT(every.guided_in_second_frame, 20u);
   EXPECT_EQ(none.guided_in_second_frame, 0u);
+}
+
+// The renderer refuses world-guide settings it cannot keep: more than 2^30 cells (the training's
+// slot indices are 32 bits), and a borrowed pixel mixture at the vertices the cells guide.
+TEST(WorldGuide, TheRendererRefusesSettingsItCannotKeep) {
+  const Scene scene = floor_and_wall_under_a_delta_sun();
+  RenderSettings settings;
+  settings.width = settings.height = 8;
+  settings.world_guide = true;
+  settings.world_guide_settings = settings_for_test();
+  for (const int n : {-1, 31}) {
+    settings.world_guide_settings.max_cells_log2 = n;
+    EXPECT_THROW(Renderer(scene, settings), RenderSettingError) << n;
+  }
+  settings.world_guide_settings.max_cells_log2 = 30;
+  EXPECT_NO_THROW(Renderer(scene, settings));
+  settings.path_tracer.guide_secondary = true;
+  EXPECT_THROW(Renderer(scene, settings), RenderSettingError);
 }
 
 }  // namespace

@@ -351,6 +351,26 @@ TEST(ImageLoader, DecodesSrgbOnlyForColourAndExpandsGrey) {
   EXPECT_EQ(load_image(dir / "rounded.exr", ImageDecode{false, false}).texels[1].y, 1.0f);
 }
 
+// A mask stored as grey + alpha with the alpha opaque in every texel (Crytek Sponza's leaf, chain
+// and plant masks) holds its mask in the grey channel: read by its alpha it cut nothing, and the
+// leaves rendered as solid cards. A mask whose alpha varies is read by its alpha, and a colour
+// texture keeps its opaque alpha.
+TEST(ImageLoader, AMaskWithAnOpaqueAlphaChannelIsItsGreyChannel) {
+  TempDir dir;
+  write_png(dir / "grey_alpha.png", 4, 4, 2,
+            [](int x, int, int c) { return c == 1 ? 255 : (x < 2 ? 0 : 255); });
+  const Texture mask = load_image(dir / "grey_alpha.png", ImageDecode{false, true});
+  EXPECT_EQ(mask.fetch(0, 0).w, 0.0f);
+  EXPECT_EQ(mask.fetch(3, 0).w, 1.0f);
+  const Texture colour = load_image(dir / "grey_alpha.png", ImageDecode{true, false});
+  EXPECT_EQ(colour.fetch(0, 0).w, 1.0f);
+  write_png(dir / "varying.png", 4, 4, 2,
+            [](int x, int, int c) { return c == 1 ? (x < 2 ? 255 : 0) : 255; });
+  const Texture varying = load_image(dir / "varying.png", ImageDecode{false, true});
+  EXPECT_EQ(varying.fetch(0, 0).w, 1.0f);
+  EXPECT_EQ(varying.fetch(3, 0).w, 0.0f);
+}
+
 // ---- a valid scene with every feature ------------------------------------------------------
 
 TEST(SceneLoader, LoadsEveryFeature) {
