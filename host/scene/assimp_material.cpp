@@ -110,7 +110,8 @@ Material convert_mtl(MaterialReader& in) {
   // Ks = 0 is how MTL says "no highlight": keep it pure Lambert. Otherwise a dielectric
   // lobe whose width follows the Phong exponent: roughness = sqrt(2 / (Ns + 2)). (The
   // Beckmann-Phong correspondence is alpha = sqrt(2 / (Ns + 2)); with alpha = roughness^2
-  // this rule gives a somewhat sharper lobe than that.)
+  // this rule's alpha is that one squared: a lobe 2.4x narrower at Ns = 10, 7x at Ns = 100.
+  // Kept: the scenes' looks and figures were made with it.)
   glm::vec3 ks(0.0f);
   in.color(AI_MATKEY_COLOR_SPECULAR, ks);
   if (std::max({ks.x, ks.y, ks.z}) <= 0.0f) {

@@ -16,6 +16,7 @@
 #include "denoise/svgf_denoiser.h"
 #include "denoise/svgf_reference.h"
 #include "rtpg/errors.h"
+#include "support/settings_rows.h"
 
 namespace rtpg {
 namespace {
@@ -404,21 +405,29 @@ ShadowEdgeResult denoise_a_shadow_edge(ClRuntime& rt, const SvgfSettings& s) {
 
 TEST(SvgfQuality, RemovesNoiseAndKeepsAnEdgeOfTheLighting) {
   ClRuntime rt;
-  const ShadowEdgeResult r = denoise_a_shadow_edge(rt, SvgfSettings{});
-  // Measured on PoCL: error ratio 0.055, dark 0.128, bright 0.972; without the luminance weight
-  // 1.69, 0.512, 0.590 (the blur across the edge makes the image worse than the noisy frame).
-  EXPECT_LT(r.error_ratio, 0.1);
-  EXPECT_LT(r.dark_near_edge, 0.2);
-  EXPECT_GT(r.bright_near_edge, 0.85);
-  SvgfSettings blind;
-  blind.phi_luminance = 1e6f;
-  const ShadowEdgeResult leaky = denoise_a_shadow_edge(rt, blind);
-  EXPECT_GT(leaky.dark_near_edge, 0.2) << "the edge check cannot tell a filter blind to it";
-  std::printf(
-      "error ratio %.4f, dark %.4f, bright %.4f; without the luminance weight: %.4f, "
-      "%.4f, %.4f\n",
-      r.error_ratio, r.dark_near_edge, r.bright_near_edge, leaky.error_ratio, leaky.dark_near_edge,
-      leaky.bright_near_edge);
+  // The filters one pixel per work-item (kernels/shared/svgf.h's weights) and in vector lanes
+  // (kernels/wide/svgf_wide.h's, the default on CPU devices).
+  for (const int lanes : {1, 0}) {
+    SCOPED_TRACE("lanes " + std::to_string(lanes));
+    SvgfSettings s;
+    s.lanes = lanes;
+    const ShadowEdgeResult r = denoise_a_shadow_edge(rt, s);
+    // Measured on PoCL: error ratio 0.055, dark 0.128, bright 0.972; without the luminance
+    // weight 1.69, 0.512, 0.590 (the blur across the edge makes the image worse than the noisy
+    // frame).
+    EXPECT_LT(r.error_ratio, 0.1);
+    EXPECT_LT(r.dark_near_edge, 0.2);
+    EXPECT_GT(r.bright_near_edge, 0.85);
+    SvgfSettings blind = s;
+    blind.phi_luminance = 1e6f;
+    const ShadowEdgeResult leaky = denoise_a_shadow_edge(rt, blind);
+    EXPECT_GT(leaky.dark_near_edge, 0.2) << "the edge check cannot tell a filter blind to it";
+    std::printf(
+        "lanes %d: error ratio %.4f, dark %.4f, bright %.4f; without the luminance weight: "
+        "%.4f, %.4f, %.4f\n",
+        lanes, r.error_ratio, r.dark_near_edge, r.bright_near_edge, leaky.error_ratio,
+        leaky.dark_near_edge, leaky.bright_near_edge);
+  }
 }
 
 // Two constant regions side by side: a depth step, then a normal step at equal depth. Neither
@@ -689,30 +698,20 @@ TEST(SvgfSettingsTable, EveryKernelSettingReachesTheKernelsBlock) {
   const shared::pg_svgf_settings defaults = to_kernel_settings(SvgfSettings{});
   for (const SvgfSettingInfo& row : svgf_settings_table()) {
     SCOPED_TRACE(row.name);
-    const double d = row.get(SvgfSettings{});
-    bool changed = false;
-    for (const double v : {2.0 * d, 0.5 * d, d + 1.0, d - 1.0, row.min, row.max}) {
-      SvgfSettings s;
-      if (!row.in_range(v) || v == d) continue;
-      row.set(s, v);
-      if (row.get(s) == d) continue;
-      // The work-group size is per device in both directions or in neither.
-      if (std::string(row.name) == "local_x") s.local_y = s.local_x;
-      if (std::string(row.name) == "local_y") s.local_x = s.local_y;
+    const auto s = test::with_row_changed<SvgfSettings>(row, [](const auto& c) {
       try {
-        validate(s);
+        validate(c);
+        return true;
       } catch (const InputError&) {
-        continue;  // a value the other settings do not allow with it
+        return false;  // a value the other settings do not allow with it
       }
-      const shared::pg_svgf_settings k = to_kernel_settings(s);
-      const bool differs = std::memcmp(&k, &defaults, sizeof k) != 0;
-      const bool in_block =
-          std::find(not_in_block.begin(), not_in_block.end(), row.name) == not_in_block.end();
-      EXPECT_EQ(differs, in_block) << "at " << v;
-      changed = true;
-      break;
-    }
-    EXPECT_TRUE(changed) << "no valid value away from the default was found";
+    });
+    ASSERT_TRUE(s.has_value()) << "no valid value away from the default";
+    const shared::pg_svgf_settings k = to_kernel_settings(*s);
+    const bool differs = std::memcmp(&k, &defaults, sizeof k) != 0;
+    const bool in_block =
+        std::find(not_in_block.begin(), not_in_block.end(), row.name) == not_in_block.end();
+    EXPECT_EQ(differs, in_block) << "at " << row.get(*s);
   }
 }
 

@@ -1,6 +1,7 @@
-// The guider as a user sees it: the public headers under include/rtpg/ and nothing else (its
-// own translation unit, so that no private header is visible). Buffer layouts and bit values
-// are the ones include/rtpg/guiding_layout.h documents.
+// The guider as a user sees it: the public headers under include/rtpg/ and nothing else of the
+// library (its own translation unit, so that no private header is visible; the tests' own
+// support headers aside). Buffer layouts and bit values are the ones
+// include/rtpg/guiding_layout.h documents.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -18,6 +19,7 @@
 #include "rtpg/guiding_distribution.h"
 #include "rtpg/image_size.h"
 #include "rtpg/vpl_packing.h"
+#include "support/settings_rows.h"
 
 namespace {
 
@@ -478,30 +480,20 @@ TEST(GuidingSettingsTable, EveryKernelSettingReachesTheKernelsBlock) {
   const rtpg::pg_kernel_settings defaults = rtpg::to_kernel_settings(rtpg::GuidingSettings{}, 540);
   for (const rtpg::GuidingSettingInfo& row : rtpg::guiding_settings_table()) {
     SCOPED_TRACE(row.name);
-    const double d = row.get(rtpg::GuidingSettings{});
-    bool changed = false;
-    for (const double v : {2.0 * d, 0.5 * d, d + 1.0, d - 1.0, row.min, row.max}) {
-      rtpg::GuidingSettings s;
-      if (!row.in_range(v) || v == d) continue;
-      row.set(s, v);
-      if (row.get(s) == d) continue;
-      // The work-group size is per device in both directions or in neither.
-      if (std::string(row.name) == "local_x") s.local_y = s.local_x;
-      if (std::string(row.name) == "local_y") s.local_x = s.local_y;
+    const auto s = rtpg::test::with_row_changed<rtpg::GuidingSettings>(row, [](const auto& c) {
       try {
-        rtpg::validate(s);
+        rtpg::validate(c);
+        return true;
       } catch (const rtpg::GuiderError&) {
-        continue;  // a value the other settings do not allow with it (n_min above n_max)
+        return false;  // a value the other settings do not allow with it (n_min above n_max)
       }
-      const rtpg::pg_kernel_settings k = rtpg::to_kernel_settings(s, 540);
-      const bool differs = std::memcmp(&k, &defaults, sizeof k) != 0;
-      const bool is_host_only =
-          std::find(host_only.begin(), host_only.end(), row.name) != host_only.end();
-      EXPECT_EQ(differs, !is_host_only) << "at " << v;
-      changed = true;
-      break;
-    }
-    EXPECT_TRUE(changed) << "no valid value away from the default was found";
+    });
+    ASSERT_TRUE(s.has_value()) << "no valid value away from the default";
+    const rtpg::pg_kernel_settings k = rtpg::to_kernel_settings(*s, 540);
+    const bool differs = std::memcmp(&k, &defaults, sizeof k) != 0;
+    const bool is_host_only =
+        std::find(host_only.begin(), host_only.end(), row.name) != host_only.end();
+    EXPECT_EQ(differs, !is_host_only) << "at " << row.get(*s);
   }
 }
 

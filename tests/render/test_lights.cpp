@@ -597,24 +597,32 @@ TEST(Lights, NoSkyWithoutAnEnvironmentOrASunsDisc) {
   EXPECT_EQ(sun_lights.escaped_radiance(side), glm::vec3(0.0f));
 }
 
-// The map's top and bottom rows are the two poles: within half a texel of a pole the bilinear
-// lookup blends along the row only, never with the other pole's row (a lookup that wraps
-// vertically gave the zenith half of the nadir's radiance; docs/robustness.md, "The environment
-// map's poles").
-TEST(Lights, SkyNearAPoleIsThatPolesRow) {
+// The floor under an 8x4 environment map whose every texel is its own value, x + 8 y + 1 (row 0,
+// 1-8, at the zenith), times `color`, turned by `rotation` about +y.
+Scene floor_under_a_numbered_map(const glm::vec3& color, float rotation) {
   Scene scene = floor_scene();
   Texture map;
   map.width = 8;
   map.height = 4;
   for (int y = 0; y < map.height; ++y)
-    for (int x = 0; x < map.width; ++x)  // every texel its own value: x + 8 y + 1
+    for (int x = 0; x < map.width; ++x)
       map.texels.push_back(glm::vec4(glm::vec3(static_cast<float>(x + map.width * y + 1)), 1.0f));
   scene.textures.push_back(map);
   scene.environment.kind = Environment::Kind::Map;
   scene.environment.map_texture = 0;
-  scene.environment.color = glm::vec3(1.0f);
+  scene.environment.color = color;
+  scene.environment.rotation = rotation;
+  return scene;
+}
+
+// The map's top and bottom rows are the two poles: within half a texel of a pole the bilinear
+// lookup blends along the row only, never with the other pole's row (a lookup that wraps
+// vertically gave the zenith half of the nadir's radiance; docs/robustness.md, "The environment
+// map's poles").
+TEST(Lights, SkyNearAPoleIsThatPolesRow) {
+  const Scene scene = floor_under_a_numbered_map(glm::vec3(1.0f), 0.0f);
   const Lights lights(scene);
-  const double half_texel = 0.5 * kPi / map.height;
+  const double half_texel = 0.5 * kPi / scene.textures[0].height;
   for (const double from_pole : {0.0, 0.1 * half_texel, 0.9 * half_texel})
     for (int a = 0; a < 16; ++a) {
       const double phi = 2.0 * kPi * (a + 0.25) / 16.0;
@@ -640,18 +648,8 @@ TEST(Lights, SkyNearAPoleIsThatPolesRow) {
 // irradiance (the radiance over its cone, weighed by the cosine, integrated by quadrature).
 TEST(Lights, SkyRadianceHasTheMapsOrientationAndTheSunsIrradiance) {
   for (const float rotation : {0.0f, 0.7f}) {
-    Scene scene = floor_scene();
-    Texture map;
-    map.width = 8;
-    map.height = 4;
-    for (int y = 0; y < map.height; ++y)
-      for (int x = 0; x < map.width; ++x)  // every texel its own value: x + 8 y + 1
-        map.texels.push_back(glm::vec4(glm::vec3(static_cast<float>(x + map.width * y + 1)), 1.0f));
-    scene.textures.push_back(map);
-    scene.environment.kind = Environment::Kind::Map;
-    scene.environment.map_texture = 0;
-    scene.environment.color = glm::vec3(2.0f, 3.0f, 0.5f);
-    scene.environment.rotation = rotation;
+    const Scene scene = floor_under_a_numbered_map(glm::vec3(2.0f, 3.0f, 0.5f), rotation);
+    const Texture& map = scene.textures[0];
     const Lights lights(scene);
     for (int y = 0; y < map.height; ++y)
       for (int x = 0; x < map.width; ++x) {

@@ -92,6 +92,19 @@ std::vector<std::vector<WorldTrainingSample>> many_cells(const WorldGuide& guide
   return blocks;
 }
 
+// The models of many_cells' first `cells` cells that have one, six floats each, in cell order.
+std::vector<float> cell_models(const WorldGuide& guide, int cells) {
+  std::vector<float> out;
+  for (int c = 0; c < cells; ++c) {
+    PixelGuide g;
+    const glm::vec3 p(static_cast<float>(c % 50) + 0.5f, static_cast<float>(c / 50) + 0.5f, 0.5f);
+    if (guide.guide(guide.cell_of(p, glm::vec3(0.0f, 0.0f, 1.0f)), g))
+      out.insert(out.end(),
+                 {g.model.pi, g.model.mx, g.model.my, g.model.l11, g.model.l21, g.model.l22});
+  }
+  return out;
+}
+
 // The table starts at 4096 slots and doubles at half full: 5,000 cells make it grow twice
 // during one frame's training, and every cell keeps its model.
 TEST(WorldGuide, TheTableGrowsAndKeepsEveryCell) {
@@ -131,15 +144,7 @@ TEST(WorldGuide, TheFrameThatFillsTheTableTrainsEveryCellOnAllItsSamples) {
     WorldGuide guide(glm::vec3(0.0f), glm::vec3(100.0f), s);
     guide.train(many_cells(guide, 2048, 2, 11u));
     EXPECT_EQ(guide.cell_count(), 2048u);
-    std::vector<float> out;
-    for (int c = 0; c < 2048; ++c) {
-      PixelGuide g;
-      const glm::vec3 p(static_cast<float>(c % 50) + 0.5f, static_cast<float>(c / 50) + 0.5f, 0.5f);
-      if (guide.guide(guide.cell_of(p, glm::vec3(0.0f, 0.0f, 1.0f)), g))
-        out.insert(out.end(),
-                   {g.model.pi, g.model.mx, g.model.my, g.model.l11, g.model.l21, g.model.l22});
-    }
-    return out;
+    return cell_models(guide, 2048);
   };
   const std::vector<float> capped = models(11), roomy = models(20);
   ASSERT_EQ(roomy.size(), 2048u * 6u);
@@ -178,15 +183,7 @@ TEST(WorldGuide, TrainsTheSameWhateverTheThreadCount) {
                               static_cast<std::size_t>(threads));
     WorldGuide guide(glm::vec3(0.0f), glm::vec3(100.0f), settings_for_test(100));
     for (int frame = 0; frame < 3; ++frame) guide.train(many_cells(guide, 3000, 6, frame + 1u));
-    std::vector<float> models;
-    for (int c = 0; c < 3000; ++c) {
-      PixelGuide g;
-      const glm::vec3 p(static_cast<float>(c % 50) + 0.5f, static_cast<float>(c / 50) + 0.5f, 0.5f);
-      if (guide.guide(guide.cell_of(p, glm::vec3(0.0f, 0.0f, 1.0f)), g))
-        models.insert(models.end(),
-                      {g.model.pi, g.model.mx, g.model.my, g.model.l11, g.model.l21, g.model.l22});
-    }
-    return models;
+    return cell_models(guide, 3000);
   };
   const std::vector<float> one = train(1), many = train(4);
   ASSERT_EQ(one.size(), 3000u * 6u);
