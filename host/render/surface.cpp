@@ -172,6 +172,10 @@ namespace {
   if (mat.normal_texture >= 0 || mat.bump_texture >= 0) {
     glm::vec3 t, b;
     tangent_basis(mesh, facts, vertices, hit.triangle, hit.u, hit.v, ns, t, b);
+    // On a back face ns (and with it the bitangent, its cross product with t) is flipped to the
+    // ray's side, the tangent is not: the map's tilt along u would come out mirrored. Its
+    // perturbed normal is the front face's, negated, which the tangent's negation gives.
+    if (glm::dot(facts.normal, ng) < 0.0f) t = -t;
     glm::vec3 perturbed = ns;
     if (mat.normal_texture >= 0) {
       const glm::vec3 tn = glm::vec3(scene.textures[mat.normal_texture].sample(uv)) * 2.0f - 1.0f;

@@ -348,7 +348,10 @@ class SceneBuilder {
     const float intensity = node.number_or("intensity", 1.0f);
     if (!(intensity >= 0.0f)) node.child("intensity").fail("intensity must not be negative");
     env.color = glm::vec3(intensity);
-    env.rotation = glm::radians(node.number_or("rotation_deg", 0.0f));
+    // One turn at most before radians: the float of a large angle's radians resolves the azimuth
+    // poorly (3.6e6 degrees: 0.004 rad steps); below 360 fmod changes nothing.
+    const double degrees = node.number_or("rotation_deg", 0.0f);
+    env.rotation = glm::radians(static_cast<float>(std::fmod(degrees, 360.0)));
   }
 
   bool has_light() const {

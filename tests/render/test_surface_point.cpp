@@ -197,12 +197,14 @@ TEST(SurfacePoint, TheTriangleTableHoldsEachTrianglesVertices) {
 
 // next_float_up and next_float_down against std::nextafter: zeros, subnormals, the extremes,
 // infinities, NaN (compared as NaN) and a million random bit patterns.
-// The surface point that a ray straight down from `origin` hits, into `out`; false for a miss.
-bool surface_below(const Scene& scene, const glm::vec3& origin, SurfacePoint& out) {
+// The surface point that a ray straight down from `origin` (straight up with `upwards`) hits,
+// into `out`; false for a miss.
+bool surface_below(const Scene& scene, const glm::vec3& origin, SurfacePoint& out,
+                   bool upwards = false) {
   const EmbreeScene tracer(scene);
   Ray ray;
   ray.origin = origin;
-  ray.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+  ray.direction = glm::vec3(0.0f, upwards ? 1.0f : -1.0f, 0.0f);
   Hit hit;
   tracer.intersect(&ray, &hit, 1);
   if (!hit.valid()) return false;
@@ -283,6 +285,12 @@ TEST(SurfacePoint, TexturesTiltTheShadingNormalAndScaleTheMaterial) {
     ASSERT_NEAR(sp.geometric_normal.y, 1.0f, 1e-6f);
     for (int k = 0; k < 3; ++k)
       EXPECT_NEAR(sp.shading_normal[k], c.expected_normal[k], 1e-5f) << "component " << k;
+    // Seen from below (a two-sided leaf's back), the map tilts the surface the same way, so the
+    // shading normal is the front's, negated (the tilt along u came out mirrored before).
+    ASSERT_TRUE(surface_below(scene, glm::vec3(0.0f, -1.0f, 0.0f), sp, true));
+    ASSERT_NEAR(sp.geometric_normal.y, -1.0f, 1e-6f);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(sp.shading_normal[k], -c.expected_normal[k], 1e-5f) << "back, component " << k;
   }
 
   // Roughness from the texel's green channel, metallic from its blue one (glTF's layout), each

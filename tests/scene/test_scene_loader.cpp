@@ -862,6 +862,25 @@ TEST(SceneLoaderErrors, BlackEnvironmentMapIsNoLight) {
   EXPECT_NO_THROW(load_scene(dir / "s.json"));
 }
 
+// An environment map's rotation is kept in [0, 360) degrees before it becomes radians: a turn of
+// 3,600,090 degrees is 90, where the float of its radians (62,833) would leave the map's azimuth
+// only to about 0.004 rad.
+TEST(SceneLoader, EnvironmentRotationIsReducedToOneTurn) {
+  TempDir dir;
+  write_float_image(dir / "sky.exr", 4, 2, 0.5f);
+  for (const char* degrees : {"90", "3600090", "-270"}) {
+    write_file(dir / "s.json", std::string("{") + kCamera + R"(,
+      "environment": {"file": "sky.exr", "rotation_deg": )" +
+                                   degrees + R"(}, "materials": {"m": {}},
+      "shapes": [{"type": "box", "min": [0,0,0], "max": [1,1,1], "material": "m"}]})");
+    const Scene scene = load_scene(dir / "s.json");
+    const float r = scene.environment.rotation;
+    EXPECT_NEAR(std::remainder(r - glm::radians(90.0f), 2.0f * 3.14159265f), 0.0f, 1e-6f)
+        << degrees;
+    EXPECT_LT(std::fabs(r), 6.2832f) << degrees;
+  }
+}
+
 // A sun direction whose components square beyond float's range is still a direction: its
 // normalisation used to give the zero vector, a sun that lit nothing.
 TEST(SceneLoader, SunDirectionOfHugeComponentsNormalises) {
