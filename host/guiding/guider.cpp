@@ -82,11 +82,10 @@ Guider::Guider(ClRuntime& runtime, int width, int height, const GuidingSettings&
       width_(width),
       height_(height),
       settings_(settings),
-      kernel_settings_(to_kernel_settings(settings, height)) {
+      kernel_settings_(to_kernel_settings(settings, height)) {  // validates the settings
   // settings() reports what the kernels run with: rows_per_model 0 resolved for this image.
   settings_.rows_per_model = kernel_settings_.rows_per_model;
   const std::size_t n = pixels(width, height);
-  validate(settings);
   const DeviceInfo& info = runtime.info();
   const bool cpu = info.type == "cpu";
   switch (settings.train_memory) {

@@ -107,6 +107,17 @@ GuiderPackedSamples make_guider_packed_samples(cl::Context& context, int width, 
                                                cl_mem_flags host_flags = 0);
 
 namespace detail {
+// A copy between a host channel and its device buffer moves exactly the buffer's bytes: a shorter
+// channel would leave the rest of the image as whatever the buffer held (another image size, or
+// a channel never filled). Throws GuiderError naming the copy and the channel.
+inline void check_transfer_size(const cl::Buffer& buffer, std::size_t bytes, const char* what,
+                                const char* name) {
+  const std::size_t have = buffer.getInfo<CL_MEM_SIZE>();
+  if (bytes != have)
+    throw GuiderError(std::string(what) + " of " + name + ": a host channel of " +
+                      std::to_string(bytes) + " bytes for a device buffer of " +
+                      std::to_string(have));
+}
 template <std::size_t Bytes, class Channel>
 void enqueue_write(cl::CommandQueue& queue, const cl::Buffer& buffer, const Channel& host,
                    const char* name) {
@@ -114,12 +125,7 @@ void enqueue_write(cl::CommandQueue& queue, const cl::Buffer& buffer, const Chan
                 "a host channel's element size differs from include/rtpg/guiding_layout.h");
   const std::size_t bytes = host.size() * Bytes;
   translate_cl_errors([&] {
-    // Exactly the device buffer's size: a shorter channel would leave the rest of the image as
-    // whatever the buffer held (another image size, or a channel never filled).
-    const std::size_t have = buffer.getInfo<CL_MEM_SIZE>();
-    if (bytes != have)
-      throw GuiderError(std::string("upload of ") + name + ": " + std::to_string(bytes) +
-                        " bytes for a device buffer of " + std::to_string(have));
+    check_transfer_size(buffer, bytes, "upload", name);
     queue.enqueueWriteBuffer(buffer, CL_FALSE, 0, bytes, host.data());
   });
 }
@@ -139,11 +145,7 @@ void enqueue_read(cl::CommandQueue& queue, const cl::Buffer& buffer, Channel& ho
                 "a host channel's element size differs from include/rtpg/guiding_layout.h");
   const std::size_t bytes = host.size() * Bytes;
   translate_cl_errors([&] {
-    const std::size_t have = buffer.getInfo<CL_MEM_SIZE>();
-    if (bytes != have)
-      throw GuiderError(std::string("download of ") + name + ": a host channel of " +
-                        std::to_string(bytes) + " bytes for a device buffer of " +
-                        std::to_string(have));
+    check_transfer_size(buffer, bytes, "download", name);
     queue.enqueueReadBuffer(buffer, CL_FALSE, 0, bytes, host.data());
   });
 }
