@@ -93,9 +93,11 @@ def main():
         guiding, extra, tag_prefix = methods[method]
         many, shared = RUNS[run]
         spp = args.spp if many else 1
-        # The cached run's key holds what else decides its figures: the binary, the variant's
-        # arguments, the size, the frames and the reference they are errors against.
-        key = json.dumps([binary, guiding, extra, args.res, args.frames, args.ref_spp])
+        # The cached run's key holds what else decides its figures: the binary, the scene file's
+        # bytes, the variant's arguments, the size, the frames and the reference they are errors
+        # against.
+        key = json.dumps([binary, runner.scene_file_hash(scene), guiding, extra, args.res, args.frames,
+                          args.ref_spp])
         tag = f"{tag_prefix}-{run}-{spp}spp-{seed}-{hashlib.sha256(key.encode()).hexdigest()[:10]}"
         cached = out / scene / f"{tag}.json"
         if cached.exists():

@@ -67,6 +67,15 @@ def markdown_table(scenes, table):
     return "\n".join(lines)
 
 
+def cache_key(binary, scene, extra, res, frames, ref_spp, ref_seed):
+    """The cache key of a run: what else decides it besides scene name, variant name and seed (the binary, the
+    scene file's bytes, the arguments, the size, the frames, and the reference too: the cached figures are
+    errors against it). 10 hex digits."""
+    key = json.dumps([binary, runner.scene_file_hash(scene), [str(a) for a in extra], res, frames, ref_spp,
+                      ref_seed])
+    return hashlib.sha256(key.encode()).hexdigest()[:10]
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--variants", required=True, help='JSON object: variant name -> list of extra rtpg arguments')
@@ -106,11 +115,8 @@ def main():
     refs = runner.ReferenceCache(out / "references")
     binary = runner.binary_fingerprint()
 
-    def run_key(extra, frames):
-        """The cache key of a run: what else decides it besides scene, variant name and seed (the
-        reference too: the cached figures are errors against it)."""
-        key = json.dumps([binary, [str(a) for a in extra], args.res, frames, args.ref_spp, args.ref_seed])
-        return hashlib.sha256(key.encode()).hexdigest()[:10]
+    def run_key(scene, extra, frames):
+        return cache_key(binary, scene, extra, args.res, frames, args.ref_spp, args.ref_seed)
 
     def path_relmse(scene, tag, seed, guiding, extra):
         """Mean relMSE of the checkpoint frames along the scene's first camera path."""
@@ -118,7 +124,7 @@ def main():
         if not name:
             raise SystemExit(f"variant_sweep.py: {runner.scene_path(scene)} has no camera path (--camera-path)")
         run_dir = out / scene
-        run_tag = f"path-{tag}-{seed}-{run_key(extra, max(checkpoints) + 1)}"
+        run_tag = f"path-{tag}-{seed}-{run_key(scene, extra, max(checkpoints) + 1)}"
         cached = run_dir / f"{run_tag}.relmse.json"
         if cached.exists():
             figures = json.loads(cached.read_text())
@@ -139,7 +145,7 @@ def main():
     def static_stats(scene, tag, seed, guiding, extra):
         reference = refs.get(scene, args.res, args.ref_spp, seed=args.ref_seed)
         run_dir = out / scene
-        run_tag = f"{tag}-{seed}-{run_key(extra, args.frames)}"
+        run_tag = f"{tag}-{seed}-{run_key(scene, extra, args.frames)}"
         cached = run_dir / f"{run_tag}.json"
         if cached.exists():
             return json.loads(cached.read_text())

@@ -51,7 +51,7 @@ def parse_run(text):
 
 def stage_medians(stats_path, skip):
     frames = json.loads(Path(stats_path).read_text())["frames"]
-    kept = frames[skip:] or frames
+    kept = frames[skip:]
     names = [s for s in STAGES if any(s in f["time_ms"] for f in kept)]
     medians = {s: statistics.median(f["time_ms"].get(s, 0.0) for f in kept) for s in names}
     if all("wall_ms" in f for f in kept):
@@ -79,8 +79,8 @@ def main():
                              "(alternate), or always as given (fixed)")
     parser.add_argument("--run", action="append", required=True, help="see the usage above")
     args = parser.parse_args()
-    if args.frames < 1 or args.rounds < 1 or args.skip < 0:
-        sys.exit("ab_frames: --frames and --rounds must be at least 1, --skip at least 0")
+    if args.frames < 1 or args.rounds < 1 or not 0 <= args.skip < args.frames:
+        sys.exit("ab_frames: --frames and --rounds must be at least 1, --skip at least 0 and below --frames")
     if args.order == "alternate" and args.rounds % 2 != 0:
         sys.exit("ab_frames: --rounds must be even with --order alternate (each order as often)")
     runs = [parse_run(r) for r in args.run]
@@ -135,8 +135,13 @@ def main():
         for n in names[1:]:
             ratios = [m.get(s, 0.0) / f[s] for m, f in zip(results[n], results[first])
                       if f.get(s, 0.0) > 0.0]
+            # The pair means need every round (each pair holds both orders); a stage that some of
+            # the first run's rounds lack (a grouping chosen away) gets its ratios alone.
+            whole = len(ratios) == len(results[first])
             cells.append(", ".join(f"{v:.3f}" for v in ratios) +
-                         (f" ({label} {summary(ratios, alternate):.3f})" if len(ratios) > 1 else "")
+                         ((f" ({label} {summary(ratios, alternate):.3f})" if whole
+                           else f" (in {len(ratios)} of {len(results[first])} rounds)")
+                          if len(ratios) > 1 else "")
                          if ratios else "-")
         print(f"| {s} | " + " | ".join(cells) + " |")
 

@@ -122,7 +122,10 @@ def verdict(result, files, args):
         if not files["output"].is_file():
             return "exit 0 without the output EXR"
         return None
-    if result.returncode in (1, 2):
+    # Exit 2 is an input the program refused (InputError, GuiderError; host/app/main.cpp) and 3
+    # an OpenCL failure; 1 is any other exception, an internal fault that a valid combination of
+    # options reached, never a clean refusal.
+    if result.returncode in (2, 3):
         if not stderr or not stderr[-1].startswith("rtpg:"):
             return f"exit {result.returncode} without an 'rtpg:' message: {stderr[-1:]}"
         left = [str(p) for p in files.values() if p.exists()]

@@ -18,7 +18,10 @@ echo "== rtpg render (default scene: scenes/cornell-box.json), guiding on"
 printf '\n== %s frames at 1 spp, %s, against a %s-spp reference\n' "$frames" "$res" "$ref_spp"
 printf '%-18s %-8s %12s %14s %10s %s\n' scene method "ms/frame" "relMSE(last8)" "s.e." image
 for scene in cornell-box cornell-indirect; do
-  ref="$out/$scene-ref-$res-$ref_spp.exr"
+  # Named by what it is made of (the program and the scene file): a rebuilt renderer or an edited
+  # scene renders its reference again.
+  key=$(cat build/rtpg "scenes/$scene.json" | sha256sum | cut -c1-12)
+  ref="$out/$scene-ref-$res-$ref_spp-$key.exr"
   [ -f "$ref" ] || ./build/rtpg reference "scenes/$scene.json" --res "$res" --spp "$ref_spp" -o "$ref" -q
   for method in off pmm; do
     ./build/rtpg render "scenes/$scene.json" --res "$res" --frames "$frames" --guiding "$method" \

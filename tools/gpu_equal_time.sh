@@ -28,7 +28,14 @@ set -u
 out=${OUT:?OUT must name the folder for the results}
 bundle=${BUNDLE:-build/gpu.tar.xz} refs=${REFS:-build/gpu-et/references}
 b=/tmp/rtpg-bundle
-[ -d $b/gpub ] || { mkdir -p $b && tar -xJf "$bundle" -C $b; } || exit 2
+# A warm machine keeps /tmp between calls: the bundle is extracted again when it is another one
+# (a rebuild between two calls), and the last call's runs, frames and tests are cleared, or they
+# would be reported as this call's.
+sum=$(sha256sum < "$bundle") || exit 2
+if [ "$(cat $b/bundle.sha256 2>/dev/null)" != "$sum" ]; then
+  rm -rf $b && mkdir -p $b && tar -xJf "$bundle" -C $b && echo "$sum" > $b/bundle.sha256 || exit 2
+fi
+rm -rf /tmp/et /tmp/etv /tmp/et-frames /tmp/et-tests
 g=$b/gpub
 . "$g/opencl_vendors.sh"
 opencl_vendors /tmp/et-vendors

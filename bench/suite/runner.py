@@ -46,6 +46,23 @@ def rtpg_binary():
     return Path(os.environ.get("RTPG_BINARY", ROOT / "build" / "rtpg"))
 
 
+def rtpg_executable():
+    """The rtpg program that RTPG_BINARY runs: the binary itself, or, where RTPG_BINARY is a script (such as
+    tools/rtpg_device_beside_host.sh), the program the script executes: RTPG, else build/rtpg, as that script
+    chooses it. A script's own bytes do not change when the renderer is rebuilt."""
+    binary = rtpg_binary()
+    with open(binary, "rb") as f:
+        if f.read(2) != b"#!":
+            return binary
+    return Path(os.environ.get("RTPG", ROOT / "build" / "rtpg"))
+
+
+def scene_file_hash(scene):
+    """The scene file's bytes: a scene edited (its bounces, lights, camera) renders another image. Its assets
+    are the shared ones (../shared/scenes), which do not change. 16 hex digits."""
+    return hashlib.sha256(Path(scene_path(scene)).read_bytes()).hexdigest()[:16]
+
+
 def renderer_source_hash(root=ROOT):
     """Hash of every source file a reference may depend on (all of host/, kernels/ and include/ but the
     reference_independent ones): a reference made by other code is stale."""
@@ -60,13 +77,14 @@ def renderer_source_hash(root=ROOT):
 
 
 def binary_fingerprint():
-    """What decides a render besides its arguments: the rtpg executable's bytes (its kernels are embedded)
-    and, where RTPG_KERNEL_DIR overrides those, the kernel files read from there and the public headers
+    """What decides a render besides its arguments: the rtpg executable's bytes (its kernels are embedded;
+    a script's and the program it runs, rtpg_executable) and, where RTPG_KERNEL_DIR overrides those, the kernel files read from there and the public headers
     beside them (<dir>/../include/rtpg, as host/cl/kernel_source.cpp reads them). 16 hex digits."""
     h = hashlib.sha256()
-    with open(rtpg_binary(), "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
+    for program in dict.fromkeys([rtpg_binary(), rtpg_executable()]):
+        with open(program, "rb") as f:
+            for chunk in iter(lambda: f.read(1 << 20), b""):
+                h.update(chunk)
     kernel_dir = os.environ.get("RTPG_KERNEL_DIR")
     if kernel_dir:
         for d in (Path(kernel_dir), Path(kernel_dir).parent / "include" / "rtpg"):
@@ -135,6 +153,22 @@ def median_frame_ms(stats, key="total"):
     return statistics.median(f["time_ms"].get(key, 0.0) for f in frames)
 
 
+def check_built_after_sources(root=ROOT):
+    """A reference is stored under the hash of the sources in the tree, so the program that renders it must
+    have been built from them: one older than a source it depends on (the tree edited, not yet rebuilt; or an
+    older build's copy) would store its image under the new sources' key. Not proof (a copy made later of an
+    old build passes), but it catches the usual slip."""
+    program = rtpg_executable()
+    built = program.stat().st_mtime
+    for d in SOURCE_DIRS:
+        for p in (Path(root) / d).rglob("*"):
+            rel = p.relative_to(root).as_posix()
+            if p.is_file() and p.suffix in (".h", ".hpp", ".cpp", ".cl") and not reference_independent(rel) \
+                    and p.stat().st_mtime > built:
+                raise SystemExit(f"{program} is older than {rel}, which a reference depends on: rebuild it (or "
+                                 "copy the build made from these sources) before rendering references")
+
+
 class ReferenceCache:
     """References cached on disk by scene, resolution, samples, seed, camera and a hash of the
     renderer's sources (so a reference is never reused after the renderer changed)."""
@@ -146,10 +180,8 @@ class ReferenceCache:
         self.timings = {}  # what each reference used in this run cost (_note)
 
     def get(self, scene, res, spp, seed=1000, camera_path="", frame=0, max_bounces=0):
-        # The scene file's bytes too: a scene edited (its bounces, lights, camera) is another image.
-        # Its assets are the shared ones (../shared/scenes), which do not change.
-        scene_hash = hashlib.sha256(Path(scene_path(scene)).read_bytes()).hexdigest()[:16]
-        key = json.dumps([scene, res, spp, seed, camera_path, frame, max_bounces, self.source_hash, scene_hash])
+        key = json.dumps([scene, res, spp, seed, camera_path, frame, max_bounces, self.source_hash,
+                          scene_file_hash(scene)])
         digest = hashlib.sha256(key.encode()).hexdigest()[:20]
         path = self.folder / f"{scene}-{res}-{spp}spp-{digest}.exr"
         timing = self.folder / f"{path.stem}.stats.json"
@@ -158,6 +190,7 @@ class ReferenceCache:
             return path
         args = ["reference", scene_path(scene), "--res", res, "--spp", spp, "--seed", seed, "-o", path, "-q",
                 "--stats-json", timing]
+        check_built_after_sources()
         if camera_path:
             args += ["--camera-path", camera_path, "--frame", frame]
         if max_bounces:

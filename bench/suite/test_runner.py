@@ -49,6 +49,62 @@ class BinaryFingerprintTests(unittest.TestCase):
                         os.environ[k] = v
 
 
+    def test_follows_the_program_a_script_runs(self):
+        """tools/rtpg_device_beside_host.sh as RTPG_BINARY: the script stays the same when the renderer it
+        runs (RTPG) is rebuilt, so the fingerprint must hold that program's bytes too."""
+        with tempfile.TemporaryDirectory() as d:
+            script, program = Path(d) / "wrapper.sh", Path(d) / "rtpg"
+            script.write_text('#!/usr/bin/env bash\nexec "$RTPG" "$@"\n')
+            program.write_bytes(b"first build")
+            saved = {k: os.environ.get(k) for k in ("RTPG_BINARY", "RTPG", "RTPG_KERNEL_DIR")}
+            try:
+                os.environ.update(RTPG_BINARY=str(script), RTPG=str(program))
+                os.environ.pop("RTPG_KERNEL_DIR", None)
+                self.assertEqual(runner.rtpg_executable(), program)
+                base = runner.binary_fingerprint()
+                program.write_bytes(b"second build")
+                self.assertNotEqual(runner.binary_fingerprint(), base)
+                os.environ["RTPG_BINARY"] = str(program)
+                self.assertEqual(runner.rtpg_executable(), program)
+            finally:
+                for k, v in saved.items():
+                    if v is None:
+                        os.environ.pop(k, None)
+                    else:
+                        os.environ[k] = v
+
+
+class BuiltAfterSourcesTests(unittest.TestCase):
+    def test_a_program_older_than_a_reference_source_is_refused(self):
+        """A reference is stored under the tree's source hash: a program built before a source it depends
+        on changed (the tree not rebuilt) must not render it. Sources no reference depends on do not count."""
+        with tempfile.TemporaryDirectory() as d:
+            root = Path(d)
+            for rel in ("host/render/path_tracer.cpp", "host/guiding/guider.cpp"):
+                (root / rel).parent.mkdir(parents=True, exist_ok=True)
+                (root / rel).write_text("// " + rel + "\n")
+            program = root / "rtpg"
+            program.write_bytes(b"build")
+            saved = os.environ.get("RTPG_BINARY")
+            try:
+                os.environ["RTPG_BINARY"] = str(program)
+                os.utime(program, (2000, 2000))
+                for rel in ("host/render/path_tracer.cpp", "host/guiding/guider.cpp"):
+                    os.utime(root / rel, (1000, 1000))
+                runner.check_built_after_sources(root)  # built after every source
+                os.utime(root / "host/guiding/guider.cpp", (3000, 3000))
+                runner.check_built_after_sources(root)  # the guider: no reference depends on it
+                os.utime(root / "host/render/path_tracer.cpp", (3000, 3000))
+                with self.assertRaises(SystemExit) as refused:
+                    runner.check_built_after_sources(root)
+                self.assertIn("host/render/path_tracer.cpp", str(refused.exception))
+            finally:
+                if saved is None:
+                    os.environ.pop("RTPG_BINARY", None)
+                else:
+                    os.environ["RTPG_BINARY"] = saved
+
+
 class ReferenceSourceTests(unittest.TestCase):
     def test_host_path_tracer_sources_count_and_device_only_ones_do_not(self):
         for rel in ("host/render/path_tracer.cpp", "host/scene/scene.cpp", "host/trace/embree_scene.cpp",
@@ -99,8 +155,9 @@ class ReferenceSceneTests(unittest.TestCase):
                 rendered.append(out)
                 return ""
 
-            saved = (runner.run, runner.scene_path)
+            saved = (runner.run, runner.scene_path, runner.check_built_after_sources)
             runner.run, runner.scene_path = fake_run, lambda name: str(root / f"{name}.json")
+            runner.check_built_after_sources = lambda: None  # no program is run
             try:
                 cache = runner.ReferenceCache(root / "refs")
                 first = cache.get("box", "8x8", 4)
@@ -111,7 +168,7 @@ class ReferenceSceneTests(unittest.TestCase):
                 self.assertNotEqual(second, first)
                 self.assertEqual(len(rendered), 2)
             finally:
-                runner.run, runner.scene_path = saved
+                runner.run, runner.scene_path, runner.check_built_after_sources = saved
 
 
 if __name__ == "__main__":

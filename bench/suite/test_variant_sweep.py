@@ -48,6 +48,26 @@ class Statistics(unittest.TestCase):
         self.assertEqual(text.splitlines()[2], "| a | 0.500 ± 0.010 | 1.000 ± 0.020 | 0.750 |")
 
 
+class CacheKey(unittest.TestCase):
+    def test_follows_the_scene_files_bytes(self):
+        """A run cached before its scene file was edited is not served after: its errors were against
+        the old scene's reference."""
+        with tempfile.TemporaryDirectory() as d:
+            scene = Path(d) / "box.json"
+            scene.write_text('{"integrator": {"max_bounces": 2}}\n')
+            saved = runner.scene_path
+            runner.scene_path = lambda name: str(Path(d) / f"{name}.json")
+            try:
+                def key():
+                    return variant_sweep.cache_key("b", "box", ["--pg-k-max", 2], "8x8", 4, 16, 1)
+                first = key()
+                self.assertEqual(key(), first)
+                scene.write_text('{"integrator": {"max_bounces": 8}}\n')
+                self.assertNotEqual(key(), first)
+            finally:
+                runner.scene_path = saved
+
+
 class EndToEnd(unittest.TestCase):
     def test_tiny_sweep(self):
         with tempfile.TemporaryDirectory() as out:

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -12,6 +13,7 @@
 
 #include <fmt/format.h>
 #include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
 #include "rtpg/cl_runtime.h"
@@ -43,14 +45,16 @@ std::string extension_of(const std::string& path) {
 }
 
 // Every output's folder is checked before any work, so that a bad path fails before an
-// earlier output of the same run has been written; so is the output itself, which must not be
-// an existing folder (the rename into place would fail only after the render and the other
+// earlier output of the same run has been written: it must exist and take a new file (a
+// folder such as /proc exists and refuses one); so is the output itself, which must not be an
+// existing folder (the rename into place would fail only after the render and the other
 // outputs).
 void check_output_folder(const std::string& path) {
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty() && !fs::is_directory(parent))
     throw InputError(path, "folder '" + parent.string() + "' does not exist");
   if (fs::is_directory(path)) throw InputError(path, "is a folder, not a file");
+  check_can_create(path);
 }
 
 // A file named by a flag: an output the run writes, or an input it reads.
@@ -257,6 +261,20 @@ std::string frame_output_path(const std::string& output, int frame) {
       .string();
 }
 
+// The host threads that ran the parallel loops: --threads caps TBB's pool (global_control, which
+// the arena's own concurrency does not show), and the pool never grows past the cores there are.
+int host_threads() {
+  return static_cast<int>(std::min<std::size_t>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+      static_cast<std::size_t>(tbb::this_task_arena::max_concurrency())));
+}
+
+// The statistics as text; a string that is not UTF-8 (a scene file's name in another encoding)
+// has its bad bytes replaced rather than failing the run after its images were written.
+std::string dump_json(const nlohmann::json& stats) {
+  return stats.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
 std::string default_scene_path() {
   if (fs::exists("scenes/cornell-box.json")) return "scenes/cornell-box.json";
   return std::string(RTPG_SOURCE_DIR) + "/scenes/cornell-box.json";
@@ -279,6 +297,14 @@ int run_render(const RenderCommand& command) {
       throw InputError("--save-frames", fmt::format("frame {} is outside 0..{} (--frames {})", f,
                                                     command.frames - 1, command.frames));
   check_max_bounces(command.max_bounces);
+  if (command.accumulate && !command.settings.camera_path.empty())
+    throw InputError("--accumulate", "needs a static camera: it would average the views along '" +
+                                         command.settings.camera_path + "'");
+  // CLI11's ranges let NaN through (no comparison with it is true).
+  if (std::isnan(command.world_guide_min_pi))
+    throw InputError("--world-guide-min-pi", "must be a number in [0, 1]");
+  if (std::isnan(command.world_guide_pi_max))
+    throw InputError("--world-guide-pi-max", "must be a number in [0, 1)");
   {
     std::vector<NamedFile> outputs = {{"--output", command.output},
                                       {"--noisy-output", command.noisy_output},
@@ -384,7 +410,9 @@ int run_render(const RenderCommand& command) {
     std::map<std::string, std::string> m = metadata;
     m["frame"] = std::to_string(f);
     m["accumulated_frames"] = std::to_string(accumulator ? f + 1 : 1);
-    m["render_time_ms"] = fmt::format("{:.3f}", totals.back());
+    // The time the image took: with --accumulate every frame it averages (frames 0..f).
+    m["render_time_ms"] = fmt::format(
+        "{:.3f}", accumulator ? std::accumulate(totals.begin(), totals.end(), 0.0) : totals.back());
     write_output(path, out, cl, m, scene.exposure);
   };
   // The unfiltered frame (with --denoise) to --noisy-output or its --save-frames file.
@@ -502,6 +530,14 @@ int run_render(const RenderCommand& command) {
         {"guiding", command.guiding},
         {"guiding_settings",
          guiding_settings_json(command.guiding_settings, command.settings.height)},
+        {"guide_vertices", command.guide_vertices},
+        {"world_guide",
+         {{"resolution", command.world_guide_resolution},
+          {"max_depth", command.world_guide_max_depth},
+          {"record_every", command.world_guide_record_every},
+          {"min_pi", command.world_guide_min_pi},
+          {"pi_max", settings.world_guide_settings.em.pi_max}}},
+        {"reference", command.reference},
         {"denoise", command.denoise},
         {"svgf_settings", settings_json(svgf_settings_table(), command.svgf_settings)},
         {"max_bounces", settings.path_tracer.max_bounces},
@@ -509,11 +545,10 @@ int run_render(const RenderCommand& command) {
         {"camera_frame", settings.camera_frame},
         {"frame_count", command.frames},
         {"device", cl.info().device_name},
-        {"threads",
-         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)},
+        {"threads", host_threads()},
         {"bvh_build_ms", renderer.tracer().build_seconds() * 1e3},
         {"frames", frames}};
-    write_text_atomically(command.stats_json, stats.dump(2) + "\n");
+    write_text_atomically(command.stats_json, dump_json(stats));
   }
   if (!command.common.quiet) {
     std::printf(
@@ -591,10 +626,9 @@ int run_reference(const ReferenceCommand& command) {
                                   {"spp", command.spp},
                                   {"seconds", seconds},
                                   {"samples_per_second", samples_per_second},
-                                  {"threads", tbb::global_control::active_value(
-                                                  tbb::global_control::max_allowed_parallelism)},
+                                  {"threads", host_threads()},
                                   {"nonfinite_samples", nonfinite}};
-    write_text_atomically(command.stats_json, stats.dump(2) + "\n");
+    write_text_atomically(command.stats_json, dump_json(stats));
   }
   if (!command.common.quiet)
     std::printf("reference %s: %dx%d, %d spp in %.1f s (%.2f M samples/s) -> %s\n",

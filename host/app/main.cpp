@@ -16,21 +16,30 @@
 
 namespace {
 
-void add_common(CLI::App* cmd, rtpg::CommonArguments& common, bool scene_required) {
+// What a subcommand uses besides its scene: an OpenCL device (render; reference and info run on
+// the host alone), host threads and a quiet mode (render and reference; info only prints). A
+// subcommand offers only the options it uses, so that none is parsed and ignored.
+enum CommonOptions { kSceneOnly = 0, kHostWork = 1, kDevice = 2 };
+
+void add_common(CLI::App* cmd, rtpg::CommonArguments& common, bool scene_required, int options) {
   auto* scene =
       cmd->add_option("scene", common.scene, "Scene JSON file (default: scenes/cornell-box.json)");
   if (scene_required) scene->required();
   cmd->add_option("--asset-root", common.asset_root,
                   "Folder for scene assets (default: $RTPG_ASSET_ROOT, else ../shared/scenes)");
-  cmd->add_option("--device", common.device,
-                  "OpenCL device: gpu, cpu, P:D or part of its name (default: $RTPG_DEVICE, else a "
-                  "GPU, else the CPU)");
-  cmd->add_option("--threads", common.threads,
-                  "Host threads for tracing and shading (0: one per core); OpenCL devices on "
-                  "the CPU keep their own (PoCL: POCL_MAX_PTHREAD_COUNT)")
-      ->check(CLI::Range(0, 4096))
-      ->capture_default_str();
-  cmd->add_flag("-q,--quiet", common.quiet, "Print nothing but errors");
+  if (options & kDevice)
+    cmd->add_option("--device", common.device,
+                    "OpenCL device: gpu, cpu, P:D or part of its name (default: $RTPG_DEVICE, "
+                    "else a GPU, else the CPU)");
+  if (options & kHostWork) {
+    cmd->add_option("--threads", common.threads,
+                    "Host threads for tracing and shading (0: one per core; at most the cores "
+                    "there are); OpenCL devices on the CPU keep their own (PoCL: "
+                    "POCL_MAX_PTHREAD_COUNT)")
+        ->check(CLI::Range(0, 4096))
+        ->capture_default_str();
+    cmd->add_flag("-q,--quiet", common.quiet, "Print nothing but errors");
+  }
 }
 
 // "--pg-" and the setting's name with '-' for '_': every row of the guiding settings table
@@ -185,7 +194,7 @@ int main(int argc, char** argv) {
   rtpg::RenderCommand render;
   std::string render_res = "640x360";
   auto* render_cmd = app.add_subcommand("render", "Render frames of a scene");
-  add_common(render_cmd, render.common, false);
+  add_common(render_cmd, render.common, false, kHostWork | kDevice);
   render_cmd->add_option("--res", render_res, "Resolution WxH")->capture_default_str();
   render_cmd->add_option("--spp", render.settings.spp, "Samples per pixel per frame")
       ->capture_default_str();
@@ -222,7 +231,8 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--reference", render.reference, "Reference EXR: relMSE per frame");
   render_cmd->add_flag(
       "--accumulate", render.accumulate,
-      "Output the running mean of all frames (static camera); adds relmse_accumulated");
+      "Output the running mean of all frames (a static camera: not with --camera-path); adds "
+      "relmse_accumulated");
   render_cmd->add_option("--stats-json", render.stats_json, "Write per-frame statistics as JSON");
   add_guiding_options(render_cmd, render);
   add_denoise_options(render_cmd, render);
@@ -230,7 +240,7 @@ int main(int argc, char** argv) {
   rtpg::ReferenceCommand reference;
   std::string reference_res = "640x360";
   auto* reference_cmd = app.add_subcommand("reference", "Render a many-sample reference image");
-  add_common(reference_cmd, reference.common, true);
+  add_common(reference_cmd, reference.common, true, kHostWork);
   reference_cmd->add_option("--res", reference_res, "Resolution WxH")->capture_default_str();
   reference_cmd->add_option("--spp", reference.spp, "Samples per pixel")->capture_default_str();
   reference_cmd->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
@@ -248,7 +258,7 @@ int main(int argc, char** argv) {
 
   rtpg::CommonArguments info;
   auto* info_cmd = app.add_subcommand("info", "Describe a scene");
-  add_common(info_cmd, info, true);
+  add_common(info_cmd, info, true, kSceneOnly);
 
   app.add_subcommand("devices", "List OpenCL devices");
 

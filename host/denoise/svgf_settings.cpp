@@ -18,7 +18,9 @@ constexpr auto integer = &SvgfSettingInfo::integer;
 const std::vector<SvgfSettingInfo>& svgf_settings_table() {
   static const std::vector<SvgfSettingInfo> table = {
       real("alpha_colour", &S::alpha_colour, 0, 1, false, false,
-           "Temporal blend weight of the new frame's illumination (0: plain mean of the history)"),
+           "Temporal blend weight of the new frame's illumination; the weight is at least "
+           "1 / history length (0: the mean of the history until max_history frames, then "
+           "1 / max_history)"),
       real("alpha_moments", &S::alpha_moments, 0, 1, false, false,
            "Temporal blend weight of the new frame's luminance moments"),
       integer("max_history", &S::max_history, 1, 1e6, "History length cap in frames"),
@@ -71,6 +73,12 @@ void validate(const SvgfSettings& s) {
     throw InputError("svgf settings", "history_iteration (" + std::to_string(s.history_iteration) +
                                           ") must be below iterations (" +
                                           std::to_string(s.iterations) + ")");
+  // A history capped below min_history would never reach it: every pixel would take the spatial
+  // estimate every frame, for good.
+  if (s.max_history < s.min_history)
+    throw InputError("svgf settings", "max_history (" + std::to_string(s.max_history) +
+                                          ") must be at least min_history (" +
+                                          std::to_string(s.min_history) + ")");
   if ((s.local_x == 0) != (s.local_y == 0))
     throw InputError("svgf settings", "local_x = " + std::to_string(s.local_x) +
                                           " and local_y = " + std::to_string(s.local_y) +

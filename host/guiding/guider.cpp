@@ -182,20 +182,21 @@ void Guider::reset() {
   const std::vector<float> zeros(
       std::max(n, std::max(sample_launch_.groups, train_launch_.groups)) * 4, 0.0f);
   translate_cl_errors([&] {
+    // Blocking writes: the host vector must outlive them, also when one of them fails and the
+    // exception unwinds past it (a non-blocking write would go on reading freed memory).
     for (State& s : state_) {
-      runtime_.queue().enqueueWriteBuffer(s.state0, CL_FALSE, 0, n * 16, zeros.data());
-      runtime_.queue().enqueueWriteBuffer(s.state1, CL_FALSE, 0, n * 16, zeros.data());
+      runtime_.queue().enqueueWriteBuffer(s.state0, CL_TRUE, 0, n * 16, zeros.data());
+      runtime_.queue().enqueueWriteBuffer(s.state1, CL_TRUE, 0, n * 16, zeros.data());
     }
     // No counts before the first sample() and train().
-    runtime_.queue().enqueueWriteBuffer(sample_counts_, CL_FALSE, 0, sample_count_record_bytes(),
+    runtime_.queue().enqueueWriteBuffer(sample_counts_, CL_TRUE, 0, sample_count_record_bytes(),
                                         zeros.data());
-    runtime_.queue().enqueueWriteBuffer(train_counts_, CL_FALSE, 0, train_count_record_bytes(),
+    runtime_.queue().enqueueWriteBuffer(train_counts_, CL_TRUE, 0, train_count_record_bytes(),
                                         zeros.data());
     // No pixel shares before a kernel decides (and a kernel that read the flags undecided would
     // read zeros, not uninitialised memory, under Oclgrind).
-    runtime_.queue().enqueueWriteBuffer(shares_model_, CL_FALSE, 0, n * PG_SHARES_MODEL_BYTES,
+    runtime_.queue().enqueueWriteBuffer(shares_model_, CL_TRUE, 0, n * PG_SHARES_MODEL_BYTES,
                                         zeros.data());
-    runtime_.queue().finish();  // the host vectors must outlive the writes
   });
   sharing_ = Sharing::undecided;
 }
@@ -474,7 +475,9 @@ void Guider::read_state(std::vector<float>& state) {
   const std::size_t n = static_cast<std::size_t>(width_) * height_;
   std::vector<float> s0(n * 4), s1(n * 4);
   translate_cl_errors([&] {
-    runtime_.queue().enqueueReadBuffer(state_[current_].state0, CL_FALSE, 0, n * 16, s0.data());
+    // Both blocking: were the first left running, a failure of the second would free s0 under
+    // it.
+    runtime_.queue().enqueueReadBuffer(state_[current_].state0, CL_TRUE, 0, n * 16, s0.data());
     runtime_.queue().enqueueReadBuffer(state_[current_].state1, CL_TRUE, 0, n * 16, s1.data());
   });
   state.resize(n * PG_STATE_FLOATS_PER_PIXEL);
@@ -498,7 +501,8 @@ void Guider::write_state(const std::vector<float>& state) {
       s1[i * 4 + c] = state[i * 8 + 4 + c];
     }
   translate_cl_errors([&] {
-    runtime_.queue().enqueueWriteBuffer(state_[current_].state0, CL_FALSE, 0, n * 16, s0.data());
+    // Both blocking, as in read_state.
+    runtime_.queue().enqueueWriteBuffer(state_[current_].state0, CL_TRUE, 0, n * 16, s0.data());
     runtime_.queue().enqueueWriteBuffer(state_[current_].state1, CL_TRUE, 0, n * 16, s1.data());
   });
 }

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -15,6 +16,33 @@
 
 namespace rtpg {
 namespace {
+
+// A frame's G-buffer and VPLs must be of the sampler's size, every channel whole, before
+// anything is copied, wrapped or swapped: a G-buffer of the same pixel count in another shape
+// (32x64 for 64x32) would pass every byte-size check and be read at the wrong width, and a short
+// channel copied through staging would leave the rest of the device buffer as it was.
+void check_frame_size(const GBuffer& g, const Guider& guider) {
+  if (g.width != guider.width() || g.height != guider.height())
+    throw GuiderError(fmt::format("guided first bounce: a {}x{} G-buffer for a {}x{} sampler",
+                                  g.width, g.height, guider.width(), guider.height()));
+  const std::size_t n = g.pixel_count();
+#define RTPG_CHECK_CHANNEL(name, type, bytes)                                                 \
+  if (g.name.size() != n)                                                                     \
+    throw GuiderError(fmt::format("guided first bounce: G-buffer channel " #name " holds {} " \
+                                  "pixels, not {}",                                           \
+                                  g.name.size(), n));
+  PG_GBUFFER_CHANNELS(RTPG_CHECK_CHANNEL)
+#undef RTPG_CHECK_CHANNEL
+}
+
+void check_vpl_size(const VplBuffer& vpls, std::size_t n) {
+#define RTPG_CHECK_CHANNEL(name, type, bytes)                                                    \
+  if (vpls.name.size() != n)                                                                     \
+    throw GuiderError(fmt::format("guided first bounce: VPL channel " #name " holds {}, not {}", \
+                                  vpls.name.size(), n));
+  PG_VPL_CHANNELS(RTPG_CHECK_CHANNEL)
+#undef RTPG_CHECK_CHANNEL
+}
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point start) {
@@ -108,6 +136,7 @@ GuidedFirstBounce::GuidedFirstBounce(ClRuntime& runtime, int width, int height,
       pixels_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height)) {
   transfer_ = resolve_host_transfer(transfer, runtime.info().host_unified_memory);
   zero_copy_ = transfer_ == HostTransfer::in_place;
+  shares_host_memory_ = runtime.info().host_unified_memory;
   // The training's automatic overlap: only where the device has cores of its own to work on
   // while the host works; on PoCL's CPU device the kernels and the host share the cores
   // (docs/guiding.md, "Training overlapped with the next frame's host work"). The sampling's:
@@ -217,6 +246,7 @@ void GuidedFirstBounce::finish_training() {
 }
 
 void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& at) {
+  check_frame_size(g, *guider_);
   bytes_ = 0;
   // Last frame's training, left running by end_frame: the staging the G-buffer goes up through,
   // and the host memory it read in place, are free once it is done. Its figures (train,
@@ -248,6 +278,7 @@ void GuidedFirstBounce::begin_frame(const GBuffer& g, const SampleCoordinates& a
           "G-buffers (FirstBounceSampler::reads_gbuffers_in_place)");
     current_gbuffer_ = wrap_host_gbuffer(runtime_.context(), g);
     current_host_ = g.position_depth.data();
+    if (!shares_host_memory_) bytes_ += kGBufferBytes * g.pixel_count();
   } else {
     const int next = 1 - owned_current_;
     if (packed_) {
@@ -349,6 +380,7 @@ void GuidedFirstBounce::enqueue_sample_transfer(SampleOutputs outputs) {
       }
       mapped_ = true;
     });
+    if (!shares_host_memory_) bytes_ += sample_bytes_per_pixel(outputs) * n;
     return;
   }
   if (host_reads_mixture_) {
@@ -425,10 +457,13 @@ void GuidedFirstBounce::end_frame(const GBuffer& g, const VplBuffer& vpls,
   previous_gbuffer_ = GuiderGBuffer{};
   count_models();
   if (!training_) return;
+  check_frame_size(g, *guider_);
+  if (!packed_) check_vpl_size(vpls, g.pixel_count());
   const auto t = Clock::now();
   GuiderVpls device_vpls = owned_vpls_;
   if (zero_copy_) {
     device_vpls = wrap_host_vpls(runtime_.context(), vpls);  // released when train is done
+    if (!shares_host_memory_) bytes_ += kVplBytes * g.pixel_count();
   } else if (packed_) {
     // The path tracer wrote them packed (VplBuffer::for_bus, which the renderer sets from
     // sends_packed_vpls()).
@@ -484,7 +519,9 @@ void GuidedFirstBounce::report(std::map<std::string, double>& time_ms,
   extra["train_lanes"] = guider_->train_lanes();
   extra["sample_lanes"] = guider_->sample_lanes();
   extra["row_work_groups"] = guider_->row_work_groups() ? 1.0 : 0.0;
-  extra["zero_copy"] = zero_copy_ ? 1.0 : 0.0;
+  // 1 where nothing but the count records crosses: read in place, and the device shares host
+  // memory.
+  extra["zero_copy"] = zero_copy_ && shares_host_memory_ ? 1.0 : 0.0;
   extra["train_overlap"] = overlap_ ? 1.0 : 0.0;
   extra["sample_overlap"] = sample_overlap_ ? 1.0 : 0.0;
   // HostTransfer as a number: 1 in place, 2 pinned, 3 pageable, 4 packed.

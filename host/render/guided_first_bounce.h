@@ -125,6 +125,10 @@ class GuidedFirstBounce final : public FirstBounceSampler {
   void unmap_samples();
   HostTransfer transfer_ = HostTransfer::automatic;
   bool zero_copy_ = false, mapped_ = false;
+  // Whether the device shares host memory (DeviceInfo::host_unified_memory): where it does not,
+  // what zero_copy_ reads in place still crosses the bus (the OpenCL implementation copies it),
+  // and the traffic counted says so.
+  bool shares_host_memory_ = false;
   // HostTransfer::packed: the G-buffer goes up packed into packed_gbuffer_ and the device
   // unpacks it into current_gbuffer_ (Guider::unpack_gbuffer).
   bool packed_ = false;

@@ -5,26 +5,16 @@
 #include <filesystem>
 #include <memory>
 
-#include <unistd.h>
-
 #include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include "rtpg/errors.h"
 #include "rtpg/image_size.h"
+#include "util/atomic_file.h"
 
 namespace rtpg {
 namespace fs = std::filesystem;
 namespace {
-
-// "dir/.name.tmp-<pid>.ext": same folder (so rename is atomic), same extension (OpenImageIO
-// picks the format from it).
-std::string temporary_path_for(const std::string& path) {
-  const fs::path p(path);
-  const std::string name =
-      "." + p.stem().string() + ".tmp-" + std::to_string(::getpid()) + p.extension().string();
-  return (p.parent_path() / name).string();
-}
 
 void write_atomically(const std::string& path, int width, int height, int channels,
                       OIIO::TypeDesc type, const void* data,

@@ -536,7 +536,9 @@ void PathTracer::shade_bounce(int depth, VplBuffer* vpls, RayCounts& rays) {
 
       const float u_sel = shared::pg_rng_next(&rng), u1 = shared::pg_rng_next(&rng),
                   u2 = shared::pg_rng_next(&rng);
-      PixelGuide guide;
+      // Read only where `guided` (borrow_guide or the world guide filled it); zeroed, since the
+      // link-time analysis cannot see that through the two calls.
+      PixelGuide guide{};
       // A borrowed lobe is the lending pixel's product of incident light and its BSDF for its
       // own view direction: it carries over to a vertex whose reflection is mostly diffuse
       // (view-independent), not to a glossy one seen from elsewhere. The world guide's cells

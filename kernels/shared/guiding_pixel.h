@@ -49,17 +49,22 @@ typedef struct {
  * sharable, the same surface by reprojection's test (pg_same_surface), and shading normals
  * within about 1.1 degrees: the model is used in a's frame as it is, and a bump map's normals
  * vary from pixel to pixel (Sponza at 960x540, rows in pairs: 25 degrees +4.8% error, 8
- * degrees +2.4%, 1.1 degrees +0.8%). Where it holds, the sample kernel also writes m's state
- * as a's own, which train then leaves alone: a pixel that stops sharing (its jittered normal
- * or position moves, the camera moves) starts from its neighbour's model instead of from the
- * untrained state it would otherwise have kept (docs/guiding.md, "Models shared by rows"). */
+ * degrees +2.4%, 1.1 degrees +0.8%). Close normals give close frames only on one side of the
+ * z = 0 plane: pg_frame_from_normal's tangent turns half a turn about the normal where n.z
+ * changes sign (pmm.h, pg_pmm_needs_reframe), so on a wall facing x or y a lobe used across it
+ * would point the other way; the two normals' z must have one sign. Where it holds, the sample
+ * kernel also writes m's state as a's own, which train then leaves alone: a pixel that stops
+ * sharing (its jittered normal or position moves, the camera moves) starts from its neighbour's
+ * model instead of from the untrained state it would otherwise have kept (docs/guiding.md, "Models
+ * shared by rows"). */
 #define PG_SHARED_MODEL_MIN_NORMAL_COS 0.9998f
 PG_FN int pg_shares_model(pg_sharing_pixel a, pg_sharing_pixel m, pg_kernel_settings p) {
   return pg_model_sharable(a.flags, a.base_color_roughness, a.metallic_specular, p) &&
          pg_model_sharable(m.flags, m.base_color_roughness, m.metallic_specular, p) &&
          pg_same_surface(a.position_depth, a.normal, a.material, m.position_depth, m.normal,
                          m.material, p.reproject_position,
-                         fmax(p.reproject_normal, PG_SHARED_MODEL_MIN_NORMAL_COS));
+                         fmax(p.reproject_normal, PG_SHARED_MODEL_MIN_NORMAL_COS)) &&
+         copysign(1.0f, a.normal.z) == copysign(1.0f, m.normal.z);
 }
 
 #ifdef __OPENCL_C_VERSION__

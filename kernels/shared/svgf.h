@@ -330,7 +330,11 @@ PG_FN float pg_svgf_edge_weight(float4 surface_c, float luminance_c, float4 surf
 /* Variance from temporal moments; a short history boosts it (SVGF 4.2: 4 / length) since
  * few frames underestimate it. */
 PG_FN float pg_svgf_variance(float m1, float m2, float length, float min_history) {
-  float v = fmax(m2 - m1 * m1, 0.0f);
+  /* The square rounded on its own, never fused into the subtraction (the variance pass allows
+   * multiply-adds): where the luminance has been one value l, m2 is l*l rounded, and only the
+   * rounded square cancels it to 0; fused, 2^-24 l^2 of variance would be left. */
+  float square = m1 * m1;
+  float v = fmax(m2 - square, 0.0f);
   return length < min_history ? v * (min_history / fmax(length, 1.0f)) : v;
 }
 

@@ -53,7 +53,8 @@ static inline pg_intw pg_shares_model_w(PG_ARGS_GBUFFER int x0, int y, int w, pg
           fmax(p.reproject_normal, PG_SHARED_MODEL_MIN_NORMAL_COS)) &
          (pg_load_row_uints(material + row_start, x0, w) ==
           pg_load_row_uints(material + model_start, x0, w)) &
-         (model_depth > 0.0f);
+         (model_depth > 0.0f) &
+         (copysign((pg_floatw)(1.0f), normal.z) == copysign((pg_floatw)(1.0f), model_normal.z));
 }
 
 #endif

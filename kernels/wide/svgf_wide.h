@@ -65,7 +65,8 @@ static inline pg_floatw pg_svgf_edge_weight_w(pg_float3w n_c, pg_floatw z_c, pg_
 /* pg_svgf_variance in the lanes. */
 static inline pg_floatw pg_svgf_variance_w(pg_floatw m1, pg_floatw m2, pg_floatw length,
                                            float min_history) {
-  pg_floatw v = fmax(m2 - m1 * m1, 0.0f);
+  pg_floatw square = m1 * m1; /* not fused: pg_svgf_variance */
+  pg_floatw v = fmax(m2 - square, 0.0f);
   return select(v, v * (min_history / fmax(length, 1.0f)), length < min_history);
 }
 

@@ -15,6 +15,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <sys/wait.h>
@@ -324,6 +325,41 @@ TEST_F(Cli, RejectsStatsJsonInMissingFolderBeforeWritingTheImage) {
       "nowhere");
 }
 
+// A folder that exists and refuses new files (/proc, even to root): found before the render,
+// not after the image was written.
+TEST_F(Cli, RejectsStatsJsonInAFolderThatTakesNoFilesBeforeWritingTheImage) {
+  expect_rejected(
+      "render --res 16x16 --spp 1 --guiding off -o out.exr --stats-json /proc/rtpg-stats.json",
+      "/proc/rtpg-stats.json");
+  expect_rejected(
+      "render --res 16x16 --spp 1 --guiding off -o out.exr --denoise svgf "
+      "--noisy-output /proc/rtpg-noisy.exr",
+      "/proc/rtpg-noisy.exr");
+}
+
+// --accumulate averages frames of one view; along a camera path it would blur the path.
+TEST_F(Cli, RejectsAccumulatingAlongACameraPath) {
+  expect_rejected(render("--res 16x16 --frames 2 --accumulate --camera-path pan"), "--accumulate");
+}
+
+// CLI11's ranges let NaN through: the world guide's two mixing-weight bounds check it.
+TEST_F(Cli, RejectsANanWorldGuideMixingWeight) {
+  expect_rejected(render("--res 16x16 --guide-vertices world --world-guide-min-pi nan"),
+                  "--world-guide-min-pi");
+  expect_rejected(render("--res 16x16 --guide-vertices world --world-guide-pi-max nan"),
+                  "--world-guide-pi-max");
+}
+
+// Options a subcommand would ignore are not offered: reference and info open no OpenCL device,
+// info runs no parallel loops.
+TEST_F(Cli, ReferenceAndInfoOfferNoDevice) {
+  expect_rejected("reference " + source_dir() +
+                      "/scenes/cornell-box.json --res 8x8 --spp 1 "
+                      "-o ref.exr --device cpu",
+                  "--device");
+  expect_rejected("info " + source_dir() + "/scenes/cornell-box.json --threads 1", "--threads");
+}
+
 TEST_F(Cli, RejectsReferenceOfWrongSize) {
   const RunResult made =
       run_rtpg(dir(), "render --res 16x8 --spp 1 --guiding off -q -o reference.exr");
@@ -555,7 +591,7 @@ TEST_F(Cli, StatisticsCarryRelMseAgainstReference) {
   // Another seed: new noise, a positive and finite error in every frame.
   r = run_rtpg(dir(),
                "render --res 32x32 --spp 2 --seed 4 --guiding off -q --frames 2 "
-               "--reference reference.exr --stats-json other.json");
+               "--reference reference.exr --stats-json other.json -o other.exr");
   ASSERT_EQ(r.exit_code, 0) << describe(r);
   const nlohmann::json other = nlohmann::json::parse(read_file(dir() / "other.json"));
   ASSERT_EQ(other["frames"].size(), 2u);
@@ -564,21 +600,59 @@ TEST_F(Cli, StatisticsCarryRelMseAgainstReference) {
     const double relmse = frame["relmse"].get<double>();
     EXPECT_TRUE(std::isfinite(relmse) && relmse > 0.0) << relmse;
   }
+  // The last frame's figure is README's definition, worked out here from the two images: the
+  // mean over pixels and channels of (I - R)^2 / (R^2 + 0.01).
+  const ExrImage image = read_exr(dir() / "other.exr"), ref = read_exr(dir() / "reference.exr");
+  ASSERT_EQ(image.pixels.size(), ref.pixels.size());
+  double sum = 0.0;
+  for (std::size_t k = 0; k < image.pixels.size(); ++k) {
+    const double d = image.pixels[k] - ref.pixels[k], r2 = double(ref.pixels[k]) * ref.pixels[k];
+    sum += d * d / (r2 + 0.01);
+  }
+  const double expected = sum / static_cast<double>(image.pixels.size());
+  EXPECT_NEAR(other["frames"][1]["relmse"].get<double>(), expected, 1e-9 + 1e-6 * expected);
+}
+
+// A scene file whose name is not UTF-8 (Latin-1 bytes): the statistics' JSON replaces the bad
+// byte instead of failing the run after its image was written.
+TEST_F(Cli, StatisticsOfASceneNamedInLatin1) {
+  const std::string name = "sc\xe8ne.json";
+  fs::copy_file(source_dir() + "/scenes/cornell-box.json", dir() / name);
+  const RunResult r = run_rtpg(
+      dir(), "render " + shell_quote(name) + " --res 8x8 -q -o out.exr --stats-json s.json");
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  const nlohmann::json stats = nlohmann::json::parse(read_file(dir() / "s.json"));
+  EXPECT_EQ(stats["frames"].size(), 1u);
 }
 
 TEST_F(Cli, ThreadsChangeNothingButTheThreadCount) {
   // Every parallel loop of the frame sums in an order that does not depend on the threads
-  // (docs/design.md), so one host thread renders the same image, guided and along a camera path,
-  // as every core does; the statistics say how many there were.
-  const std::string common =
-      "render --res 37x21 --frames 3 --spp 2 --seed 9 --camera-path pan -q --stats-json ";
-  RunResult r = run_rtpg(dir(), common + "all.json -o all.exr");
-  ASSERT_EQ(r.exit_code, 0) << describe(r);
-  r = run_rtpg(dir(), common + "one.json -o one.exr --threads 1");
-  ASSERT_EQ(r.exit_code, 0) << describe(r);
-  EXPECT_EQ(read_exr(dir() / "one.exr").pixels, read_exr(dir() / "all.exr").pixels);
+  // (docs/design.md), so one host thread renders the same images, guided and along a camera
+  // path, as every core does; the statistics say how many there were. The image is large enough
+  // that every loop splits (128x96: six of the path tracer's 2048-pixel blocks, several chunks of
+  // every other pixel loop); the bounce rays go grouped, and the second pair trains and samples
+  // the world guide; every frame is compared.
+  for (const std::string variant : {"", " --guide-vertices world"}) {
+    const std::string common =
+        "render --res 128x96 --frames 3 --spp 2 --seed 9 --camera-path pan -q "
+        "--bounce-ray-order grouped --save-frames 0,1" +
+        variant + " --stats-json ";
+    RunResult r = run_rtpg(dir(), common + "all.json -o all.exr");
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    r = run_rtpg(dir(), common + "one.json -o one.exr --threads 1");
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    for (const char* image : {"-f0000.exr", "-f0001.exr", ".exr"})
+      EXPECT_EQ(read_exr(dir() / (std::string("one") + image)).pixels,
+                read_exr(dir() / (std::string("all") + image)).pixels)
+          << image << variant;
+  }
   const nlohmann::json one = nlohmann::json::parse(read_file(dir() / "one.json"));
   EXPECT_EQ(one["threads"].get<int>(), 1);
+  // A limit above the cores is a limit, not the threads that ran.
+  RunResult r = run_rtpg(dir(), "render --res 8x8 -q --threads 4096 --stats-json many.json");
+  ASSERT_EQ(r.exit_code, 0) << describe(r);
+  const nlohmann::json many = nlohmann::json::parse(read_file(dir() / "many.json"));
+  EXPECT_LE(many["threads"].get<unsigned>(), std::max(1u, std::thread::hardware_concurrency()));
   r = run_rtpg(dir(), "render --res 8x8 -q --threads -2");
   EXPECT_EQ(r.exit_code, 2) << describe(r);
   EXPECT_NE(r.err.find("--threads"), std::string::npos) << describe(r);

@@ -465,6 +465,54 @@ TEST(SvgfKernels, EdgesOfDepthAndNormalAreNotBlurred) {
     }
 }
 
+// The same two edges where only depth and normal can stop the filter: both sides about equally
+// bright (luminance 0.186 and 0.185) and noisy (a grey factor in [0.5, 1.5] a pixel), so the
+// luminance weight lets taps across; the sides differ in hue (red over green 0.5 on the left, 5
+// on the right). A grey factor keeps each pixel's hue, so any mean of one side's pixels keeps it
+// exactly, and a pixel beside the edge that took light from the other side shows it. (Noiseless
+// sides of different brightness, as above, are kept apart by the luminance weight alone.)
+TEST(SvgfKernels, EdgesOfDepthAndNormalStopTheFilterWhereLuminanceCannot) {
+  ClRuntime rt;
+  const int w = simulated(rt) ? 24 : 64, h = simulated(rt) ? 8 : 24;
+  const glm::vec3 left(0.1f, 0.2f, 0.3f), right(0.5f, 0.1f, 0.1f);
+  for (const int lanes : {1, 0})
+    for (const bool normal_edge : {false, true}) {
+      SCOPED_TRACE(std::string(normal_edge ? "normal edge" : "depth edge") + ", lanes " +
+                   std::to_string(lanes));
+      GBuffer g;
+      g.resize(w, h);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const std::size_t i = static_cast<std::size_t>(y) * w + x;
+          const bool on_right = x >= w / 2;
+          const float depth = on_right && !normal_edge ? 3.0f : 2.0f;
+          g.flags[i] = 0;
+          g.position_depth[i] = glm::vec4(0.01f * x, 0.01f * y, depth, depth);
+          g.shading_normal[i] =
+              on_right && normal_edge ? glm::vec4(1, 0, 0, 0) : glm::vec4(0, 0, 1, 0);
+          g.base_color_roughness[i] = glm::vec4(0.5f, 0.5f, 0.5f, 0.5f);
+        }
+      SvgfSettings s;
+      s.lanes = lanes;
+      SvgfDenoiser device(rt, w, h, s);
+      std::mt19937 rng(5);
+      std::uniform_real_distribution<float> factor(0.5f, 1.5f);
+      std::vector<glm::vec3> out;
+      for (int f = 0; f < 3; ++f) {
+        std::vector<glm::vec3> colour(g.pixel_count());
+        for (std::size_t i = 0; i < colour.size(); ++i)
+          colour[i] = (static_cast<int>(i % w) >= w / 2 ? right : left) * factor(rng);
+        out = device.denoise(colour, g);
+      }
+      for (int y = 0; y < h; ++y)
+        for (int x = w / 2 - 2; x < w / 2 + 2; ++x) {
+          const glm::vec3 c = out[static_cast<std::size_t>(y) * w + x];
+          const float hue = x >= w / 2 ? right.r / right.g : left.r / left.g;
+          ASSERT_NEAR(c.r / c.g, hue, 1e-3f * hue) << "pixel " << x << "," << y;
+        }
+    }
+}
+
 // The a-trous kernels' 1D weights (pg_svgf_atrous_weight, shared by the kernels and the host
 // reference, so the reference comparisons cannot see them): the paper's B3 spline at radius 2
 // (SVGF 4.3: 1/16, 1/4, 3/8, 1/4, 1/16), the linear B-spline at radius 1 (1/4, 1/2, 1/4); each
@@ -546,6 +594,66 @@ TEST(SvgfKernels, TemporalAccumulationConvergesToTheMean) {
     for (double x : image_means) v += (x - m) * (x - m);
     const double se = std::sqrt(v / (runs - 1) / runs);
     EXPECT_NEAR(m, 0.5, 4.0 * se + 1e-6) << "standard error " << se;
+  }
+}
+
+// The temporal pass against its recursion worked out here in double precision, on a plane where
+// every pixel sees one grey value v_f in frame f (so every filter is the identity): colour and
+// moments each blend with their own weight, max(alpha, 1 / length), the length capped at
+// max_history; the variance is m2 - m1^2 once the history is min_history frames long. The values
+// are not symmetric about their mean, so a blend in the wrong direction, or the colour's alpha
+// used for the moments, shows. Then a value held for several frames: its variance must be exactly
+// 0 (m2 is v*v rounded, and so is m1*m1; a multiply-add fused into m2 - m1*m1 leaves 2^-24 v^2,
+// which turned the luminance weight of a noiseless static pixel from a wall into a slope).
+TEST(SvgfKernels, TemporalAccumulationFollowsItsRecursion) {
+  ClRuntime rt;
+  const int w = 16, h = 8;
+  GBuffer g;
+  g.resize(w, h);
+  for (std::size_t i = 0; i < g.pixel_count(); ++i) {
+    g.flags[i] = 0;
+    g.position_depth[i] = glm::vec4(0.01f * (i % w), 0.01f * (i / w), 2.0f, 2.0f);
+    g.shading_normal[i] = glm::vec4(0, 0, 1, 0);
+    g.base_color_roughness[i] = glm::vec4(1.0f, 1.0f, 1.0f, 0.5f);
+  }
+  SvgfSettings s;
+  s.alpha_colour = 0.2f;
+  s.alpha_moments = 0.5f;
+  s.max_history = 3;
+  s.min_history = 2;
+  SvgfDenoiser device(rt, w, h, s);
+  const float values[] = {0.1f, 3.0f, 0.2f, 0.3f, 5.0f, 0.15f};
+  double c = 0.0, m1 = 0.0, m2 = 0.0;
+  for (int f = 0; f < 6; ++f) {
+    SCOPED_TRACE("frame " + std::to_string(f));
+    const float v = values[f];
+    device.denoise(std::vector<glm::vec3>(g.pixel_count(), glm::vec3(v)), g);
+    const double length = std::min(f + 1, 3);
+    const double l = shared::pg_luminance(glm::vec3(v));
+    const double a_colour = std::max(0.2, 1.0 / length), a_moments = std::max(0.5, 1.0 / length);
+    c += (v - c) * a_colour;
+    m1 += (l - m1) * a_moments;
+    m2 += (l * l - m2) * a_moments;
+    const std::vector<glm::vec4> integrated = device.read(SvgfStage::Integrated);
+    const std::vector<glm::vec4> moments = device.read(SvgfStage::Moments);
+    const std::vector<glm::vec4> illumination = device.read(SvgfStage::Illumination);
+    for (std::size_t i = 0; i < g.pixel_count(); i += 37) {
+      ASSERT_NEAR(integrated[i].x, c, 1e-5 * std::max(1.0, c)) << "pixel " << i;
+      ASSERT_NEAR(moments[i].x, m1, 1e-5 * std::max(1.0, m1)) << "pixel " << i;
+      ASSERT_NEAR(moments[i].y, m2, 1e-5 * std::max(1.0, m2)) << "pixel " << i;
+      ASSERT_EQ(moments[i].z, static_cast<float>(length)) << "pixel " << i;
+      if (f >= 1) {  // length >= min_history: the temporal variance, no boost
+        ASSERT_NEAR(illumination[i].w, m2 - m1 * m1, 1e-4 * std::max(1.0, m2)) << "pixel " << i;
+      }
+    }
+  }
+  SvgfDenoiser held(rt, w, h, s);  // 100.01 from the first frame on: the history is that value
+  for (int f = 0; f < 3; ++f) {
+    held.denoise(std::vector<glm::vec3>(g.pixel_count(), glm::vec3(100.01f)), g);
+    if (f == 0) continue;  // a one-frame history takes the spatial estimate
+    const std::vector<glm::vec4> illumination = held.read(SvgfStage::Illumination);
+    for (std::size_t i = 0; i < g.pixel_count(); ++i)
+      ASSERT_EQ(illumination[i].w, 0.0f) << "frame " << f << " pixel " << i;
   }
 }
 
@@ -732,6 +840,10 @@ TEST(SvgfKernels, BadInputIsAClearError) {
   SvgfSettings late;
   late.history_iteration = 5;
   expect_refused(late, "history_iteration");
+  SvgfSettings short_history;  // a cap below min_history: the spatial estimate for good
+  short_history.max_history = 3;
+  short_history.min_history = 4;
+  expect_refused(short_history, "max_history (3) must be at least min_history (4)");
   EXPECT_THROW(SvgfDenoiser(rt, 0, 8), InputError);
   EXPECT_THROW(SvgfDenoiser(rt, 70000, 1), InputError);  // a side beyond rtpg/image_size.h's
   SvgfSettings half_auto;  // a work-group size of 0 is per device in both directions or neither

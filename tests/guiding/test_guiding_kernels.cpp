@@ -160,7 +160,11 @@ HostGBuffer random_gbuffer(Random& r, int w, int h) {
 // later rows shows the surface of the pixel above it in the group's first row (its position a
 // hundredth of a pixel away, its normal and material), and keeps its own flags and material
 // parameters, so that it shares that pixel's model where both are sharable (pg_shares_model).
+// In every sixteenth column the two face -x, half a degree apart, on the two sides of z = 0,
+// where their frames are half a turn apart and no model may be shared.
 void share_rows(HostGBuffer& g, int rows_per_model) {
+  const float4 wall_above(glm::normalize(float3(-1.0f, 0.002f, 0.004f)), 0.0f);
+  const float4 wall_below(glm::normalize(float3(-1.0f, 0.003f, -0.004f)), 0.0f);
   for (int y = 0; y < g.height; ++y)
     for (int x = 0; x < g.width / 2; ++x) {
       const int model_y = y - y % rows_per_model;
@@ -169,6 +173,10 @@ void share_rows(HostGBuffer& g, int rows_per_model) {
       const std::size_t m = static_cast<std::size_t>(model_y) * g.width + x;
       g.position_depth[i] = g.position_depth[m] + float4(1e-4f, 0.0f, 0.0f, 0.0f);
       g.shading_normal[i] = g.shading_normal[m];
+      if (x % 16 == 1) {
+        g.shading_normal[m] = wall_above;
+        g.shading_normal[i] = wall_below;
+      }
       g.material[i] = g.material[m];
     }
 }
@@ -1194,7 +1202,10 @@ TEST(GuidingKernels, ReprojectionFollowsAMovingCamera) {
     const float3 l = sh::pg_to_local(f, lf);
     if (l.z < 0.15f) continue;
     const float2 u = sh::pg_hemisphere_to_square(l);
-    set_state(state0, j, make_state(u.x, u.y, 0.002f, 0.003f, 0.0005f, 0.6f, 10.0f, 1.0f));
+    // Each pixel's lobe carries its own weight S0, so a kept state names the pixel it came from:
+    // a fetch one pixel off on the same object would pass every other check here.
+    const float s0 = 1.0f + 0.01f * static_cast<float>(j % 97);
+    set_state(state0, j, make_state(u.x, u.y, 0.002f, 0.003f, 0.0005f, 0.6f, 10.0f, s0));
   }
   guider.write_state(state0);
   guider.reproject(upload(rt, g1), upload(rt, g0));

@@ -17,6 +17,7 @@
 
 #include "rtpg/guiding_settings.h"
 #include "shared/bsdf.h"
+#include "shared/guiding_pixel.h"
 #include "shared/mapping.h"
 #include "shared/pmm.h"
 #include "shared/pmm_train.h"
@@ -1218,4 +1219,53 @@ TEST(TrainWindow, TheWalkVisitsEveryVplOnceForEveryApron) {
           << "apron " << apron << ", stride " << p.stride << ", start " << start;
     }
   }
+}
+
+// A pixel that shares its row's model (kernels/shared/guiding_pixel.h, pg_shares_model) uses
+// that model in its own frame as it is, so the frames must agree: any square point must give
+// nearly the same world direction through both. Normals near the z = 0 plane (walls facing x or
+// y) are drawn on purpose: there pg_frame_from_normal's tangent turns half a turn about the normal
+// as n.z changes sign, and 0.5-degree-apart normals on both sides once gave lobes 100 degrees
+// apart.
+TEST(SharedModels, EveryAcceptedPairPointsALobeTheSameWayInBothFrames) {
+  rtpg::GuidingSettings settings;
+  settings.rows_per_model = 2;
+  const rtpg::pg_kernel_settings p = rtpg::to_kernel_settings(settings);
+  std::mt19937 gen(41);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  pg_sharing_pixel a{}, m{};
+  a.material = m.material = 1;
+  a.base_color_roughness = m.base_color_roughness = float4(0.5f, 0.5f, 0.5f, 1.0f);
+  a.position_depth = float4(1.0f, 2.0f, 3.0f, 4.0f);
+  m.position_depth = float4(1.0f, 2.0f, 3.001f, 4.0f);
+  int accepted = 0, across_z0 = 0;
+  double worst = 0.0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const float phi = 6.2831853f * uniform(gen);
+    // Half the pairs within 0.01 of z = 0, the others anywhere on the sphere.
+    const bool near_z0 = trial % 2 == 0;
+    const float z = near_z0 ? 0.01f * (2.0f * uniform(gen) - 1.0f) : 2.0f * uniform(gen) - 1.0f;
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    m.normal = float3(r * std::cos(phi), r * std::sin(phi), z);
+    // A second normal up to 1.5 degrees away (some outside the 1.1-degree rule).
+    const float3 across = normalize(
+        cross(m.normal, float3(uniform(gen) - 0.5f, uniform(gen) - 0.5f, uniform(gen) - 0.5f)));
+    a.normal = normalize(m.normal + 0.026f * uniform(gen) * across);
+    if (!pg_shares_model(a, m, p)) continue;
+    ++accepted;
+    across_z0 += (a.normal.z >= 0.0f) != (m.normal.z >= 0.0f);
+    const pg_frame fa = pg_frame_from_normal(a.normal), fm = pg_frame_from_normal(m.normal);
+    for (float u : {0.1f, 0.5f, 0.8f})
+      for (float v : {0.2f, 0.5f, 0.9f}) {
+        const float3 h = pg_square_to_hemisphere(float2(u, v));
+        const double c = dot(pg_to_world(fa, h), pg_to_world(fm, h));
+        worst = std::max(worst, std::acos(std::min(1.0, c)) * 57.29578);
+      }
+  }
+  EXPECT_GT(accepted, 5000);  // the rule is not vacuous
+  EXPECT_EQ(across_z0, 0) << "pairs on both sides of z = 0 share a model";
+  // On one side of z = 0 the frame turns smoothly with the normal (the tangent's derivative is
+  // bounded there), so 1.1 degrees between normals is a few degrees between lobes at most; a
+  // half turn would be 180.
+  EXPECT_LT(worst, 5.0) << "a shared lobe points elsewhere in the sharing pixel's frame";
 }

@@ -229,6 +229,46 @@ TEST(GBufferPacker, ARefusedFrameLeavesTheHistoryAsItWas) {
   EXPECT_GT(kept, 0u);
 }
 
+// A G-buffer of the sampler's pixel count in another shape (7x19 for 19x7), or one of another
+// size, is refused by every transfer before anything is copied or swapped, and the next good
+// frame reprojects as if the bad one had never come (the same state as a sampler that never saw
+// it). Before, a transposed G-buffer passed every byte-size check, and a smaller one went up
+// through pinned staging as far as it reached, the rest of the device buffer left as it was.
+TEST(GBufferPacker, AGBufferOfAnotherShapeIsRefusedAndLeavesTheHistory) {
+  ClRuntime cl;
+  GBuffer g = varied_gbuffer(19, 7, 5);
+  const GBuffer transposed = varied_gbuffer(7, 19, 5), smaller = varied_gbuffer(8, 7, 5);
+  for (HostTransfer transfer : {HostTransfer::in_place, HostTransfer::pinned, HostTransfer::packed,
+                                HostTransfer::pageable}) {
+    SCOPED_TRACE(static_cast<int>(transfer));
+    GuidedFirstBounce refused(cl, 19, 7, GuidingSettings{}, transfer, Overlap::off);
+    GuidedFirstBounce clean(cl, 19, 7, GuidingSettings{}, transfer, Overlap::off);
+    // In place the two frames must be two G-buffers (reads_gbuffers_in_place).
+    GBuffer second = g;
+    std::vector<float> state;
+    for (GuidedFirstBounce* sampler : {&refused, &clean}) {
+      sampler->begin_frame(g, SampleCoordinates{1, 0, 0});
+      sampler->guider().read_state(state);
+      for (std::size_t i = 0; i < state.size(); ++i) state[i] += 0.125f * static_cast<float>(i % 5);
+      sampler->guider().write_state(state);
+    }
+    for (const GBuffer* bad : {&transposed, &smaller}) {
+      try {
+        refused.begin_frame(*bad, SampleCoordinates{1, 1, 0});
+        ADD_FAILURE() << "a " << bad->width << "x" << bad->height << " G-buffer was taken";
+      } catch (const GuiderError& e) {
+        EXPECT_NE(std::string(e.what()).find("19x7 sampler"), std::string::npos) << e.what();
+      }
+    }
+    refused.begin_frame(second, SampleCoordinates{1, 2, 0});
+    clean.begin_frame(second, SampleCoordinates{1, 2, 0});
+    std::vector<float> after_refusal, after_clean;
+    refused.guider().read_state(after_refusal);
+    clean.guider().read_state(after_clean);
+    EXPECT_EQ(after_refusal, after_clean);
+  }
+}
+
 // The guided first bounce with --host-transfer packed sends the VPLs in the form the path
 // tracer writes beside the layout (VplBuffer::for_bus, which the renderer sets from
 // sends_packed_vpls()); VPLs without it are refused, naming the flag, not sent as garbage.

@@ -169,10 +169,18 @@ TEST(CameraPath, InterpolatesThroughKeysAndClampsAtTheEnds) {
   expect_vec3_near(path.at(3.0f).position, {1, 2, 0});
   expect_vec3_near(path.at(10.0f).look_at, {1, 2, -1});
   EXPECT_NEAR(path.at(2.0f).fov_y, 0.9f, 1e-6f);  // fov linear between keys
-  // Between keys the position is a smooth curve, near the chord.
-  const glm::vec3 mid = path.at(0.5f).position;
-  EXPECT_GT(mid.x, 0.3f);
-  EXPECT_LT(mid.x, 0.8f);
+  // Between keys, the cubic Hermite curve whose tangents are the keys' central differences in
+  // time (one-sided at the ends), scaled by the segment's duration (scenes/README.md), worked
+  // out by hand: tangents (1, 0, 0), (1/3, 2/3, 0), (0, 1, 0) per second; at s = 1/2 the basis is
+  // (1/2, 1/8, 1/2, -1/8), at s = 1/4 (27/32, 9/64, 5/32, -3/64). Tangents taken per key
+  // instead of per second (uniform Catmull-Rom) give x = 0.5625 at t = 0.5, unscaled by the
+  // second segment's 2 s (1.0417, 0.9583) at t = 2.
+  expect_vec3_near(path.at(0.5f).position, {0.125f + 0.5f - 0.125f / 3.0f, -0.25f / 3.0f, 0.0f});
+  expect_vec3_near(path.at(0.25f).position,
+                   {9.0f / 64.0f + 5.0f / 32.0f - 1.0f / 64.0f, -1.0f / 32.0f, 0.0f});
+  expect_vec3_near(path.at(2.0f).position,
+                   {0.5f + 0.25f / 3.0f + 0.5f, 0.5f / 3.0f + 1.0f - 0.25f, 0.0f});
+  expect_vec3_near(path.at(0.5f).look_at, {0.125f + 0.5f - 0.125f / 3.0f, -0.25f / 3.0f, -1.0f});
 }
 
 TEST(CameraFrame, TopLeftIsUpLeftAndProjectInvertsRayDirection) {
