@@ -37,14 +37,14 @@
 //   roofline_fraction    roofline_ms / kernel time (1: at the roof; 0.5: within 2x)
 // Bytes per pixel, counted from the inputs along each pixel's path through the kernel (each
 // buffer element counted once, at its full width; a pixel's neighbours' VPLs are the same
-// memory as its own, so the VPL buffers count 48 bytes per pixel):
+// memory as its own, so the VPL buffers count 32 bytes per pixel):
 //   reproject  flags 4 + base_color_roughness 16 + state out 32; guided pixels + motion 8;
 //              inside the image + position_depth 2x16 + normal 2x16 + material 2x4;
 //              accepted + last frame's state 32
 //   sample     flags 4 + direction_pdf/strategy out 20 (the renderer's SampleOutputs::
 //              directions: no mixture); surfaces + bcr, normal, view, metallic 4x16; guided +
 //              state 32
-//   train      state in 32 + out 32 + flags 4 + bcr 16 + VPLs 48; guided + position, normal,
+//   train      state in 32 + out 32 + flags 4 + bcr 16 + VPLs 32; guided + position, normal,
 //              view, metallic 4x16 (the work-groups' count records: a few bytes per group)
 // FrameTraffic/WxH/{pageable,pinned}: one guided frame's copies between host and device when
 // they do not share memory (G-buffer and VPLs up, the samples' directions, densities and

@@ -195,7 +195,9 @@ static float pg_train_lanes(PG_ARGS_GBUFFER PG_ARGS_VPLS PG_ARGS_STATE
     for (int s = 0; s < most_samples; ++s)
       b = pg_pmm_batch_add_w(b, m, terms, settings, samples[s], history_weight);
     pg_intw live = ~done, step;
-    /* A re-seed replaces the history: later passes refine the new model alone. */
+    /* A re-seed replaces the history with a new model, the batch's plain moments, which later
+     * passes' responsibilities do not change: they give the same state again (spent work, at
+     * most em_passes - 1 passes of a re-seeding pixel). */
     base = pg_pmm_state_select_w(base, pg_pmm_initial_state_w(),
                                  live & pg_pmm_batch_reseeds_w(b, settings));
     pg_pmm_state_w next = pg_pmm_update_w(base, b, settings, target, &step);

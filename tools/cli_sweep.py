@@ -5,12 +5,16 @@ Each run draws 1-8 options from the table below (every rendering, guiding and de
 of the CLI, at ordinary and extreme values) and an image of 1-65 x 1-31 pixels, and must end in
 one of two ways:
 - success: exit status 0, the stats JSON with one record per frame and no non-finite sample, the
-  output EXR written;
-- a clear refusal: exit status 1 or 2, a last line of stderr that starts with "rtpg:", and no
-  output file left behind (docs/robustness.md: bad input gets a clear error and no half-written
-  output).
-Anything else (a signal, another status, an unnamed message, a missing or half-written file) is
-reported with its command line, and the exit status is 1. Fixed seeds: the same --seed draws the
+  output image written, and no NaN or infinite value in the EXRs written (`oiiotool --stats`: the
+  denoised and accumulated images come after the renderer's own count);
+- a clear refusal: exit status 2 (an input the program refuses), a last line of stderr that starts
+  with "rtpg:", and no output file left behind (docs/robustness.md: bad input gets a clear error
+  and no half-written output).
+Anything else (a signal, exit 1, an internal exception; exit 3, an OpenCL failure, such as a
+kernel that does not build for a valid combination of settings; an unnamed message, a missing or
+half-written file) is reported with its command line, and the exit status is 1. An option that
+acts only beside another (the denoiser's settings beside --denoise svgf, the world guide's beside
+--guide-vertices world) brings that one with it, unless the run already chose otherwise. Fixed seeds: the same --seed draws the
 same runs. The long sweep is a slow check: README.md, "Robustness checks".
 
     python3 tools/cli_sweep.py [--runs 250] [--seed 3] [--binary build/rtpg] [--out DIR]
@@ -75,7 +79,30 @@ OPTIONS = [
     lambda r: ["--svgf-min-history", "1"],
     lambda r: ["--pg-reproject-view-memory", "2"],
     lambda r: ["--threads", str(r.choice([1, 3]))],
+    lambda r: ["--seed", str(r.choice([0, 7, 4294967295]))],
+    lambda r: ["--bounce-ray-order", r.choice(["grouped", "listed"])],
+    lambda r: ["--world-guide-pi-max", str(r.choice([0.2, 0.95]))],
+    lambda r: ["--world-guide-min-pi", str(r.choice([0.0, 0.5, 1.0]))],
+    lambda r: ["--pg-pi-min", str(r.choice([0.0, 0.1])), "--pg-pi-max", str(r.choice([0.5, 0.99]))],
+    lambda r: ["--pg-k-max", str(r.choice([1, 1000]))],
+    lambda r: ["--pg-weight-clamp", str(r.choice([1, 100]))],
+    lambda r: ["--pg-max-weight", str(r.choice([1, 1e30]))],
+    lambda r: ["--pg-train-all-samples", str(r.choice([0, 1]))],
+    lambda r: ["--pg-roughness-skip", str(r.choice([0, 0.5]))],
+    lambda r: ["--svgf-alpha-colour", str(r.choice([0, 1])),
+               "--svgf-alpha-moments", str(r.choice([0, 0.5]))],
+    lambda r: ["--svgf-max-history", str(r.choice([1, 4, 1000]))],
+    lambda r: ["--svgf-history-fallback", str(r.choice([0, 1]))],
+    lambda r: ["--svgf-depth-slope-from-normal", "1"],
+    lambda r: ["--svgf-history-atrous-radius", "1"],
+    lambda r: ["--svgf-phi-depth", str(r.choice([1e-6, 1e6])),
+               "--svgf-phi-luminance", str(r.choice([1e-6, 1e6]))],
+    lambda r: ["--svgf-reproject-position", str(r.choice([0, 10])),
+               "--svgf-reproject-normal", str(r.choice([-1, 1]))],
+    lambda r: ["--svgf-albedo-floor", str(r.choice([1e-6, 1]))],
 ]
+# An option that acts only beside another: the flag prefix and what it needs.
+NEEDS = [("--svgf-", ["--denoise", "svgf"]), ("--world-guide-", ["--guide-vertices", "world"])]
 
 
 def camera_path(scene):
@@ -99,10 +126,25 @@ def draw(r, k, out, scenes=None):
                 continue
             drawn = [path if a == "PATH" else a for a in drawn]
         args += drawn
+    for prefix, needed in NEEDS:
+        if any(a.startswith(prefix) for a in args) and needed[0] not in args:
+            args += needed
     if "--denoise" in args and r.random() < 0.3:
         files["noisy"] = out / f"n{k}.exr"
         args += ["--save-frames", "0", "--noisy-output", str(files["noisy"])]
     return args, files
+
+
+def nonfinite_values(path):
+    """NaN and infinite values in an image, by `oiiotool --stats` (OpenImageIO's tools, which
+    tools/setup.sh installs)."""
+    out = subprocess.run(["oiiotool", "--stats", str(path)], capture_output=True, text=True).stdout
+    count = 0
+    for line in out.splitlines():
+        words = line.split()
+        if len(words) > 2 and words[0] == "Stats" and words[1] in ("NanCount:", "InfCount:"):
+            count += sum(int(w) for w in words[2:])
+    return count
 
 
 def verdict(result, files, args):
@@ -121,11 +163,16 @@ def verdict(result, files, args):
             return f"{nonfinite} non-finite samples"
         if not files["output"].is_file():
             return "exit 0 without the output EXR"
+        for name, path in files.items():
+            if path.suffix == ".exr" and path.is_file():
+                bad = nonfinite_values(path)
+                if bad:
+                    return f"{bad} NaN or infinite values in the {name} image {path.name}"
         return None
-    # Exit 2 is an input the program refused (InputError, GuiderError; host/app/main.cpp) and 3
-    # an OpenCL failure; 1 is any other exception, an internal fault that a valid combination of
-    # options reached, never a clean refusal.
-    if result.returncode in (2, 3):
+    # Exit 2 is an input the program refused (InputError, GuiderError; host/app/main.cpp); 1 is
+    # any other exception and 3 an OpenCL failure, faults that a combination of options reached,
+    # never a clean refusal.
+    if result.returncode == 2:
         if not stderr or not stderr[-1].startswith("rtpg:"):
             return f"exit {result.returncode} without an 'rtpg:' message: {stderr[-1:]}"
         left = [str(p) for p in files.values() if p.exists()]

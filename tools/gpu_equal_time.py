@@ -10,7 +10,7 @@ on stdout and everything in OUT/results.json.
 Run from the repository's root (the scenes and bench/suite are read from there), with RTPG_BINARY
 the bundle's rtpg and the bundle's environment (LD_LIBRARY_PATH, OCL_ICD_VENDORS, RTPG_DEVICE):
     RTPG_BINARY=DIR/bin/rtpg python3 tools/gpu_equal_time.py --out OUT [--scenes ...] [--res WxH]
-        [--frames 32] [--repeats 3] [--ref-spp 1024] [--pg-args "ARGS"] [--references-only]
+        [--frames 32] [--repeats 4] [--ref-spp 1024] [--pg-args "ARGS"] [--references-only]
 --pg-args adds rtpg arguments to the guided runs alone (a variant of guiding against the same path
 tracing, say "--guide-vertices world"). --references-only makes the references in OUT/references
 and stops: references take minutes of host time, which a CPU machine can spend instead of the GPU
@@ -34,7 +34,8 @@ def main():
     parser.add_argument("--scenes", nargs="+", default=["cornell-box", "sunlit-room", "cornell-glossy"])
     parser.add_argument("--res", default="960x540")
     parser.add_argument("--frames", type=int, default=32)
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--repeats", type=int, default=4,
+                        help="even: each order of the pair of runs as often (equal_time.method_order)")
     parser.add_argument("--ref-spp", type=int, default=1024)
     parser.add_argument("--pg-args", default="", help="more rtpg arguments for the guided runs only")
     parser.add_argument("--references-only", action="store_true")

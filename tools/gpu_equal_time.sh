@@ -12,7 +12,7 @@
 #           a copy of ../shared/scenes/cornell-box for cornell-glossy, say; Sponza's 122 MB do not
 #           fit the lease's transfer).
 # SCENES (default: the Cornell box, the sunlit room, cornell-indirect), RES (960x540), FRAMES
-# (32), REPEATS (5); VARIANT: rtpg arguments for a second guided run against the same path
+# (32), REPEATS (4: even, so that each order of a pair of runs comes as often); VARIANT: rtpg arguments for a second guided run against the same path
 # tracing (empty: none); TESTS: the test binaries run at the end (the OpenCL ones by default);
 # T1, T2 (300, 180 s): the time each table may take, so that the tests and results still come
 # back inside the lease's call. FRAME_RUNS (empty: none): after the tests, the bundle's run.sh
@@ -46,7 +46,7 @@ export LD_LIBRARY_PATH=$g/lib PYTHONUNBUFFERED=1 RTPG_BINARY=$g/bin/rtpg
   grep -m1 'model name' /proc/cpuinfo; "$g/bin/rtpg" devices; } > "$out/machine.txt" 2>&1
 cat "$out/machine.txt"
 scenes=${SCENES:-cornell-box sunlit-room cornell-indirect}
-common=(--res "${RES:-960x540}" --frames "${FRAMES:-32}" --repeats "${REPEATS:-5}")
+common=(--res "${RES:-960x540}" --frames "${FRAMES:-32}" --repeats "${REPEATS:-4}")
 mkdir -p /tmp/et/references
 [ -d "$refs" ] && cp "$refs"/* /tmp/et/references/
 echo "== path tracing against the default guiding"

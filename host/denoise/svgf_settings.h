@@ -42,8 +42,8 @@ struct SvgfSettings {
   int history_atrous_radius = 2;
   int history_iteration = 0;     // the iteration whose output is next frame's history
   int local_x = 0, local_y = 0;  // work-group size of the kernels; 0 and 0 = per device:
-                                 // on CPUs temporal and remodulate in rows, the filters in
-                                 // 16x16; 16x16 elsewhere (host/cl/work_groups.h)
+                                 // on CPUs every kernel in rows (each reads its neighbours
+                                 // from global memory); 16x16 elsewhere (host/cl/work_groups.h)
   // Pixels per work-item of the variance and a-trous kernels: 1 (svgf_variance.cl,
   // svgf_atrous.cl), or 2, 4, 8, 16 in vector lanes (svgf_variance_wide.cl,
   // svgf_atrous_wide.cl); 0 = the device's SIMD width on CPUs, 1 elsewhere

@@ -57,12 +57,24 @@ void write_png(const std::string& path, int width, int height,
 }
 
 ImageRgb read_image(const std::string& path, int expected_width, int expected_height) {
-  if (!fs::exists(path)) throw InputError(path, "no such file");
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw InputError(path, "no such file");
+  // A FIFO or a device would block the read or never end.
+  if (!fs::is_regular_file(path, ec)) throw InputError(path, "not a file");
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw InputError(path, "cannot read image: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.depth > 1) throw InputError(path, "volume images are not supported");
   if (spec.nchannels <= 0) throw InputError(path, "image has no channels");
+  // Radiance is linear and unbounded: an 8-bit image (a tonemapped PNG) is no reference, and its
+  // relMSE against radiance would mean nothing.
+  if (!spec.format.is_floating_point())
+    throw InputError(path, "not a radiance image (stored as " + std::string(spec.format.c_str()) +
+                               "; a reference is a float EXR, as rtpg reference writes)");
+  // The header may claim any number of channels; only the first three are read, and a reference
+  // has at most four (RGBA).
+  if (spec.nchannels > 4)
+    throw InputError(path, fmt::format("{} channels (a reference has 3 or 4)", spec.nchannels));
   if (expected_width > 0 && expected_height > 0 &&
       (spec.width != expected_width || spec.height != expected_height))
     throw InputError(path, fmt::format("image is {}x{}, expected {}x{}", spec.width, spec.height,

@@ -45,7 +45,9 @@ Texture read_opened(OIIO::ImageInput& in, const std::string& name, ImageDecode d
   const bool eight_bit = spec.format == OIIO::TypeDesc::UINT8;
   const std::size_t count = static_cast<std::size_t>(spec.width) *
                             static_cast<std::size_t>(spec.height) * static_cast<std::size_t>(nch);
-  std::vector<float> values(count);
+  // One of the two holds the texels: an 8-bit image never touches the floats (4 bytes a
+  // channel, 4 GiB for a 16384^2 RGBA PNG the size limits accept).
+  std::vector<float> values(eight_bit ? 0 : count);
   std::vector<unsigned char> bytes;
   bool ok;
   if (eight_bit) {
@@ -158,6 +160,8 @@ Texture load_image(const std::string& path, ImageDecode decode) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
   if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory");
+  // A FIFO or a device would block the read or never end.
+  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "not a file");
   const OIIO::ImageSpec config = read_config();
   std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(path, &config);
   if (!in) throw InputError(path, reason(OIIO::geterror(), "not a readable image"));

@@ -121,6 +121,12 @@ MeshFile load_mesh_file(const std::string& path, TextureCache* textures,
   if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found" + where);
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "not a file" + where);
   const std::string ext = lower_extension(path);
+  // Only the formats scenes/README.md names, by their extensions: for any other name assimp
+  // picks a reader by the file's content, so an OBJ or PLY named .txt or .dat would skip the
+  // checks below and reach readers that crash on malformed input (docs/robustness.md,
+  // "Fuzzing"), and every other assimp reader would be reachable unchecked.
+  if (ext != ".obj" && ext != ".ply" && ext != ".gltf" && ext != ".glb")
+    throw InputError(path, "not a mesh format rtpg reads (.obj, .ply, .gltf or .glb)" + where);
   if (ext == ".obj") check_obj(path, context, textures != nullptr);
   if (ext == ".ply") check_ply(path, context);
 

@@ -183,7 +183,7 @@ void check_obj(const std::string& path, const std::string& context, bool with_ma
     const Place at{path, context, line, ""};
     if (keyword == "v" || keyword == "vn" || keyword == "vt" || keyword == "vp") {
       check_vertex_statement(split(text), at);
-    } else if (keyword == "mtllib" && with_materials) {
+    } else if (keyword == "mtllib") {
       // assimp ignores a missing .mtl and gives every surface its default grey.
       std::string name = text.substr(end == std::string::npos ? text.size() : end);
       name.erase(0, name.find_first_not_of(" \t"));
@@ -196,8 +196,14 @@ void check_obj(const std::string& path, const std::string& context, bool with_ma
     const std::filesystem::path mtl = std::filesystem::path(path).parent_path() / name;
     const std::string mtl_context = "mtllib of " + path + ", " + context;
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(mtl, ec))
+    if (!std::filesystem::is_regular_file(mtl, ec)) {
+      // Without materials from the file (the scene overrides them) a missing library costs
+      // nothing: assimp skips it.
+      if (!with_materials) continue;
       throw InputError(mtl.lexically_normal().string(), "file not found (" + mtl_context + ")");
+    }
+    // Checked also where the scene overrides the materials: assimp parses the library anyway,
+    // and its reader crashes on some malformed ones (docs/robustness.md, "Fuzzing").
     check_mtl(mtl.string(), mtl_context);
   }
 }

@@ -13,7 +13,8 @@ namespace rtpg {
 // number of the vertex statements (v, vn, vt, vp) and of the MTL statements is finite, fits a
 // float, has at most kMaxNumberLength characters and lies in its statement's range, and every
 // mtllib names a file that exists. `context` says where the file was named (a scene key).
-// Without with_materials (the scene replaces them) the MTL libraries are not read.
+// Without with_materials (the scene replaces them) a missing MTL library is no error, but one
+// that exists is checked all the same: assimp parses it whatever the scene does.
 void check_obj(const std::string& path, const std::string& context, bool with_materials);
 
 // Longer numeric tokens are refused: no float needs more (9 significant digits, a sign, a

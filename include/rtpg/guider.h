@@ -278,10 +278,11 @@ class Guider {
   // memory they wrap) untouched until it has waited.
   enum class Wait { finish, later };
   // Writes out's channels from a G-buffer the host packed (PG_PACKED_GBUFFER_CHANNELS;
-  // kernels/shared/gbuffer_packing.h packs) and the frame's cameras, from which the depth, the
-  // view direction and the motion vector follow (pg_gbuffer_cameras, whose width and height
-  // must be the guider's): for a device with memory of its own, where the packed form sends a
-  // third of the layout's bytes. out must be made with KernelAccess::read_write.
+  // kernels/shared/gbuffer_packing.h packs) and the frame's cameras, from which, with the depth
+  // it sends, the position, the view direction and the motion vector follow (pg_gbuffer_cameras,
+  // whose width and height must be the guider's): for a device with memory of its own, where
+  // the packed form sends a quarter of the layout's bytes (24 of 96). out must be made with
+  // KernelAccess::read_write.
   void unpack_gbuffer(const GuiderPackedGBuffer& packed, const GuiderGBuffer& out,
                       const pg_gbuffer_cameras& cameras, Wait wait = Wait::finish);
   // Writes out from samples' directions, densities and strategies (PG_PACKED_SAMPLE_CHANNELS;
@@ -292,7 +293,7 @@ class Guider {
   // Writes out's channels from VPLs the host packed (PG_PACKED_VPL_CHANNELS; kernels/shared/
   // vpl_packing.h packs), the G-buffer they were found from and the frame's first samples
   // (sample 0's, which the VPLs followed: their directions, densities and strategies): for a
-  // device with memory of its own, where the packed form sends 12 bytes a pixel instead of 32.
+  // device with memory of its own, where the packed form sends 10 bytes a pixel instead of 32.
   // out, and first_samples, must be made with KernelAccess::read_write.
   void unpack_vpls(const GuiderPackedVpls& packed, const GuiderGBuffer& gbuffer,
                    const GuiderSamples& first_samples, const GuiderVpls& out,

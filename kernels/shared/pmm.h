@@ -306,14 +306,20 @@ PG_FN pg_pmm_state pg_pmm_update(pg_pmm_state s, pg_pmm_batch b, pg_kernel_setti
     batch.s1 = pg_make_float4(b.axx * w, b.ayy * w, b.axy * w, 0.0f);
     k = 0.0f;
   } else {
-    /* Skip a batch that gives the Gaussian nothing: at eta = 1 it would zero S0. */
-    if (!(b.ag > 0.0f)) return s;
-    /* With pi_learning the batch's mixing weight is not EM's ag / a but one Newton step on the
+    /* A batch that gives the Gaussian nothing (every lit sample far from the lobe: its density
+     * underflows to 0 beyond about 0.6 of the square for a mature lobe) is still a step: S0 and
+     * the Gaussian's moments shrink together by 1 - eta, so the mean and the covariance stay,
+     * while W moves to the batch and pi falls, as stepwise EM does. (Skipping it froze the whole
+     * model, pi included, on a lobe that no longer saw any light: docs/guiding.md, "A batch that
+     * gives the Gaussian nothing".) eta < 1 here (k > 0), and a step that would zero S0 is
+     * refused below.
+     * With pi_learning the batch's mixing weight is not EM's ag / a but one Newton step on the
      * convex M(pi) from the E-step's pi: its Gaussian statistics are scaled to that weight, so
      * the running pi follows the variance-optimal one at the EM step size while the lobe's
-     * mean and covariance (ratios of these statistics) stay EM's. */
+     * mean and covariance (ratios of these statistics) stay EM's; with ag = 0 there is nothing
+     * to scale. */
     float scale = 1.0f;
-    if (p.pi_learning && b.v2 > 0.0f && isfinite(b.v1) && isfinite(b.v2))
+    if (p.pi_learning && b.ag > 0.0f && b.v2 > 0.0f && isfinite(b.v1) && isfinite(b.v2))
       scale = clamp(b.model_pi + 0.5f * b.v1 / b.v2, p.pi_min, p.pi_max) * b.a / b.ag;
     float ag = b.ag * scale * inv;
     batch.s0 = pg_make_float4(b.a * inv, ag, b.agx * scale * inv, b.agy * scale * inv);
@@ -367,7 +373,9 @@ PG_FN pg_pmm_state pg_pmm_train(pg_pmm_state s, PG_PRIVATE const float4* samples
       b = pg_pmm_batch_add_terms(b, m, terms, p, samples[j].x,
                                  pg_make_float2(samples[j].y, samples[j].z), samples[j].w,
                                  densities[j], history_weight);
-    /* A re-seed replaces the history: later passes refine the new model alone. */
+    /* A re-seed replaces the history with a new model, the batch's plain moments, which later
+     * passes' responsibilities do not change: they give the same state again (spent work, at
+     * most em_passes - 1 passes of a re-seeding pixel). */
     if (pg_pmm_batch_reseeds(b, p)) base = pg_pmm_initial_state();
     out = pg_pmm_update(base, b, p, target_count, updated);
     if (!*updated) return s;

@@ -179,7 +179,7 @@ static inline pg_pmm_state_w pg_pmm_update_w(pg_pmm_state_w s, pg_pmm_batch_w b,
   /* pi_learning: the batch's Gaussian statistics at the Newton step's weight. */
   pg_floatw scale = (pg_floatw)(1.0f);
   if (p.pi_learning) {
-    pg_intw learn = (b.v2 > 0.0f) & isfinite(b.v1) & isfinite(b.v2);
+    pg_intw learn = (b.ag > 0.0f) & (b.v2 > 0.0f) & isfinite(b.v1) & isfinite(b.v2);
     scale = select(scale, clamp(b.model_pi + 0.5f * b.v1 / b.v2, p.pi_min, p.pi_max) * b.a / b.ag,
                    learn);
   }
@@ -205,9 +205,9 @@ static inline pg_pmm_state_w pg_pmm_update_w(pg_pmm_state_w s, pg_pmm_batch_w b,
   out.syy = s.syy + (batch.syy - s.syy) * eta;
   out.sxy = s.sxy + (batch.sxy - s.sxy) * eta;
   out.k = fmin(k + 1.0f, p.k_max);
-  /* Skip a batch that gives the Gaussian nothing: at eta = 1 it would zero S0. */
-  *updated = (b.count > 0.0f) & (b.a > 0.0f) & (fresh | (b.ag > 0.0f)) &
-             pg_pmm_state_finite_w(batch) & pg_pmm_state_finite_w(out) & (out.s0 > 0.0f);
+  /* A batch that gives the Gaussian nothing is a step too (pg_pmm_update). */
+  *updated = (b.count > 0.0f) & (b.a > 0.0f) & pg_pmm_state_finite_w(batch) &
+             pg_pmm_state_finite_w(out) & (out.s0 > 0.0f);
   return pg_pmm_state_select_w(s, out, *updated);
 }
 

@@ -420,6 +420,24 @@ TEST_F(Cli, RejectsAHugeOrNonFiniteReference) {
   expect_rejected(render("--res 16x16 --reference nan.exr"), "pixel (5, 2) is not finite");
 }
 
+// A reference is radiance: a tonemapped 8-bit PNG (relMSE against it would mean nothing) and a
+// header claiming more channels than RGBA are refused before any pixel is read.
+TEST_F(Cli, RejectsAReferenceThatIsNoRadianceImage) {
+  const RunResult made = run_rtpg(dir(), "render --res 16x16 --spp 1 --guiding off -q -o ref.png");
+  ASSERT_EQ(made.exit_code, 0) << describe(made);
+  expect_rejected(render("--res 16x16 --reference ref.png"), "ref.png");
+  {
+    const std::vector<float> pixels(16 * 16 * 5, 0.5f);
+    auto out = OIIO::ImageOutput::create("five.exr");
+    ASSERT_TRUE(out);
+    const OIIO::ImageSpec spec(16, 16, 5, OIIO::TypeDesc::FLOAT);
+    ASSERT_TRUE(out->open((dir() / "five.exr").string(), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    ASSERT_TRUE(out->close());
+  }
+  expect_rejected(render("--res 16x16 --reference five.exr"), "5 channels");
+}
+
 TEST_F(Cli, RejectsMissingReference) {
   expect_rejected(render("--res 16x16 --reference gone.exr"), "gone.exr");
 }

@@ -29,5 +29,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     rtpg::load_mesh_file(mesh, &cache, "fuzz");
   } catch (const rtpg::InputError&) {
   }
+  // Again as a scene that overrides the mesh's materials reads it (no texture cache): assimp
+  // still parses the MTL there.
+  try {
+    rtpg::load_mesh_file(mesh, nullptr, "fuzz");
+  } catch (const rtpg::InputError&) {
+  }
   return 0;
 }

@@ -160,7 +160,8 @@ HostGBuffer random_gbuffer(Random& r, int w, int h) {
 // later rows shows the surface of the pixel above it in the group's first row (its position a
 // hundredth of a pixel away, its normal and material), and keeps its own flags and material
 // parameters, so that it shares that pixel's model where both are sharable (pg_shares_model).
-// In every sixteenth column the two face -x, half a degree apart, on the two sides of z = 0,
+// In every sixteenth column (from the 16th: the smallest images keep their sharing pixels for the
+// counts below) the two face -x, half a degree apart, on the two sides of z = 0,
 // where their frames are half a turn apart and no model may be shared.
 void share_rows(HostGBuffer& g, int rows_per_model) {
   const float4 wall_above(glm::normalize(float3(-1.0f, 0.002f, 0.004f)), 0.0f);
@@ -173,7 +174,7 @@ void share_rows(HostGBuffer& g, int rows_per_model) {
       const std::size_t m = static_cast<std::size_t>(model_y) * g.width + x;
       g.position_depth[i] = g.position_depth[m] + float4(1e-4f, 0.0f, 0.0f, 0.0f);
       g.shading_normal[i] = g.shading_normal[m];
-      if (x % 16 == 1) {
+      if (x % 16 == 15) {
         g.shading_normal[m] = wall_above;
         g.shading_normal[i] = wall_below;
       }

@@ -523,6 +523,48 @@ TEST(PmmEm, UnusableWeightsLeaveTheStateUnchanged) {
   }
 }
 
+// A batch whose lit samples all lie far from a mature, narrow lobe gives the Gaussian nothing (its
+// density underflows to 0 there). Stepwise EM still takes the step: S0 and the Gaussian's moments
+// shrink together, so the lobe's mean and covariance stay while pi falls, and a lobe that no
+// longer sees light fades. Skipping such batches froze the model, pi included, for good (a
+// reprojected lobe pointing where the light was, a light that moved).
+TEST(PmmEm, ABatchThatGivesTheGaussianNothingLowersPiAndKeepsTheLobe) {
+  for (const int pi_learning : {0, 1}) {
+    SCOPED_TRACE("pi_learning " + std::to_string(pi_learning));
+    rtpg::GuidingSettings settings;
+    settings.pi_learning = pi_learning;
+    const pg_kernel_settings p = rtpg::to_kernel_settings(settings);
+    const pg_pmm_state start = make_state(0.8f, 0.5f, 2e-4f, 2e-4f, 0.0f, 0.5f, 32.0f);
+    // One lit sample 0.7 of the square away (about 17 standard deviations), four dark ones.
+    const std::vector<std::pair<float, float2>> batch = {{10.0f, float2(0.1f, 0.5f)},
+                                                         {0.0f, float2(0.2f, 0.2f)},
+                                                         {0.0f, float2(0.3f, 0.7f)},
+                                                         {0.0f, float2(0.6f, 0.1f)},
+                                                         {0.0f, float2(0.9f, 0.9f)}};
+    pg_pmm_state s = start;
+    int updated = 0;
+    s = update_with(s, p, batch, &updated);
+    EXPECT_EQ(updated, 1);
+    const pg_pmm_model after = pg_pmm_model_from_state(s, p);
+    ASSERT_TRUE(after.valid);
+    // The model of the start's statistics at the step's new age (the covariance prior follows
+    // the age): the same mean and covariance.
+    pg_pmm_state aged = start;
+    aged.s1.w = s.s1.w;
+    const pg_pmm_model before = pg_pmm_model_from_state(aged, p);
+    ASSERT_TRUE(before.valid);
+    EXPECT_GT(s.s1.w, start.s1.w - 0.5f);  // an update, not a re-seed (k 0 or 1)
+    EXPECT_NEAR(after.mx, before.mx, 1e-6f);
+    EXPECT_NEAR(after.my, before.my, 1e-6f);
+    EXPECT_NEAR(after.l11, before.l11, 1e-5f * before.l11);
+    EXPECT_NEAR(after.l21, before.l21, 1e-5f);
+    EXPECT_NEAR(after.l22, before.l22, 1e-5f * before.l22);
+    EXPECT_LT(after.pi, pg_pmm_model_from_state(start, p).pi);
+    for (int step = 1; step < 100; ++step) s = update_with(s, p, batch, &updated);
+    EXPECT_LT(pg_pmm_model_from_state(s, p).pi, 0.25f) << "the lobe kept its weight";
+  }
+}
+
 // pg_pmm_batch_add_terms documents that NaN, negative and absurd weights are dropped: mixed into a
 // good batch they change nothing (compared to the good batch alone, up to float rounding).
 TEST(PmmEm, UnusableWeightsMixedIntoAGoodBatchAreDropped) {

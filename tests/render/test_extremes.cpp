@@ -81,7 +81,13 @@ GuidedRun run_guided(const Scene& scene, int size, int frames, const std::string
   GuidedRun run;
   std::vector<float> state;
   for (int f = 0; f < frames; ++f) {
-    renderer.render_frame(f);
+    // The path tracer replaces a non-finite estimate by 0 and counts it, so the image alone
+    // cannot show one: the count must stay 0.
+    const std::uint64_t nonfinite = renderer.render_frame(f).nonfinite_samples;
+    if (nonfinite != 0) {
+      ADD_FAILURE() << "frame " << f << ": " << nonfinite << " non-finite samples";
+      return run;
+    }
     double sum = 0.0;
     for (const glm::vec3& c : renderer.image()) {
       if (!(c.x >= 0.0f && c.y >= 0.0f && c.z >= 0.0f && std::isfinite(c.x) && std::isfinite(c.y) &&

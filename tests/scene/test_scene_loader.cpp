@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
@@ -1003,6 +1004,43 @@ TEST(SceneLoaderErrors, MissingMtlFile) {
   expect_input_error([&] { load_scene(dir / "s.json"); }, {"lost.mtl", "not found", "s.json"});
 }
 
+// A scene that replaces a mesh's materials still has assimp parse the MTL the OBJ names, so the
+// library is checked all the same (assimp 5.2 crashed on this one, a texture before any newmtl:
+// tests/fuzz/corpus/mtl/texture-before-newmtl.mtl); a missing one stays harmless there.
+TEST(SceneLoaderErrors, AMaterialOverrideStillChecksTheMtl) {
+  TempDir dir;
+  write_file(dir / "m.obj", "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  write_file(dir / "bad.mtl", "map_d9\n\n");
+  write_file(dir / "s.json",
+             simple_scene(R"("meshes": [{"file": "m.obj", "material": "white"}],)"));
+  expect_input_error([&] { load_scene(dir / "s.json"); }, {"bad.mtl", "s.json"});
+  fs::remove(dir / "bad.mtl");
+  EXPECT_NO_THROW(load_scene(dir / "s.json"));
+}
+
+// Meshes are read only in the formats scenes/README.md names, by extension: for another name
+// assimp would pick a reader by the content, past the OBJ and PLY checks (a PLY named .dat that
+// trips assimp's triangulation assert: tests/fuzz/corpus/ply/two-format-lines-triangulation-
+// assert.ply), or reach any of its other readers.
+TEST(SceneLoaderErrors, MeshesOnlyInTheFormatsNamed) {
+  TempDir dir;
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n"
+      "0 1 0\n3 0 1 2\n";
+  for (const char* name : {"m.dat", "m.txt", "m.stl", "m"}) {
+    write_file(dir / name, ply);
+    write_file(dir / "s.json", simple_scene(std::string(R"("meshes": [{"file": ")") + name +
+                                            R"(", "material": "white"}],)"));
+    expect_input_error([&] { load_scene(dir / "s.json"); }, {name, "not a mesh format", "s.json"});
+  }
+  write_file(dir / "m.ply", ply);
+  write_file(dir / "s.json",
+             simple_scene(R"("meshes": [{"file": "m.ply", "material": "white"}],)"));
+  EXPECT_NO_THROW(load_scene(dir / "s.json"));
+}
+
 TEST(SceneLoaderErrors, MissingTexture) {
   TempDir dir;
   write_file(dir / "s.json", simple_scene("", R"("t": {"base_color_texture": "tex/absent.png"},)"));
@@ -1032,6 +1070,15 @@ TEST(SceneLoaderErrors, CorruptTexture) {
   const std::string subject = (dir / "model/tex/height.png") + ": ";
   EXPECT_EQ(message.rfind(subject, 0), 0u) << message;  // the subject first, and once
   EXPECT_EQ(message.find(subject, 1), std::string::npos) << message;
+}
+
+// A texture or an environment map that is a FIFO would block the read for good: refused before
+// it is opened (the asset lookup takes regular files only, and load_image checks the kind too).
+TEST(SceneLoaderErrors, ATextureThatIsNoFile) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo((dir / "pipe.png").c_str(), 0600), 0);
+  write_file(dir / "s.json", simple_scene("", R"("t": {"base_color_texture": "pipe.png"},)"));
+  expect_input_error([&] { load_scene(dir / "s.json"); }, {"pipe.png", "s.json"});
 }
 
 TEST(SceneLoaderErrors, MissingEnvironmentMap) {
