@@ -297,6 +297,10 @@ int run_render(const RenderCommand& command) {
       throw InputError("--save-frames", fmt::format("frame {} is outside 0..{} (--frames {})", f,
                                                     command.frames - 1, command.frames));
   check_max_bounces(command.max_bounces);
+  if (command.guide_vertices == "all" && command.guiding != "pmm")
+    throw InputError("--guide-vertices",
+                     "all borrows the pixels' guided mixtures: it needs "
+                     "--guiding pmm");
   if (command.accumulate && !command.settings.camera_path.empty())
     throw InputError("--accumulate", "needs a static camera: it would average the views along '" +
                                          command.settings.camera_path + "'");
@@ -581,6 +585,8 @@ int run_reference(const ReferenceCommand& command) {
   settings.path_tracer.bounce_ray_order = parse_bounce_ray_order(command.bounce_ray_order);
   settings.camera_path = command.camera_path;
   if (command.frame < 0) throw InputError("--frame", "must not be negative");
+  if (command.frame != 0 && command.camera_path.empty())
+    throw InputError("--frame", "needs --camera-path (the scene's static camera has one view)");
   settings.camera_frame = command.frame;
   // Several samples share a G-buffer; new jitter per pass gives the pixel filter's integral.
   settings.spp = command.spp % 4 == 0 ? 4 : 1;

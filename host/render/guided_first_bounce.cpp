@@ -221,16 +221,22 @@ GuidedFirstBounce::~GuidedFirstBounce() {
 
 void GuidedFirstBounce::unmap_samples() {
   if (!mapped_) return;
-  mapped_ = false;
+  // Each pointer is cleared once its unmap is enqueued, and mapped_ only after all of them: an
+  // unmap that fails leaves the buffers still mapped to the next call, instead of mapped behind
+  // a flag that says they are not (the sample kernel would then write a mapped buffer).
   translate_cl_errors([&] {
     cl::CommandQueue& q = runtime_.queue();
-    q.enqueueUnmapMemObject(samples_.direction_pdf, const_cast<glm::vec4*>(view_.direction_pdf));
-    q.enqueueUnmapMemObject(samples_.strategy, const_cast<std::uint32_t*>(view_.strategy));
-    if (view_.mixture_a != nullptr) {
-      q.enqueueUnmapMemObject(samples_.mixture_a, const_cast<glm::vec4*>(view_.mixture_a));
-      q.enqueueUnmapMemObject(samples_.mixture_b, const_cast<glm::vec2*>(view_.mixture_b));
-    }
+    const auto unmap = [&](const cl::Buffer& buffer, const auto*& pointer) {
+      if (pointer == nullptr) return;
+      q.enqueueUnmapMemObject(buffer, const_cast<void*>(static_cast<const void*>(pointer)));
+      pointer = nullptr;
+    };
+    unmap(samples_.direction_pdf, view_.direction_pdf);
+    unmap(samples_.strategy, view_.strategy);
+    unmap(samples_.mixture_a, view_.mixture_a);
+    unmap(samples_.mixture_b, view_.mixture_b);
   });
+  mapped_ = false;
   view_ = SampleView{};
 }
 
@@ -367,6 +373,9 @@ FirstBounceSamples GuidedFirstBounce::finish_sample() {
 void GuidedFirstBounce::enqueue_sample_transfer(SampleOutputs outputs) {
   const std::size_t n = pixels_;
   if (zero_copy_) {
+    // Marked mapped before the first map: each pointer is set as its map returns, so a map that
+    // fails leaves the ones before it for unmap_samples to release.
+    mapped_ = true;
     translate_cl_errors([&] {
       cl::CommandQueue& q = runtime_.queue();
       auto map = [&](const cl::Buffer& b, std::size_t bytes) {
@@ -378,7 +387,6 @@ void GuidedFirstBounce::enqueue_sample_transfer(SampleOutputs outputs) {
         view_.mixture_a = static_cast<const glm::vec4*>(map(samples_.mixture_a, 16));
         view_.mixture_b = static_cast<const glm::vec2*>(map(samples_.mixture_b, 8));
       }
-      mapped_ = true;
     });
     if (!shares_host_memory_) bytes_ += sample_bytes_per_pixel(outputs) * n;
     return;

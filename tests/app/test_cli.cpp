@@ -337,6 +337,17 @@ TEST_F(Cli, RejectsStatsJsonInAFolderThatTakesNoFilesBeforeWritingTheImage) {
       "/proc/rtpg-noisy.exr");
 }
 
+// Options that would be parsed and do nothing: a camera path's frame without the path, later
+// vertices borrowing the mixtures of a render that has none.
+TEST_F(Cli, RejectsOptionsThatWouldDoNothing) {
+  expect_rejected("reference " + source_dir() +
+                      "/scenes/cornell-box.json --res 8x8 --spp 1 "
+                      "-o ref.exr --frame 3",
+                  "--frame", {"ref.exr"});
+  expect_rejected("render --res 8x8 --guiding off --guide-vertices all -o out.exr",
+                  "--guide-vertices", {"out.exr"});
+}
+
 // --accumulate averages frames of one view; along a camera path it would blur the path.
 TEST_F(Cli, RejectsAccumulatingAlongACameraPath) {
   expect_rejected(render("--res 16x16 --frames 2 --accumulate --camera-path pan"), "--accumulate");
