@@ -2,6 +2,7 @@
 """Checks of the reference cache's source hash (bench/suite/runner.py; run by ctest): which sources can
 change what `rtpg reference` renders, and that the hash follows them and only them; and of the binary
 fingerprint the variant sweep keys its renders by."""
+import contextlib
 import os
 import shutil
 import sys
@@ -11,6 +12,26 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from suite import runner  # noqa: E402
+
+
+def set_environment(values):
+    """Sets each variable of `values`, or unsets it where its value is None."""
+    for k, v in values.items():
+        if v is None:
+            os.environ.pop(k, None)
+        else:
+            os.environ[k] = v
+
+
+@contextlib.contextmanager
+def environment(**values):
+    """The environment with `values` set (None: unset) for the block, as it was after it."""
+    saved = {k: os.environ.get(k) for k in values}
+    try:
+        set_environment(values)
+        yield
+    finally:
+        set_environment(saved)
 
 
 class BinaryFingerprintTests(unittest.TestCase):
@@ -24,10 +45,7 @@ class BinaryFingerprintTests(unittest.TestCase):
             (root / "k" / "include" / "rtpg").mkdir(parents=True)
             (kernels / "wide" / "lanes.h").write_text("// lanes\n")
             (root / "k" / "include" / "rtpg" / "guiding_layout.h").write_text("// layout\n")
-            saved = {k: os.environ.get(k) for k in ("RTPG_BINARY", "RTPG_KERNEL_DIR")}
-            try:
-                os.environ["RTPG_BINARY"] = str(binary)
-                os.environ.pop("RTPG_KERNEL_DIR", None)
+            with environment(RTPG_BINARY=str(binary), RTPG_KERNEL_DIR=None):
                 base = runner.binary_fingerprint()
                 self.assertEqual(runner.binary_fingerprint(), base)
                 binary.write_bytes(b"second build")
@@ -41,12 +59,6 @@ class BinaryFingerprintTests(unittest.TestCase):
                 edited = runner.binary_fingerprint()
                 (root / "k" / "include" / "rtpg" / "guiding_layout.h").write_text("// layout, edited\n")
                 self.assertNotEqual(runner.binary_fingerprint(), edited)
-            finally:
-                for k, v in saved.items():
-                    if v is None:
-                        os.environ.pop(k, None)
-                    else:
-                        os.environ[k] = v
 
 
     def test_follows_the_program_a_script_runs(self):
@@ -56,22 +68,13 @@ class BinaryFingerprintTests(unittest.TestCase):
             script, program = Path(d) / "wrapper.sh", Path(d) / "rtpg"
             script.write_text('#!/usr/bin/env bash\nexec "$RTPG" "$@"\n')
             program.write_bytes(b"first build")
-            saved = {k: os.environ.get(k) for k in ("RTPG_BINARY", "RTPG", "RTPG_KERNEL_DIR")}
-            try:
-                os.environ.update(RTPG_BINARY=str(script), RTPG=str(program))
-                os.environ.pop("RTPG_KERNEL_DIR", None)
+            with environment(RTPG_BINARY=str(script), RTPG=str(program), RTPG_KERNEL_DIR=None):
                 self.assertEqual(runner.rtpg_executable(), program)
                 base = runner.binary_fingerprint()
                 program.write_bytes(b"second build")
                 self.assertNotEqual(runner.binary_fingerprint(), base)
                 os.environ["RTPG_BINARY"] = str(program)
                 self.assertEqual(runner.rtpg_executable(), program)
-            finally:
-                for k, v in saved.items():
-                    if v is None:
-                        os.environ.pop(k, None)
-                    else:
-                        os.environ[k] = v
 
 
 class BuiltAfterSourcesTests(unittest.TestCase):
@@ -85,9 +88,7 @@ class BuiltAfterSourcesTests(unittest.TestCase):
                 (root / rel).write_text("// " + rel + "\n")
             program = root / "rtpg"
             program.write_bytes(b"build")
-            saved = os.environ.get("RTPG_BINARY")
-            try:
-                os.environ["RTPG_BINARY"] = str(program)
+            with environment(RTPG_BINARY=str(program)):
                 os.utime(program, (2000, 2000))
                 for rel in ("host/render/path_tracer.cpp", "host/guiding/guider.cpp"):
                     os.utime(root / rel, (1000, 1000))
@@ -98,11 +99,6 @@ class BuiltAfterSourcesTests(unittest.TestCase):
                 with self.assertRaises(SystemExit) as refused:
                     runner.check_built_after_sources(root)
                 self.assertIn("host/render/path_tracer.cpp", str(refused.exception))
-            finally:
-                if saved is None:
-                    os.environ.pop("RTPG_BINARY", None)
-                else:
-                    os.environ["RTPG_BINARY"] = saved
 
 
 class ReferenceSourceTests(unittest.TestCase):

@@ -412,22 +412,26 @@ TEST_F(Cli, RejectsAnOutputThatIsAFolder) {
                   "folder.exr", {"out.exr"});
 }
 
+// A float EXR of any channel count, written by OpenImageIO (references the program must refuse).
+void write_float_exr(const fs::path& path, int width, int height, int channels,
+                     const std::vector<float>& pixels) {
+  auto out = OIIO::ImageOutput::create(path.string());
+  ASSERT_TRUE(out);
+  const OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
+  ASSERT_TRUE(out->open(path.string(), spec));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+  ASSERT_TRUE(out->close());
+}
+
 // A reference whose header claims another size is refused before its pixels are allocated (a
 // 55-byte HDR file claiming 100000x100000 pixels used to end in std::bad_alloc), and one with a
 // NaN pixel is refused instead of making every relMSE NaN.
 TEST_F(Cli, RejectsAHugeOrNonFiniteReference) {
   write("huge.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n");
   expect_rejected(render("--res 16x16 --reference huge.hdr"), "huge.hdr");
-  {
-    std::vector<float> pixels(16 * 16 * 3, 0.5f);
-    pixels[3 * 37 + 1] = std::nanf("");
-    auto out = OIIO::ImageOutput::create("nan.exr");
-    ASSERT_TRUE(out);
-    const OIIO::ImageSpec spec(16, 16, 3, OIIO::TypeDesc::FLOAT);
-    ASSERT_TRUE(out->open((dir() / "nan.exr").string(), spec));
-    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
-    ASSERT_TRUE(out->close());
-  }
+  std::vector<float> pixels(16 * 16 * 3, 0.5f);
+  pixels[3 * 37 + 1] = std::nanf("");
+  write_float_exr(dir() / "nan.exr", 16, 16, 3, pixels);
   expect_rejected(render("--res 16x16 --reference nan.exr"), "pixel (5, 2) is not finite");
 }
 
@@ -437,15 +441,7 @@ TEST_F(Cli, RejectsAReferenceThatIsNoRadianceImage) {
   const RunResult made = run_rtpg(dir(), "render --res 16x16 --spp 1 --guiding off -q -o ref.png");
   ASSERT_EQ(made.exit_code, 0) << describe(made);
   expect_rejected(render("--res 16x16 --reference ref.png"), "ref.png");
-  {
-    const std::vector<float> pixels(16 * 16 * 5, 0.5f);
-    auto out = OIIO::ImageOutput::create("five.exr");
-    ASSERT_TRUE(out);
-    const OIIO::ImageSpec spec(16, 16, 5, OIIO::TypeDesc::FLOAT);
-    ASSERT_TRUE(out->open((dir() / "five.exr").string(), spec));
-    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
-    ASSERT_TRUE(out->close());
-  }
+  write_float_exr(dir() / "five.exr", 16, 16, 5, std::vector<float>(16 * 16 * 5, 0.5f));
   expect_rejected(render("--res 16x16 --reference five.exr"), "5 channels");
 }
 

@@ -430,6 +430,38 @@ TEST(SvgfQuality, RemovesNoiseAndKeepsAnEdgeOfTheLighting) {
   }
 }
 
+// A white plane facing the camera at depth 2, one surface: with one value in every pixel the
+// filters are the identity, which the temporal tests rely on.
+GBuffer white_plane_gbuffer(int w, int h) {
+  GBuffer g;
+  g.resize(w, h);
+  for (std::size_t i = 0; i < g.pixel_count(); ++i) {
+    g.flags[i] = 0;
+    g.position_depth[i] = glm::vec4(0.01f * (i % w), 0.01f * (i / w), 2.0f, 2.0f);
+    g.shading_normal[i] = glm::vec4(0, 0, 1, 0);
+    g.base_color_roughness[i] = glm::vec4(1.0f, 1.0f, 1.0f, 0.5f);
+  }
+  return g;
+}
+
+// A plane facing the camera whose right half is a depth step (3 against 2) or, at equal depth,
+// faces +x (a normal step): the two edge tests' surfaces.
+GBuffer two_sided_gbuffer(int w, int h, bool normal_edge) {
+  GBuffer g;
+  g.resize(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const bool right = x >= w / 2;
+      const float depth = right && !normal_edge ? 3.0f : 2.0f;
+      g.flags[i] = 0;
+      g.position_depth[i] = glm::vec4(0.01f * x, 0.01f * y, depth, depth);
+      g.shading_normal[i] = right && normal_edge ? glm::vec4(1, 0, 0, 0) : glm::vec4(0, 0, 1, 0);
+      g.base_color_roughness[i] = glm::vec4(0.5f, 0.5f, 0.5f, 0.5f);
+    }
+  return g;
+}
+
 // Two constant regions side by side: a depth step, then a normal step at equal depth. Neither
 // leaks into the other, though the a-trous taps reach 32 pixels across (16 with the 3x3 kernel).
 TEST(SvgfKernels, EdgesOfDepthAndNormalAreNotBlurred) {
@@ -439,21 +471,11 @@ TEST(SvgfKernels, EdgesOfDepthAndNormalAreNotBlurred) {
     for (const bool normal_edge : {false, true}) {
       SCOPED_TRACE(std::string(normal_edge ? "normal edge" : "depth edge") + ", a-trous radius " +
                    std::to_string(radius));
-      GBuffer g;
-      g.resize(w, h);
+      const GBuffer g = two_sided_gbuffer(w, h, normal_edge);
       std::vector<glm::vec3> colour(g.pixel_count());
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          const std::size_t i = static_cast<std::size_t>(y) * w + x;
-          const bool right = x >= w / 2;
-          const float depth = right && !normal_edge ? 3.0f : 2.0f;
-          g.flags[i] = 0;
-          g.position_depth[i] = glm::vec4(0.01f * x, 0.01f * y, depth, depth);
-          g.shading_normal[i] =
-              right && normal_edge ? glm::vec4(1, 0, 0, 0) : glm::vec4(0, 0, 1, 0);
-          g.base_color_roughness[i] = glm::vec4(0.5f, 0.5f, 0.5f, 0.5f);
-          colour[i] = right ? glm::vec3(2.0f, 1.0f, 0.5f) : glm::vec3(0.1f, 0.2f, 0.3f);
-        }
+      for (std::size_t i = 0; i < colour.size(); ++i)
+        colour[i] = static_cast<int>(i % w) >= w / 2 ? glm::vec3(2.0f, 1.0f, 0.5f)
+                                                     : glm::vec3(0.1f, 0.2f, 0.3f);
       SvgfSettings s;
       s.atrous_radius = radius;
       s.history_atrous_radius = radius;
@@ -479,19 +501,7 @@ TEST(SvgfKernels, EdgesOfDepthAndNormalStopTheFilterWhereLuminanceCannot) {
     for (const bool normal_edge : {false, true}) {
       SCOPED_TRACE(std::string(normal_edge ? "normal edge" : "depth edge") + ", lanes " +
                    std::to_string(lanes));
-      GBuffer g;
-      g.resize(w, h);
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          const std::size_t i = static_cast<std::size_t>(y) * w + x;
-          const bool on_right = x >= w / 2;
-          const float depth = on_right && !normal_edge ? 3.0f : 2.0f;
-          g.flags[i] = 0;
-          g.position_depth[i] = glm::vec4(0.01f * x, 0.01f * y, depth, depth);
-          g.shading_normal[i] =
-              on_right && normal_edge ? glm::vec4(1, 0, 0, 0) : glm::vec4(0, 0, 1, 0);
-          g.base_color_roughness[i] = glm::vec4(0.5f, 0.5f, 0.5f, 0.5f);
-        }
+      const GBuffer g = two_sided_gbuffer(w, h, normal_edge);
       SvgfSettings s;
       s.lanes = lanes;
       SvgfDenoiser device(rt, w, h, s);
@@ -548,14 +558,7 @@ TEST(SvgfKernels, TemporalAccumulationConvergesToTheMean) {
   ClRuntime rt;
   const int w = simulated(rt) ? 16 : 64, h = simulated(rt) ? 8 : 32, frames = 12;
   const int runs = simulated(rt) ? 3 : 10;
-  GBuffer g;
-  g.resize(w, h);
-  for (std::size_t i = 0; i < g.pixel_count(); ++i) {
-    g.flags[i] = 0;
-    g.position_depth[i] = glm::vec4(0.01f * (i % w), 0.01f * (i / w), 2.0f, 2.0f);
-    g.shading_normal[i] = glm::vec4(0, 0, 1, 0);
-    g.base_color_roughness[i] = glm::vec4(1.0f, 1.0f, 1.0f, 0.5f);
-  }
+  const GBuffer g = white_plane_gbuffer(w, h);
   for (const float alpha : {0.0f, 0.2f}) {
     SCOPED_TRACE("alpha " + std::to_string(alpha));
     SvgfSettings s;
@@ -608,14 +611,7 @@ TEST(SvgfKernels, TemporalAccumulationConvergesToTheMean) {
 TEST(SvgfKernels, TemporalAccumulationFollowsItsRecursion) {
   ClRuntime rt;
   const int w = 16, h = 8;
-  GBuffer g;
-  g.resize(w, h);
-  for (std::size_t i = 0; i < g.pixel_count(); ++i) {
-    g.flags[i] = 0;
-    g.position_depth[i] = glm::vec4(0.01f * (i % w), 0.01f * (i / w), 2.0f, 2.0f);
-    g.shading_normal[i] = glm::vec4(0, 0, 1, 0);
-    g.base_color_roughness[i] = glm::vec4(1.0f, 1.0f, 1.0f, 0.5f);
-  }
+  const GBuffer g = white_plane_gbuffer(w, h);
   SvgfSettings s;
   s.alpha_colour = 0.2f;
   s.alpha_moments = 0.5f;

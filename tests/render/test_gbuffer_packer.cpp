@@ -192,6 +192,17 @@ TEST(GBufferPacker, PackedTransferRefusesAMaterialIdThatDoesNotFit) {
   EXPECT_NO_THROW(sampler.begin_frame(g, SampleCoordinates{1, 2, 0}));
 }
 
+// The refusal tests' first frame: g's G-buffer, then a state of the sampler's own changed so
+// that it differs from anything reprojection derives (the state written, returned).
+std::vector<float> first_frame_with_a_state(GuidedFirstBounce& sampler, const GBuffer& g) {
+  std::vector<float> state;
+  sampler.begin_frame(g, SampleCoordinates{1, 0, 0});
+  sampler.guider().read_state(state);
+  for (std::size_t i = 0; i < state.size(); ++i) state[i] += 0.125f * static_cast<float>(i % 5);
+  sampler.guider().write_state(state);
+  return state;
+}
+
 // A refused frame leaves the sampler as it was: the next good frame reprojects from the last
 // good frame's G-buffer. Before, the refused frame had already swapped the two device G-buffers,
 // so the next one reprojected from a buffer never written (history lost, or on later frames a
@@ -203,12 +214,8 @@ TEST(GBufferPacker, ARefusedFrameLeavesTheHistoryAsItWas) {
   GuidedFirstBounce refused(cl, 19, 7, GuidingSettings{}, HostTransfer::packed);
   GuidedFirstBounce clean(cl, 19, 7, GuidingSettings{}, HostTransfer::packed);
   std::vector<float> state;
-  for (GuidedFirstBounce* sampler : {&refused, &clean}) {
-    sampler->begin_frame(g, SampleCoordinates{1, 0, 0});
-    sampler->guider().read_state(state);
-    for (std::size_t i = 0; i < state.size(); ++i) state[i] += 0.125f * static_cast<float>(i % 5);
-    sampler->guider().write_state(state);
-  }
+  for (GuidedFirstBounce* sampler : {&refused, &clean})
+    state = first_frame_with_a_state(*sampler, g);
   g.material[100] = PG_PACKED_MATERIAL_MAX + 1u;
   EXPECT_THROW(refused.begin_frame(g, SampleCoordinates{1, 1, 0}), GuiderError);
   g.material[100] = 0u;
@@ -245,13 +252,7 @@ TEST(GBufferPacker, AGBufferOfAnotherShapeIsRefusedAndLeavesTheHistory) {
     GuidedFirstBounce clean(cl, 19, 7, GuidingSettings{}, transfer, Overlap::off);
     // In place the two frames must be two G-buffers (reads_gbuffers_in_place).
     GBuffer second = g;
-    std::vector<float> state;
-    for (GuidedFirstBounce* sampler : {&refused, &clean}) {
-      sampler->begin_frame(g, SampleCoordinates{1, 0, 0});
-      sampler->guider().read_state(state);
-      for (std::size_t i = 0; i < state.size(); ++i) state[i] += 0.125f * static_cast<float>(i % 5);
-      sampler->guider().write_state(state);
-    }
+    for (GuidedFirstBounce* sampler : {&refused, &clean}) first_frame_with_a_state(*sampler, g);
     for (const GBuffer* bad : {&transposed, &smaller}) {
       try {
         refused.begin_frame(*bad, SampleCoordinates{1, 1, 0});
